@@ -1,0 +1,101 @@
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hila/core/mesh.hpp"
+#include "hila/core/pose.hpp"
+#include "hila/core/robot_model.hpp"
+
+namespace hila::core {
+
+struct CollisionModelImpl;
+struct CollisionDataImpl;
+
+// Rigid bodies (each a set of shapes), whether each is static, and which pairs may touch. Built
+// once, then shared read-only between threads; the per-thread mutable part is CollisionData.
+class CollisionModel {
+ public:
+  CollisionModel();
+  ~CollisionModel();
+  CollisionModel(CollisionModel&&) noexcept;
+  CollisionModel& operator=(CollisionModel&&) noexcept;
+
+  // Adds a body made of `shapes` (each with its origin in the body frame). Mesh shapes are loaded
+  // from their files. Returns the body index.
+  int add_body(const std::string& name, const std::vector<GeometrySpec>& shapes, bool is_static,
+               const Pose& pose = Pose::Identity());
+  int add_mesh_body(const std::string& name, const TriangleMesh& mesh, bool is_static,
+                    const Pose& pose = Pose::Identity());
+  void allow(int body_a, int body_b);
+  void allow(const std::string& body_a, const std::string& body_b);  // throws if unknown
+  // Removes the body from all checks (keeps indices stable).
+  void set_enabled(int body, bool enabled);
+
+  int num_bodies() const;
+  const std::string& body_name(int body) const;
+  std::optional<int> find_body(const std::string& name) const;
+  bool is_static(int body) const;
+  bool is_enabled(int body) const;
+  bool allowed(int body_a, int body_b) const;
+  const Pose& initial_pose(int body) const;
+
+  const CollisionModelImpl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<CollisionModelImpl> impl_;
+};
+
+// Per-thread state: body poses and FCL broad-phase structures. Create one per thread.
+class CollisionData {
+ public:
+  explicit CollisionData(const CollisionModel& model);
+  ~CollisionData();
+  CollisionData(CollisionData&&) noexcept;
+  CollisionData& operator=(CollisionData&&) noexcept;
+
+  void set_body_pose(int body, const Pose& pose);
+  const Pose& body_pose(int body) const;
+
+  CollisionDataImpl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<CollisionDataImpl> impl_;
+};
+
+struct CollisionPair {
+  int body_a = -1;
+  int body_b = -1;
+  double distance = 0.0;  // for distance queries
+};
+
+// Any collision between enabled bodies, except static-static and allowed pairs. Broad-phase
+// (FCL dynamic AABB trees) over the static and the moving bodies. Stops at the first contact and
+// reports its pair.
+bool in_collision(const CollisionModel& model, CollisionData& data,
+                  CollisionPair* first = nullptr);
+// The same answer by testing every candidate pair with FCL's narrow phase (reference for tests).
+bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
+                              CollisionPair* first = nullptr);
+// Smallest distance over the same pairs (negative or zero when in collision).
+double min_distance(const CollisionModel& model, CollisionData& data,
+                    CollisionPair* closest = nullptr);
+
+std::string describe_pair(const CollisionModel& model, const CollisionPair& pair);
+
+// Maps a robot's links to collision bodies (one body per link with collision geometry).
+struct RobotBodies {
+  std::vector<int> link_to_body;  // -1 for links without geometry
+};
+
+// Adds the robot's links as moving bodies named prefix + link name, and allows each link with
+// the nearest ancestor that has geometry (links joined through geometry-less frames touch).
+RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std::string& prefix);
+
+// Sets every link body's pose to base * link_poses[link].
+void set_robot_pose(CollisionData& data, const RobotBodies& bodies,
+                    const std::vector<Pose>& link_poses, const Pose& base = Pose::Identity());
+
+}  // namespace hila::core

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "hila/core/pose.hpp"
+#include "hila/core/robot_model.hpp"
+
+namespace hila::core {
+
+using Jacobian = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+// The serial chain of a RobotModel between a base link and a tip link (the base must be an
+// ancestor of the tip). Fixed joints are folded away and every movable joint is normalised to
+// rotate about (or slide along) local z, so forward kinematics is one sin/cos and one rigid
+// product per joint. Immutable after construction, so it is safe to share between threads.
+class KinematicChain {
+ public:
+  KinematicChain(const RobotModel& model, const std::string& base_link,
+                 const std::string& tip_link);
+
+  int dof() const { return static_cast<int>(joint_types_.size()); }
+  const std::string& base_link() const { return base_link_; }
+  const std::string& tip_link() const { return tip_link_; }
+  const std::vector<std::string>& joint_names() const { return joint_names_; }
+  // Index into RobotModel's configuration vector for each chain joint.
+  const std::vector<int>& model_variables() const { return model_variables_; }
+  const Eigen::VectorXd& lower_limits() const { return lower_; }
+  const Eigen::VectorXd& upper_limits() const { return upper_; }
+  bool within_limits(const Eigen::VectorXd& q, double tolerance = 0.0) const;
+
+  // Tip pose in the base frame.
+  Pose fk(const Eigen::VectorXd& q) const;
+  // Geometric Jacobian at the tip origin, rows [linear velocity; angular velocity], base frame.
+  Jacobian jacobian(const Eigen::VectorXd& q) const;
+  // Both at once (the Jacobian needs the frames anyway).
+  void fk_and_jacobian(const Eigen::VectorXd& q, Pose& tip, Jacobian& jac) const;
+
+ private:
+  std::string base_link_;
+  std::string tip_link_;
+  std::vector<std::string> joint_names_;
+  std::vector<int> model_variables_;
+  std::vector<JointType> joint_types_;
+  // fixed_[0] * M(q0) * fixed_[1] * M(q1) * ... * fixed_[n], with M a motion about/along z.
+  std::vector<Pose> fixed_;
+  Eigen::VectorXd lower_;
+  Eigen::VectorXd upper_;
+};
+
+}  // namespace hila::core

@@ -1,0 +1,336 @@
+#include "hila/core/collision.hpp"
+
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/cylinder.h>
+#include <fcl/geometry/shape/sphere.h>
+#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/distance.h>
+#include <limits>
+
+#include "hila/core/error.hpp"
+
+namespace hila::core {
+
+using FclGeometry = std::shared_ptr<fcl::CollisionGeometryd>;
+
+struct BodyModel {
+  std::string name;
+  std::vector<FclGeometry> geometries;
+  std::vector<Pose> offsets;
+  bool is_static = false;
+  bool enabled = true;
+  Pose initial_pose = Pose::Identity();
+};
+
+struct CollisionModelImpl {
+  std::vector<BodyModel> bodies;
+  std::vector<std::vector<bool>> allowed;
+};
+
+namespace {
+
+FclGeometry make_mesh_geometry(const TriangleMesh& mesh, const Eigen::Vector3d& scale) {
+  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
+  std::vector<fcl::Vector3d> points;
+  points.reserve(mesh.vertices.size());
+  for (const auto& v : mesh.vertices) points.emplace_back(v.cwiseProduct(scale));
+  std::vector<fcl::Triangle> triangles;
+  triangles.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  bvh->beginModel();
+  bvh->addSubModel(points, triangles);
+  bvh->endModel();
+  bvh->computeLocalAABB();
+  return bvh;
+}
+
+FclGeometry make_geometry(const GeometrySpec& spec) {
+  FclGeometry g;
+  switch (spec.type) {
+    case GeometrySpec::Type::Box:
+      g = std::make_shared<fcl::Boxd>(spec.box_size);
+      break;
+    case GeometrySpec::Type::Cylinder:
+      g = std::make_shared<fcl::Cylinderd>(spec.radius, spec.length);
+      break;
+    case GeometrySpec::Type::Sphere:
+      g = std::make_shared<fcl::Sphered>(spec.radius);
+      break;
+    case GeometrySpec::Type::Mesh:
+      return make_mesh_geometry(load_mesh(spec.mesh_path, 1.0), spec.mesh_scale);
+  }
+  g->computeLocalAABB();
+  return g;
+}
+
+}  // namespace
+
+CollisionModel::CollisionModel() : impl_(std::make_unique<CollisionModelImpl>()) {}
+CollisionModel::~CollisionModel() = default;
+CollisionModel::CollisionModel(CollisionModel&&) noexcept = default;
+CollisionModel& CollisionModel::operator=(CollisionModel&&) noexcept = default;
+
+int CollisionModel::add_body(const std::string& name, const std::vector<GeometrySpec>& shapes,
+                             bool is_static, const Pose& pose) {
+  if (find_body(name)) {
+    throw InputError("collision scene", "body '" + name + "'", "a unique body name",
+                     "a duplicate");
+  }
+  BodyModel body;
+  body.name = name;
+  body.is_static = is_static;
+  body.initial_pose = pose;
+  for (const auto& s : shapes) {
+    body.geometries.push_back(make_geometry(s));
+    body.offsets.push_back(s.origin);
+  }
+  impl_->bodies.push_back(std::move(body));
+  for (auto& row : impl_->allowed) row.push_back(false);
+  impl_->allowed.emplace_back(impl_->bodies.size(), false);
+  return num_bodies() - 1;
+}
+
+int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& mesh,
+                                  bool is_static, const Pose& pose) {
+  const int id = add_body(name, {}, is_static, pose);
+  impl_->bodies[id].geometries.push_back(make_mesh_geometry(mesh, Eigen::Vector3d::Ones()));
+  impl_->bodies[id].offsets.push_back(Pose::Identity());
+  return id;
+}
+
+void CollisionModel::allow(int a, int b) {
+  impl_->allowed[a][b] = true;
+  impl_->allowed[b][a] = true;
+}
+
+void CollisionModel::allow(const std::string& a, const std::string& b) {
+  const auto ia = find_body(a);
+  const auto ib = find_body(b);
+  if (!ia) throw InputError("collision scene", "allowed pair", "a known body name", "'" + a + "'");
+  if (!ib) throw InputError("collision scene", "allowed pair", "a known body name", "'" + b + "'");
+  allow(*ia, *ib);
+}
+
+void CollisionModel::set_enabled(int body, bool enabled) { impl_->bodies[body].enabled = enabled; }
+int CollisionModel::num_bodies() const { return static_cast<int>(impl_->bodies.size()); }
+const std::string& CollisionModel::body_name(int body) const { return impl_->bodies[body].name; }
+bool CollisionModel::is_static(int body) const { return impl_->bodies[body].is_static; }
+bool CollisionModel::is_enabled(int body) const { return impl_->bodies[body].enabled; }
+bool CollisionModel::allowed(int a, int b) const { return impl_->allowed[a][b]; }
+const Pose& CollisionModel::initial_pose(int body) const { return impl_->bodies[body].initial_pose; }
+
+std::optional<int> CollisionModel::find_body(const std::string& name) const {
+  for (int i = 0; i < num_bodies(); ++i) {
+    if (impl_->bodies[i].name == name) return i;
+  }
+  return std::nullopt;
+}
+
+// --- per-thread data -----------------------------------------------------------------------
+
+struct ShapeTag {
+  int body;
+};
+
+struct CollisionDataImpl {
+  const CollisionModelImpl* model = nullptr;
+  std::vector<Pose> body_poses;
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
+  std::vector<std::vector<int>> body_objects;
+  std::vector<ShapeTag> tags;
+  fcl::DynamicAABBTreeCollisionManagerd static_manager;
+  fcl::DynamicAABBTreeCollisionManagerd moving_manager;
+  bool moving_dirty = true;
+  bool static_dirty = true;
+};
+
+CollisionData::CollisionData(const CollisionModel& model)
+    : impl_(std::make_unique<CollisionDataImpl>()) {
+  const auto& bodies = model.impl().bodies;
+  impl_->body_poses.resize(bodies.size());
+  impl_->body_objects.resize(bodies.size());
+  std::size_t total = 0;
+  for (const auto& b : bodies) total += b.geometries.size();
+  impl_->tags.reserve(total);  // tags are referenced by pointer: no reallocation
+  std::vector<fcl::CollisionObjectd*> static_objects;
+  std::vector<fcl::CollisionObjectd*> moving_objects;
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    impl_->body_poses[b] = bodies[b].initial_pose;
+    for (std::size_t s = 0; s < bodies[b].geometries.size(); ++s) {
+      auto object = std::make_unique<fcl::CollisionObjectd>(
+          bodies[b].geometries[s], bodies[b].initial_pose * bodies[b].offsets[s]);
+      object->computeAABB();
+      impl_->tags.push_back({static_cast<int>(b)});
+      object->setUserData(&impl_->tags.back());
+      impl_->body_objects[b].push_back(static_cast<int>(impl_->objects.size()));
+      if (bodies[b].enabled) {
+        (bodies[b].is_static ? static_objects : moving_objects).push_back(object.get());
+      }
+      impl_->objects.push_back(std::move(object));
+    }
+  }
+  impl_->static_manager.registerObjects(static_objects);
+  impl_->static_manager.setup();
+  impl_->moving_manager.registerObjects(moving_objects);
+  impl_->moving_manager.setup();
+  impl_->model = &model.impl();
+}
+
+CollisionData::~CollisionData() = default;
+CollisionData::CollisionData(CollisionData&&) noexcept = default;
+CollisionData& CollisionData::operator=(CollisionData&&) noexcept = default;
+
+void CollisionData::set_body_pose(int body, const Pose& pose) {
+  auto& d = *impl_;
+  d.body_poses[body] = pose;
+  const auto& offsets = d.model->bodies[body].offsets;
+  const auto& objs = d.body_objects[body];
+  for (std::size_t s = 0; s < objs.size(); ++s) {
+    auto& object = *d.objects[objs[s]];
+    object.setTransform(pose * offsets[s]);
+    object.computeAABB();
+  }
+  if (d.model->bodies[body].is_static) {
+    d.static_dirty = true;
+  } else {
+    d.moving_dirty = true;
+  }
+}
+
+const Pose& CollisionData::body_pose(int body) const { return impl_->body_poses[body]; }
+
+namespace {
+
+struct QueryContext {
+  const CollisionModelImpl* model;
+  CollisionPair* pair;
+  bool hit = false;
+  double min_distance = std::numeric_limits<double>::infinity();
+};
+
+inline bool skip_pair(const CollisionModelImpl& m, int a, int b) {
+  if (a == b) return true;
+  if (!m.bodies[a].enabled || !m.bodies[b].enabled) return true;
+  if (m.bodies[a].is_static && m.bodies[b].is_static) return true;
+  return m.allowed[a][b];
+}
+
+bool collide_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* raw) {
+  auto* ctx = static_cast<QueryContext*>(raw);
+  const int a = static_cast<ShapeTag*>(o1->getUserData())->body;
+  const int b = static_cast<ShapeTag*>(o2->getUserData())->body;
+  if (skip_pair(*ctx->model, a, b)) return false;
+  fcl::CollisionRequestd request;
+  fcl::CollisionResultd result;
+  if (fcl::collide(o1, o2, request, result) > 0) {
+    ctx->hit = true;
+    if (ctx->pair) *ctx->pair = {std::min(a, b), std::max(a, b), 0.0};
+    return true;  // stop at the first contact
+  }
+  return false;
+}
+
+bool distance_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* raw,
+                       double& dist) {
+  auto* ctx = static_cast<QueryContext*>(raw);
+  const int a = static_cast<ShapeTag*>(o1->getUserData())->body;
+  const int b = static_cast<ShapeTag*>(o2->getUserData())->body;
+  if (skip_pair(*ctx->model, a, b)) {
+    dist = ctx->min_distance;
+    return false;
+  }
+  fcl::DistanceRequestd request;
+  request.enable_signed_distance = true;
+  fcl::DistanceResultd result;
+  const double d = fcl::distance(o1, o2, request, result);
+  if (d < ctx->min_distance) {
+    ctx->min_distance = d;
+    if (ctx->pair) *ctx->pair = {std::min(a, b), std::max(a, b), d};
+  }
+  dist = ctx->min_distance;
+  return false;
+}
+
+void refresh(CollisionDataImpl& d) {
+  if (d.moving_dirty) {
+    d.moving_manager.update();
+    d.moving_dirty = false;
+  }
+  if (d.static_dirty) {
+    d.static_manager.update();
+    d.static_dirty = false;
+  }
+}
+
+}  // namespace
+
+bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPair* first) {
+  auto& d = data.impl();
+  refresh(d);
+  QueryContext ctx{&model.impl(), first};
+  d.moving_manager.collide(&ctx, collide_callback);
+  if (!ctx.hit) d.moving_manager.collide(&d.static_manager, &ctx, collide_callback);
+  return ctx.hit;
+}
+
+bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
+                              CollisionPair* first) {
+  auto& d = data.impl();
+  QueryContext ctx{&model.impl(), first};
+  for (std::size_t i = 0; i < d.objects.size(); ++i) {
+    for (std::size_t j = i + 1; j < d.objects.size(); ++j) {
+      if (collide_callback(d.objects[i].get(), d.objects[j].get(), &ctx)) return true;
+    }
+  }
+  return false;
+}
+
+double min_distance(const CollisionModel& model, CollisionData& data, CollisionPair* closest) {
+  auto& d = data.impl();
+  refresh(d);
+  QueryContext ctx{&model.impl(), closest};
+  d.moving_manager.distance(&ctx, distance_callback);
+  d.moving_manager.distance(&d.static_manager, &ctx, distance_callback);
+  return ctx.min_distance;
+}
+
+std::string describe_pair(const CollisionModel& model, const CollisionPair& pair) {
+  if (pair.body_a < 0) return "none";
+  return model.body_name(pair.body_a) + " <-> " + model.body_name(pair.body_b);
+}
+
+RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std::string& prefix) {
+  RobotBodies bodies;
+  bodies.link_to_body.assign(robot.links().size(), -1);
+  for (std::size_t l = 0; l < robot.links().size(); ++l) {
+    const Link& link = robot.links()[l];
+    if (link.collisions.empty()) continue;
+    bodies.link_to_body[l] = model.add_body(prefix + link.name, link.collisions, false);
+  }
+  for (std::size_t l = 0; l < robot.links().size(); ++l) {
+    if (bodies.link_to_body[l] < 0) continue;
+    // Walk up to the nearest ancestor with geometry.
+    int link = static_cast<int>(l);
+    while (true) {
+      const int j = robot.links()[link].parent_joint;
+      if (j < 0) break;
+      link = robot.joints()[j].parent_link;
+      if (bodies.link_to_body[link] >= 0) {
+        model.allow(bodies.link_to_body[l], bodies.link_to_body[link]);
+        break;
+      }
+    }
+  }
+  return bodies;
+}
+
+void set_robot_pose(CollisionData& data, const RobotBodies& bodies,
+                    const std::vector<Pose>& link_poses, const Pose& base) {
+  for (std::size_t l = 0; l < bodies.link_to_body.size(); ++l) {
+    if (bodies.link_to_body[l] >= 0) data.set_body_pose(bodies.link_to_body[l], base * link_poses[l]);
+  }
+}
+
+}  // namespace hila::core

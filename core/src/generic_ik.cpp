@@ -1,0 +1,88 @@
+#include "hila/core/generic_ik.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+namespace hila::core {
+
+Eigen::Matrix<double, 6, 1> pose_error(const Pose& target, const Pose& current) {
+  Eigen::Matrix<double, 6, 1> e;
+  e.head<3>() = target.translation() - current.translation();
+  const Eigen::AngleAxisd aa(target.linear() * current.linear().transpose());
+  e.tail<3>() = aa.angle() * aa.axis();
+  return e;
+}
+
+Eigen::VectorXd random_configuration(const KinematicChain& chain, std::mt19937_64& rng) {
+  Eigen::VectorXd q(chain.dof());
+  for (int i = 0; i < chain.dof(); ++i) {
+    const double lo = std::max(chain.lower_limits()[i], -kPi);
+    const double hi = std::min(chain.upper_limits()[i], kPi);
+    q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
+  }
+  return q;
+}
+
+GenericIkResult solve_ik(const KinematicChain& chain, const Pose& target,
+                         const Eigen::VectorXd& seed, std::mt19937_64& rng,
+                         const GenericIkSettings& settings) {
+  GenericIkResult result;
+  const int n = chain.dof();
+  const int rows = settings.position_only ? 3 : 6;
+  Pose tip;
+  Jacobian jac;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int attempt = 0; attempt < settings.max_attempts; ++attempt) {
+    ++result.attempts;
+    Eigen::VectorXd q = attempt == 0 ? seed : random_configuration(chain, rng);
+    q = q.cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
+    double lambda = 1e-2;
+    chain.fk_and_jacobian(q, tip, jac);
+    Eigen::Matrix<double, 6, 1> e = pose_error(target, tip);
+    double cost = e.head(rows).squaredNorm();
+    for (int it = 0; it < settings.max_iterations; ++it) {
+      ++result.iterations;
+      if (e.head<3>().norm() < settings.position_tolerance &&
+          (settings.position_only || e.tail<3>().norm() < settings.orientation_tolerance)) {
+        break;
+      }
+      const Eigen::MatrixXd j = jac.topRows(rows);
+      Eigen::MatrixXd jjt = j * j.transpose();
+      jjt.diagonal().array() += lambda + settings.damping * settings.damping;
+      const Eigen::VectorXd dq = j.transpose() * jjt.ldlt().solve(e.head(rows));
+      const Eigen::VectorXd q_new =
+          (q + dq).cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
+      Pose tip_new;
+      Jacobian jac_new;
+      chain.fk_and_jacobian(q_new, tip_new, jac_new);
+      const Eigen::Matrix<double, 6, 1> e_new = pose_error(target, tip_new);
+      const double cost_new = e_new.head(rows).squaredNorm();
+      if (cost_new < cost) {
+        q = q_new;
+        tip = tip_new;
+        jac = jac_new;
+        e = e_new;
+        cost = cost_new;
+        lambda = std::max(lambda * 0.3, 1e-12);
+      } else {
+        lambda = std::min(lambda * 10.0, 1e6);
+        if (lambda >= 1e6) break;  // stuck in a local minimum or at a limit: restart
+      }
+    }
+    if (cost < best_cost) {
+      best_cost = cost;
+      result.q = q;
+      result.position_error = e.head<3>().norm();
+      result.orientation_error = settings.position_only ? 0.0 : e.tail<3>().norm();
+    }
+    // Converged when within tolerance after the loop's own test.
+    if (result.position_error < settings.position_tolerance * 10 &&
+        result.orientation_error < settings.orientation_tolerance * 10) {
+      result.success = true;
+      return result;
+    }
+  }
+  return result;
+}
+
+}  // namespace hila::core

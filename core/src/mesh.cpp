@@ -1,0 +1,140 @@
+#include "hila/core/mesh.hpp"
+
+#include <Eigen/Geometry>
+
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <filesystem>
+#include <memory>
+
+#include "hila/core/error.hpp"
+
+namespace hila::core {
+
+Eigen::Vector3d TriangleMesh::min_corner() const {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  for (const auto& v : vertices) lo = lo.cwiseMin(v);
+  return lo;
+}
+
+Eigen::Vector3d TriangleMesh::max_corner() const {
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  for (const auto& v : vertices) hi = hi.cwiseMax(v);
+  return hi;
+}
+
+namespace {
+void append_node(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent,
+                 double scale, TriangleMesh& out) {
+  const aiMatrix4x4 transform = parent * node->mTransformation;
+  for (unsigned m = 0; m < node->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
+    const int base = static_cast<int>(out.vertices.size());
+    for (unsigned i = 0; i < mesh->mNumVertices; ++i) {
+      const aiVector3D v = transform * mesh->mVertices[i];
+      out.vertices.emplace_back(v.x * scale, v.y * scale, v.z * scale);
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
+      out.triangles.push_back({base + static_cast<int>(face.mIndices[0]),
+                               base + static_cast<int>(face.mIndices[1]),
+                               base + static_cast<int>(face.mIndices[2])});
+    }
+  }
+  for (unsigned c = 0; c < node->mNumChildren; ++c) {
+    append_node(scene, node->mChildren[c], transform, scale, out);
+  }
+}
+}  // namespace
+
+TriangleMesh load_mesh(const std::string& path, double unit_scale) {
+  if (!(unit_scale > 0.0) || !std::isfinite(unit_scale)) {
+    throw InputError(path, "unit scale", "a positive metres-per-unit factor",
+                     format_number(unit_scale));
+  }
+  if (!std::filesystem::exists(path)) {
+    throw InputError(path, "(file)", "an existing mesh file", "no such file");
+  }
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw InputError(path, "(file)", "a mesh readable by assimp",
+                     std::string("'") + importer.GetErrorString() + "'");
+  }
+  TriangleMesh mesh;
+  append_node(scene, scene->mRootNode, aiMatrix4x4(), unit_scale, mesh);
+  if (mesh.triangles.empty()) {
+    throw InputError(path, "(mesh)", "at least one triangle", "an empty mesh");
+  }
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    if (!mesh.vertices[i].allFinite()) {
+      throw InputError(path, "vertex " + std::to_string(i), "finite coordinates",
+                       "NaN or infinite values");
+    }
+  }
+  return mesh;
+}
+
+TriangleMesh make_box_mesh(const Eigen::Vector3d& size) {
+  TriangleMesh mesh;
+  const Eigen::Vector3d h = size / 2.0;
+  for (int i = 0; i < 8; ++i) {
+    mesh.vertices.emplace_back((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                               (i & 4) ? h.z() : -h.z());
+  }
+  // Counter-clockwise seen from outside.
+  mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                    {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return mesh;
+}
+
+void write_mesh(const TriangleMesh& mesh, const std::string& path, const std::string& format_id) {
+  auto scene = std::make_unique<aiScene>();
+  scene->mRootNode = new aiNode();
+  scene->mMaterials = new aiMaterial*[1];
+  scene->mMaterials[0] = new aiMaterial();
+  scene->mNumMaterials = 1;
+  scene->mMeshes = new aiMesh*[1];
+  scene->mNumMeshes = 1;
+  auto* out = new aiMesh();
+  scene->mMeshes[0] = out;
+  out->mMaterialIndex = 0;
+  out->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  scene->mRootNode->mMeshes = new unsigned[1]{0};
+  scene->mRootNode->mNumMeshes = 1;
+  // One vertex triple per face with the face normal, so formats with per-face normals (STL)
+  // carry the true outward normal.
+  out->mNumFaces = static_cast<unsigned>(mesh.triangles.size());
+  out->mNumVertices = 3 * out->mNumFaces;
+  out->mVertices = new aiVector3D[out->mNumVertices];
+  out->mNormals = new aiVector3D[out->mNumVertices];
+  out->mFaces = new aiFace[out->mNumFaces];
+  for (unsigned f = 0; f < out->mNumFaces; ++f) {
+    const auto& t = mesh.triangles[f];
+    const Eigen::Vector3d n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                                  .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                                  .normalized();
+    out->mFaces[f].mNumIndices = 3;
+    out->mFaces[f].mIndices = new unsigned[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto& v = mesh.vertices[t[k]];
+      const unsigned index = 3 * f + static_cast<unsigned>(k);
+      out->mVertices[index] = aiVector3D(static_cast<ai_real>(v.x()), static_cast<ai_real>(v.y()),
+                                         static_cast<ai_real>(v.z()));
+      out->mNormals[index] = aiVector3D(static_cast<ai_real>(n.x()), static_cast<ai_real>(n.y()),
+                                        static_cast<ai_real>(n.z()));
+      out->mFaces[f].mIndices[k] = index;
+    }
+  }
+  Assimp::Exporter exporter;
+  if (exporter.Export(scene.get(), format_id, path) != AI_SUCCESS) {
+    throw InputError(path, "(export)", "a writable mesh file of format " + format_id,
+                     exporter.GetErrorString());
+  }
+}
+
+}  // namespace hila::core

@@ -1,0 +1,85 @@
+#include "hila/core/product.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include "hila/core/error.hpp"
+#include "hila/core/yaml_reader.hpp"
+
+namespace hila::core {
+
+double unit_scale_from_name(const std::string& unit, const std::string& file,
+                            const std::string& field) {
+  if (unit == "m") return 1.0;
+  if (unit == "cm") return 0.01;
+  if (unit == "mm") return 0.001;
+  if (unit == "in") return 0.0254;
+  throw InputError(file, field, "one of m, cm, mm, in", "'" + unit + "'");
+}
+
+const PartSpec& ProductSpec::part(const std::string& part_name) const {
+  for (const auto& p : parts) {
+    if (p.name == part_name) return p;
+  }
+  std::string names;
+  for (const auto& p : parts) names += (names.empty() ? "" : ", ") + p.name;
+  throw InputError(file, "part", "one of: " + names, "'" + part_name + "'");
+}
+
+ProductSpec load_product(const std::string& path) {
+  const YamlNode root = YamlNode::load_file(path);
+  root.expect_only({"name", "assembly_frame", "suction_tool_pose", "parts"});
+  ProductSpec product;
+  product.file = path;
+  product.name = root.at("name").as_string();
+  product.assembly_frame = root.at("assembly_frame").as_pose();
+  check_pose(product.assembly_frame, path, "assembly_frame");
+  product.suction_tool_pose = root.at("suction_tool_pose").as_pose();
+  check_pose(product.suction_tool_pose, path, "suction_tool_pose");
+  const YamlNode parts = root.at("parts");
+  if (!parts.is_sequence() || parts.size() == 0) parts.fail("a non-empty list of parts", "none");
+  std::set<std::string> names;
+  std::set<int> orders;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const YamlNode p = parts.at(i);
+    p.expect_only({"name", "mesh", "mesh_unit", "mass", "target", "initial", "order"});
+    PartSpec part;
+    part.name = p.at("name").as_string();
+    if (!names.insert(part.name).second) p.at("name").fail("a unique part name", "a duplicate");
+    part.mesh_file = p.resolve_path(p.at("mesh").as_string());
+    part.unit_scale = unit_scale_from_name(p.at("mesh_unit").as_string(), path, p.path() + ".mesh_unit");
+    part.mass = p.at("mass").as_positive();
+    if (part.mass > 100.0) p.at("mass").fail("a mass in kilograms below 100 (grams given?)", format_number(part.mass));
+    part.target = p.at("target").as_pose();
+    check_pose(part.target, path, p.path() + ".target");
+    part.initial = p.at("initial").as_pose();
+    check_pose(part.initial, path, p.path() + ".initial");
+    part.order = p.at("order").as_int();
+    if (!orders.insert(part.order).second) p.at("order").fail("a unique assembly order", "a duplicate");
+    part.mesh = load_mesh(part.mesh_file, part.unit_scale);
+    const Eigen::Vector3d extent = part.mesh.max_corner() - part.mesh.min_corner();
+    if (extent.maxCoeff() > 3.0) {
+      throw InputError(path, p.path() + ".mesh_unit",
+                       "a unit that gives a plausible part size (under 3 m)",
+                       format_number(extent.maxCoeff()) + " m across (is the mesh in mm?)");
+    }
+    if (extent.maxCoeff() < 0.005) {
+      throw InputError(path, p.path() + ".mesh_unit",
+                       "a unit that gives a plausible part size (over 5 mm)",
+                       format_number(extent.maxCoeff()) + " m across (is the mesh in m, not mm?)");
+    }
+    product.parts.push_back(std::move(part));
+  }
+  std::sort(product.parts.begin(), product.parts.end(),
+            [](const PartSpec& a, const PartSpec& b) { return a.order < b.order; });
+  for (std::size_t i = 0; i < product.parts.size(); ++i) {
+    if (product.parts[i].order != static_cast<int>(i) + 1) {
+      parts.fail("orders 1.." + std::to_string(product.parts.size()),
+                 "order " + std::to_string(product.parts[i].order) + " at position " +
+                     std::to_string(i + 1));
+    }
+  }
+  return product;
+}
+
+}  // namespace hila::core

@@ -1,0 +1,21 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+
+namespace hila::tools {
+
+// Each subcommand registers its options on `app` and returns the action to run when chosen.
+// Actions return the process exit status.
+using Action = std::function<int()>;
+
+void add_cell_command(CLI::App& app, Action& action);
+void add_human_command(CLI::App& app, Action& action);
+void add_mesh_command(CLI::App& app, Action& action);
+void add_product_command(CLI::App& app, Action& action);
+
+std::string default_cell_path();
+std::string default_product_path();
+
+}  // namespace hila::tools
