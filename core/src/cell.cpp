@@ -46,10 +46,12 @@ ArmSpec parse_arm(const YamlNode& node) {
       k->at("type").fail("'ur' or 'generic'", "'" + type + "'");
     }
   }
-  const std::size_t dof = node.at("home_deg").size();
-  arm.home = degrees_vector(node.at("home_deg"), dof);
-  arm.max_velocity = positive_degrees_vector(node.at("max_velocity_deg_s"), dof);
-  arm.max_acceleration = positive_degrees_vector(node.at("max_acceleration_deg_s2"), dof);
+  // Lengths are checked against the chain's DoF once the URDF is loaded (Cell::load).
+  arm.home = degrees_vector(node.at("home_deg"), node.at("home_deg").size());
+  arm.max_velocity =
+      positive_degrees_vector(node.at("max_velocity_deg_s"), node.at("max_velocity_deg_s").size());
+  arm.max_acceleration = positive_degrees_vector(node.at("max_acceleration_deg_s2"),
+                                                 node.at("max_acceleration_deg_s2").size());
   return arm;
 }
 
@@ -193,16 +195,31 @@ std::shared_ptr<const Cell> Cell::load(const std::string& path) {
     require_link(cell->robot_, path, field + ".tip_link", a.tip_link);
     require_link(cell->robot_, path, field + ".flange_link", a.flange_link);
     KinematicChain chain(cell->robot_, a.base_link, a.tip_link);
-    if (a.home.size() != chain.dof()) {
-      throw InputError(path, field + ".home_deg", std::to_string(chain.dof()) + " joint angles",
-                       std::to_string(a.home.size()));
+    const std::pair<const char*, const Eigen::VectorXd*> per_joint[] = {
+        {".home_deg", &a.home},
+        {".max_velocity_deg_s", &a.max_velocity},
+        {".max_acceleration_deg_s2", &a.max_acceleration}};
+    for (const auto& [name, values] : per_joint) {
+      if (values->size() != chain.dof()) {
+        throw InputError(path, field + name,
+                         std::to_string(chain.dof()) + " values (one per joint of " +
+                             a.base_link + " -> " + a.tip_link + ")",
+                         std::to_string(values->size()));
+      }
     }
     if (!chain.within_limits(a.home, 1e-9)) {
       throw InputError(path, field + ".home_deg", "angles inside the URDF joint limits",
                        "a value outside them");
     }
     std::optional<UrIk> ik;
-    if (a.ur_dh) ik.emplace(chain, *a.ur_dh);
+    if (a.ur_dh) {
+      try {
+        ik.emplace(chain, *a.ur_dh);
+      } catch (const InputError& e) {
+        throw InputError(path, field + ".kinematics",
+                         "UR DH parameters matching " + spec.robot_urdf, std::string("'") + e.what() + "'");
+      }
+    }
     // The jaw joint must be an independent prismatic joint of the robot.
     int finger_variable = -1;
     bool found = false;

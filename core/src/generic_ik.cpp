@@ -27,7 +27,6 @@ GenericIkResult solve_ik(const KinematicChain& chain, const Pose& target,
                          const Eigen::VectorXd& seed, std::mt19937_64& rng,
                          const GenericIkSettings& settings) {
   GenericIkResult result;
-  const int n = chain.dof();
   const int rows = settings.position_only ? 3 : 6;
   Pose tip;
   Jacobian jac;

@@ -13,7 +13,7 @@ namespace {
 
 std::string num(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.6g", std::abs(v) < 1e-12 ? 0.0 : v);
+  std::snprintf(buf, sizeof(buf), "%.10g", std::abs(v) < 1e-12 ? 0.0 : v);
   return buf;
 }
 

@@ -4,6 +4,7 @@
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <filesystem>
@@ -59,8 +60,13 @@ TriangleMesh load_mesh(const std::string& path, double unit_scale) {
     throw InputError(path, "(file)", "an existing mesh file", "no such file");
   }
   Assimp::Importer importer;
+  // Drop normals, colours and texture coordinates first so that vertices weld by position alone
+  // (an STL repeats every corner once per face).
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                                          aiComponent_COLORS | aiComponent_TEXCOORDS);
   const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+      path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                aiProcess_SortByPType);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw InputError(path, "(file)", "a mesh readable by assimp",
                      std::string("'") + importer.GetErrorString() + "'");

@@ -56,7 +56,12 @@ ProductSpec load_product(const std::string& path) {
     check_pose(part.initial, path, p.path() + ".initial");
     part.order = p.at("order").as_int();
     if (!orders.insert(part.order).second) p.at("order").fail("a unique assembly order", "a duplicate");
-    part.mesh = load_mesh(part.mesh_file, part.unit_scale);
+    try {
+      part.mesh = load_mesh(part.mesh_file, part.unit_scale);
+    } catch (const InputError& e) {
+      throw InputError(path, p.path() + ".mesh", "a readable, non-empty mesh with finite vertices",
+                       std::string("'") + e.what() + "'");
+    }
     const Eigen::Vector3d extent = part.mesh.max_corner() - part.mesh.min_corner();
     if (extent.maxCoeff() > 3.0) {
       throw InputError(path, p.path() + ".mesh_unit",

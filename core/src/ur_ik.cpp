@@ -117,15 +117,19 @@ int UrIk::solve(const Pose& tcp, const Vector6d& seed, UrIkSolutions& out) const
   for (int s1 = 0; s1 < 2; ++s1) {
     const double q1 = psi + (s1 == 0 ? phi : -phi) + kPi / 2;
     const double c1 = std::cos(q1), sn1 = std::sin(q1);
-    double q5abs = 0.0;
-    if (!safe_acos((p.x() * sn1 - p.y() * c1 - dh_.d4) / dh_.d6, q5abs)) continue;
+    // The joint-2 axis direction v = (s1, -c1, 0) seen from the flange gives the wrist angle in
+    // atan2 form (acos near +-1 would lose half the digits at the wrist singularity):
+    // cos q5 = a.v, sin q5 = +-|(n.v, o.v)|, and q6 from the direction of (n.v, -o.v).
+    const double nv = r(0, 0) * sn1 - r(1, 0) * c1;
+    const double ov = r(0, 1) * sn1 - r(1, 1) * c1;
+    const double av = r(0, 2) * sn1 - r(1, 2) * c1;
+    const double s5abs = std::hypot(nv, ov);
     for (int s5 = 0; s5 < 2; ++s5) {
-      const double q5 = s5 == 0 ? q5abs : -q5abs;
-      const double sn5 = std::sin(q5);
+      const double sign5 = s5 == 0 ? 1.0 : -1.0;
+      const double q5 = std::atan2(sign5 * s5abs, av);
       double q6 = 0.0;
-      if (std::abs(sn5) > 1e-10) {
-        // Rows of R06 are the base axes seen from the flange.
-        q6 = std::atan2((-r(0, 1) * sn1 + r(1, 1) * c1) / sn5, (r(0, 0) * sn1 - r(1, 0) * c1) / sn5);
+      if (s5abs > 1e-12) {
+        q6 = std::atan2(-sign5 * ov, sign5 * nv);
       } else {
         q6 = seed[5];  // wrist singularity: q4 and q6 share one rotation; keep the seed's q6
       }

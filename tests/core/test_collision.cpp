@@ -1,0 +1,206 @@
+#include "hila/core/collision.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <thread>
+
+#include "hila/core/generic_ik.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+core::GeometrySpec box(double x, double y, double z) {
+  core::GeometrySpec g;
+  g.type = core::GeometrySpec::Type::Box;
+  g.box_size = {x, y, z};
+  return g;
+}
+
+core::GeometrySpec sphere(double r) {
+  core::GeometrySpec g;
+  g.type = core::GeometrySpec::Type::Sphere;
+  g.radius = r;
+  return g;
+}
+
+struct Fixture {
+  std::shared_ptr<const core::Cell> cell = test::reference_cell();
+  core::CellScene scene = core::build_cell_scene(*cell);
+};
+
+Fixture& fixture() {
+  static Fixture f;
+  return f;
+}
+
+Eigen::VectorXd random_robot_q(const core::Cell& cell, std::mt19937_64& rng) {
+  Eigen::VectorXd q = cell.home_configuration();
+  for (const core::Arm& arm : cell.arms()) {
+    cell.set_arm(q, arm, core::random_configuration(arm.chain, rng));
+    cell.set_jaw(q, arm, std::uniform_real_distribution<double>(0.0, 0.085)(rng));
+  }
+  return q;
+}
+
+Eigen::VectorXd random_human_q(const core::Cell& cell, std::mt19937_64& rng) {
+  const Eigen::VectorXd lo = cell.human().lower_limits();
+  const Eigen::VectorXd hi = cell.human().upper_limits();
+  Eigen::VectorXd q(lo.size());
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    q[i] = std::uniform_real_distribution<double>(lo[i], hi[i])(rng);
+  }
+  return q;
+}
+
+}  // namespace
+
+TEST(Collision, HomeConfigurationIsCollisionFree) {
+  auto& f = fixture();
+  core::CollisionData data(f.scene.model);
+  core::set_cell_state(*f.cell, f.scene, data, f.cell->home_configuration(0.085),
+                       f.cell->human_neutral());
+  core::CollisionPair pair;
+  EXPECT_FALSE(core::in_collision(f.scene.model, data, &pair))
+      << core::describe_pair(f.scene.model, pair);
+  EXPECT_FALSE(core::in_collision_brute_force(f.scene.model, data));
+  EXPECT_GT(core::min_distance(f.scene.model, data), 0.0);
+}
+
+TEST(Collision, BroadPhaseAgreesWithBruteForceOnRandomConfigurations) {
+  auto& f = fixture();
+  core::CollisionData data(f.scene.model);
+  std::mt19937_64 rng(31);
+  int colliding = 0;
+  for (int i = 0; i < 600; ++i) {
+    core::set_cell_state(*f.cell, f.scene, data, random_robot_q(*f.cell, rng),
+                         i % 3 ? f.cell->human_neutral() : random_human_q(*f.cell, rng));
+    core::CollisionPair fast_pair, slow_pair;
+    const bool fast = core::in_collision(f.scene.model, data, &fast_pair);
+    const bool slow = core::in_collision_brute_force(f.scene.model, data, &slow_pair);
+    ASSERT_EQ(fast, slow) << "configuration " << i << ": broad phase says "
+                          << core::describe_pair(f.scene.model, fast_pair) << ", brute force "
+                          << core::describe_pair(f.scene.model, slow_pair);
+    if (fast) {
+      ++colliding;
+      // The reported pair really collides and is not an allowed pair.
+      EXPECT_FALSE(f.scene.model.allowed(fast_pair.body_a, fast_pair.body_b));
+    }
+  }
+  // Random configurations of two arms collide often, but not always: both branches are tested.
+  EXPECT_GT(colliding, 50);
+  EXPECT_LT(colliding, 580);
+}
+
+TEST(Collision, ArmPushedIntoTheTableCollidesWithTheTable) {
+  auto& f = fixture();
+  const core::Arm& arm = f.cell->arm("left");
+  std::vector<core::Pose> links;
+  const Eigen::VectorXd home = f.cell->home_configuration();
+  f.cell->robot().link_poses(home, links);
+  const core::Pose base = links[f.cell->robot().link_index(arm.spec.base_link)];
+  // TCP 3 cm below the table top, gripper pointing down.
+  core::Pose tcp_world = core::make_pose({0.35, 0.30, 1.094 - 0.03}, {core::kPi, 0, 0});
+  core::UrIkSolutions sols;
+  ASSERT_GT(arm.ur_ik->solve(base.inverse() * tcp_world, arm.spec.home, sols), 0);
+  core::CollisionData data(f.scene.model);
+  for (int k = 0; k < sols.count; ++k) {
+    Eigen::VectorXd q = home;
+    f.cell->set_arm(q, arm, sols.q[k]);
+    core::set_cell_state(*f.cell, f.scene, data, q, f.cell->human_neutral());
+    core::CollisionPair pair;
+    ASSERT_TRUE(core::in_collision(f.scene.model, data, &pair)) << "solution " << k;
+    EXPECT_LE(core::min_distance(f.scene.model, data), 0.0);
+  }
+  // And the same TCP 10 cm above the table is free for the elbow-up solution.
+  tcp_world.translation().z() = 1.094 + 0.10;
+  ASSERT_GT(arm.ur_ik->solve(base.inverse() * tcp_world, arm.spec.home, sols), 0);
+  bool some_free = false;
+  for (int k = 0; k < sols.count; ++k) {
+    Eigen::VectorXd q = home;
+    f.cell->set_arm(q, arm, sols.q[k]);
+    core::set_cell_state(*f.cell, f.scene, data, q, f.cell->human_neutral());
+    some_free = some_free || !core::in_collision(f.scene.model, data);
+  }
+  EXPECT_TRUE(some_free);
+}
+
+TEST(Collision, TableContactNamesTheTable) {
+  auto& f = fixture();
+  core::CollisionData data(f.scene.model);
+  Eigen::VectorXd q = f.cell->home_configuration();
+  // Shoulder lift swings the left arm down through the table.
+  Eigen::VectorXd arm_q = f.cell->arm("left").spec.home;
+  arm_q[1] += core::deg_to_rad(60);
+  f.cell->set_arm(q, f.cell->arm("left"), arm_q);
+  core::set_cell_state(*f.cell, f.scene, data, q, f.cell->human_neutral());
+  core::CollisionPair pair;
+  if (core::in_collision(f.scene.model, data, &pair)) {
+    const std::string names = core::describe_pair(f.scene.model, pair);
+    EXPECT_NE(names.find("left_"), std::string::npos) << names;
+  }
+  // Whatever the pose, the two phases agree.
+  EXPECT_EQ(core::in_collision(f.scene.model, data), core::in_collision_brute_force(f.scene.model, data));
+}
+
+TEST(Collision, DistanceBetweenPrimitivesMatchesClosedForm) {
+  core::CollisionModel model;
+  model.add_body("wall", {box(1.0, 1.0, 1.0)}, true, core::make_pose({0, 0, 0}));
+  const int ball = model.add_body("ball", {sphere(0.1)}, false);
+  core::CollisionData data(model);
+  data.set_body_pose(ball, core::make_pose({1.2, 0.0, 0.0}));
+  EXPECT_NEAR(core::min_distance(model, data), 1.2 - 0.5 - 0.1, 1e-6);
+  EXPECT_FALSE(core::in_collision(model, data));
+  data.set_body_pose(ball, core::make_pose({0.55, 0.0, 0.0}));
+  core::CollisionPair pair;
+  EXPECT_TRUE(core::in_collision(model, data, &pair));
+  EXPECT_EQ(core::describe_pair(model, pair), "wall <-> ball");
+}
+
+TEST(Collision, AllowedStaticAndDisabledPairsAreSkipped) {
+  core::CollisionModel model;
+  const int a = model.add_body("a", {box(1, 1, 1)}, true);
+  model.add_body("b", {box(1, 1, 1)}, true, core::make_pose({0.2, 0, 0}));  // static-static
+  const int c = model.add_body("c", {sphere(0.3)}, false);
+  core::CollisionData data(model);
+  EXPECT_TRUE(core::in_collision(model, data));  // c overlaps a and b
+  model.allow("c", "a");
+  EXPECT_TRUE(core::in_collision(model, data));  // still overlaps b
+  model.allow("c", "b");
+  EXPECT_FALSE(core::in_collision(model, data));
+  EXPECT_FALSE(core::in_collision_brute_force(model, data));
+  model.set_enabled(c, false);
+  EXPECT_FALSE(core::in_collision(model, data));
+  EXPECT_TRUE(model.allowed(a, c));
+  test::expect_input_error([&] { model.allow("c", "nope"); }, {"nope"});
+}
+
+TEST(Collision, AdjacentRobotLinksAreAllowedThroughFramesWithoutGeometry) {
+  auto& f = fixture();
+  const auto& m = f.scene.model;
+  // wrist_3 -> tool0 (no geometry) -> ft_sensor
+  EXPECT_TRUE(m.allowed(*m.find_body("left_wrist_3_link"), *m.find_body("left_ft_sensor")));
+  EXPECT_TRUE(m.allowed(*m.find_body("left_shoulder_link"), *m.find_body("left_upper_arm_link")));
+  EXPECT_FALSE(m.allowed(*m.find_body("left_upper_arm_link"), *m.find_body("left_wrist_2_link")));
+}
+
+TEST(Collision, PerThreadDataGivesTheSameAnswers) {
+  auto& f = fixture();
+  std::mt19937_64 rng(41);
+  std::vector<Eigen::VectorXd> configs;
+  for (int i = 0; i < 200; ++i) configs.push_back(random_robot_q(*f.cell, rng));
+  auto run = [&](std::vector<int>& out) {
+    core::CollisionData data(f.scene.model);
+    for (const auto& q : configs) {
+      core::set_cell_state(*f.cell, f.scene, data, q, f.cell->human_neutral());
+      out.push_back(core::in_collision(f.scene.model, data));
+    }
+  };
+  std::vector<int> a, b;
+  std::thread ta(run, std::ref(a)), tb(run, std::ref(b));
+  ta.join();
+  tb.join();
+  EXPECT_EQ(a, b);
+}

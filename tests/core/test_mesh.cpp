@@ -1,0 +1,216 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+
+#include "hila/core/error.hpp"
+#include "hila/core/mesh.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila::core;
+using namespace hila::test;
+
+namespace {
+
+// Signed volume by the divergence theorem: sum over triangles of v0 . (v1 x v2) / 6.
+// Positive when every triangle is counter-clockwise seen from outside.
+double signed_volume(const TriangleMesh& mesh) {
+  double volume = 0.0;
+  for (const auto& t : mesh.triangles) {
+    volume += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]])) / 6.0;
+  }
+  return volume;
+}
+
+double total_area(const TriangleMesh& mesh) {
+  double area = 0.0;
+  for (const auto& t : mesh.triangles) {
+    area += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                      .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                      .norm();
+  }
+  return area;
+}
+
+}  // namespace
+
+TEST(Mesh, BoxHasEightVerticesAndTwelveOutwardTriangles) {
+  const Eigen::Vector3d size(0.3, 0.2, 0.1);
+  const TriangleMesh box = make_box_mesh(size);
+  ASSERT_EQ(box.vertices.size(), 8u);
+  ASSERT_EQ(box.triangles.size(), 12u);
+  for (const auto& v : box.vertices) {
+    EXPECT_NEAR(std::abs(v.x()), 0.15, 1e-15);
+    EXPECT_NEAR(std::abs(v.y()), 0.10, 1e-15);
+    EXPECT_NEAR(std::abs(v.z()), 0.05, 1e-15);
+  }
+  for (std::size_t i = 0; i < box.triangles.size(); ++i) {
+    const auto& t = box.triangles[i];
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_GE(t[k], 0);
+      ASSERT_LT(t[k], 8);
+    }
+    const Eigen::Vector3d& a = box.vertices[t[0]];
+    const Eigen::Vector3d& b = box.vertices[t[1]];
+    const Eigen::Vector3d& c = box.vertices[t[2]];
+    const Eigen::Vector3d normal = (b - a).cross(c - a);
+    const Eigen::Vector3d centroid = (a + b + c) / 3.0;
+    EXPECT_GT(normal.dot(centroid), 0.0) << "triangle " << i << " faces inward";
+    EXPECT_GT(normal.norm(), 0.0) << "triangle " << i << " is degenerate";
+  }
+  EXPECT_NEAR(signed_volume(box), size.prod(), 1e-15);
+  EXPECT_NEAR(total_area(box), 2.0 * (0.3 * 0.2 + 0.2 * 0.1 + 0.3 * 0.1), 1e-15);
+  EXPECT_LT((box.min_corner() + size / 2).norm(), 1e-15);
+  EXPECT_LT((box.max_corner() - size / 2).norm(), 1e-15);
+
+  // Every edge is shared by exactly two triangles in opposite directions (closed, oriented).
+  int directed_edges = 0;
+  for (const auto& t : box.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int from = t[k];
+      const int to = t[(k + 1) % 3];
+      int reverse = 0;
+      int same = 0;
+      for (const auto& u : box.triangles) {
+        for (int m = 0; m < 3; ++m) {
+          if (u[m] == to && u[(m + 1) % 3] == from) ++reverse;
+          if (u[m] == from && u[(m + 1) % 3] == to) ++same;
+        }
+      }
+      EXPECT_EQ(reverse, 1);
+      EXPECT_EQ(same, 1);
+      ++directed_edges;
+    }
+  }
+  EXPECT_EQ(directed_edges, 36);
+}
+
+TEST(Mesh, BoxVolumeForOtherSizes) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> side(0.001, 2.0);
+  for (int i = 0; i < 20; ++i) {
+    const Eigen::Vector3d size(side(rng), side(rng), side(rng));
+    EXPECT_NEAR(signed_volume(make_box_mesh(size)), size.prod(), 1e-12 * (1 + size.prod()));
+  }
+}
+
+class MeshRoundTrip : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MeshRoundTrip, MillimetreBoxReadsBackInMetres) {
+  const std::string format = GetParam();
+  const std::string dir = temp_dir("mesh_round_trip_" + format);
+  const std::string extension = format == "stlb" ? "stl" : format;
+  const std::string path = dir + "/box_mm." + extension;
+  // A 300 x 200 x 100 mm box, offset so that the extent check also sees the translation.
+  TriangleMesh mm = make_box_mesh(Eigen::Vector3d(300, 200, 100));
+  for (auto& v : mm.vertices) v += Eigen::Vector3d(10, -20, 50);
+  write_mesh(mm, path, format);
+
+  const TriangleMesh m = load_mesh(path, 0.001);
+  ASSERT_EQ(m.triangles.size(), 12u);
+  EXPECT_GE(m.vertices.size(), 8u);
+  const Eigen::Vector3d extent = m.max_corner() - m.min_corner();
+  EXPECT_NEAR(extent.x(), 0.3, 1e-9);
+  EXPECT_NEAR(extent.y(), 0.2, 1e-9);
+  EXPECT_NEAR(extent.z(), 0.1, 1e-9);
+  EXPECT_LT((m.min_corner() - Eigen::Vector3d(-0.14, -0.12, 0.0)).norm(), 1e-9);
+  EXPECT_LT((m.max_corner() - Eigen::Vector3d(0.16, 0.08, 0.1)).norm(), 1e-9);
+  // Orientation survives the round trip (outward normals: positive volume).
+  EXPECT_NEAR(signed_volume(m), 0.3 * 0.2 * 0.1, 1e-9);
+  for (const auto& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_GE(t[k], 0);
+      ASSERT_LT(t[k], static_cast<int>(m.vertices.size()));
+    }
+  }
+
+  // Read in file units, the same file is 1000 times larger.
+  const TriangleMesh raw = load_mesh(path, 1.0);
+  EXPECT_NEAR((raw.max_corner() - raw.min_corner()).x(), 300.0, 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, MeshRoundTrip, ::testing::Values("stl", "stlb", "obj"));
+
+TEST(Mesh, LoadMissingFileNamesThePath) {
+  const std::string dir = temp_dir("mesh_missing");
+  const std::string path = dir + "/nothing_here.stl";
+  expect_input_error([&] { load_mesh(path, 1.0); }, {path, "no such file"});
+}
+
+TEST(Mesh, LoadGarbageFileNamesThePath) {
+  const std::string dir = temp_dir("mesh_garbage");
+  std::mt19937_64 rng(99);
+  std::string bytes;
+  for (int i = 0; i < 237; ++i) bytes.push_back(static_cast<char>(rng() & 0xff));
+  bytes[0] = '\x01';  // not "solid": the STL reader must treat it as (broken) binary STL
+  const std::string path = write_file(dir, "garbage.stl", bytes);
+  expect_input_error([&] { load_mesh(path, 1.0); }, {path, "a mesh readable by assimp"});
+
+  const std::string path2 = write_file(dir, "garbage.bin", bytes);
+  expect_input_error([&] { load_mesh(path2, 1.0); }, {path2, "a mesh readable by assimp"});
+}
+
+TEST(Mesh, LoadObjWithoutFacesIsAnEmptyMesh) {
+  const std::string dir = temp_dir("mesh_empty");
+  const std::string path = write_file(dir, "points.obj",
+                                      "# only vertices\n"
+                                      "v 0 0 0\n"
+                                      "v 1 0 0\n"
+                                      "v 0 1 0\n"
+                                      "v 0 0 1\n");
+  expect_input_error([&] { load_mesh(path, 1.0); }, {path, "at least one triangle", "empty mesh"});
+}
+
+TEST(Mesh, LoadObjWithNanCoordinateIsRejected) {
+  const std::string dir = temp_dir("mesh_nan");
+  const std::string path = write_file(dir, "nan.obj",
+                                      "v 0 0 0\n"
+                                      "v 1 0 0\n"
+                                      "v 0 nan 0\n"
+                                      "v 0 0 1\n"
+                                      "f 1 2 3\n"
+                                      "f 1 3 4\n"
+                                      "f 1 4 2\n"
+                                      "f 2 4 3\n");
+  expect_input_error([&] { load_mesh(path, 1.0); }, {path, "vertex 2", "finite"});
+}
+
+TEST(Mesh, ObjTetrahedronLoads) {
+  // The control for the two tests above: the same file with valid numbers and faces loads.
+  const std::string dir = temp_dir("mesh_tetra");
+  const std::string path = write_file(dir, "tetra.obj",
+                                      "v 0 0 0\n"
+                                      "v 1 0 0\n"
+                                      "v 0 1 0\n"
+                                      "v 0 0 1\n"
+                                      "f 1 3 2\n"
+                                      "f 1 2 4\n"
+                                      "f 1 4 3\n"
+                                      "f 2 3 4\n");
+  const TriangleMesh m = load_mesh(path, 2.0);
+  EXPECT_EQ(m.triangles.size(), 4u);
+  EXPECT_LT((m.max_corner() - Eigen::Vector3d(2, 2, 2)).norm(), 1e-12);
+  EXPECT_NEAR(signed_volume(m), 8.0 / 6.0, 1e-12);
+}
+
+TEST(Mesh, NonPositiveUnitScaleIsRejected) {
+  const std::string dir = temp_dir("mesh_scale");
+  const std::string path = dir + "/box.stl";
+  write_mesh(make_box_mesh(Eigen::Vector3d(1, 1, 1)), path, "stlb");
+  EXPECT_NO_THROW(load_mesh(path, 1.0));
+  expect_input_error([&] { load_mesh(path, 0.0); }, {path, "unit scale", "positive"});
+  expect_input_error([&] { load_mesh(path, -0.001); }, {path, "unit scale", "-0.001"});
+  expect_input_error([&] { load_mesh(path, std::numeric_limits<double>::quiet_NaN()); },
+                     {path, "unit scale", "nan"});
+  expect_input_error([&] { load_mesh(path, std::numeric_limits<double>::infinity()); },
+                     {path, "unit scale", "inf"});
+}
+
+TEST(Mesh, WriteToUnwritablePathThrows) {
+  const std::string dir = temp_dir("mesh_unwritable");
+  const std::string path = dir + "/no/such/folder/box.stl";
+  expect_input_error(
+      [&] { write_mesh(make_box_mesh(Eigen::Vector3d(1, 1, 1)), path, "stlb"); }, {path});
+}

@@ -1,0 +1,68 @@
+#include "util/test_util.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "hila/core/error.hpp"
+
+namespace hila::test {
+
+std::string data_path(const std::string& relative) {
+  return std::string(HILA_DATA_DIR) + "/" + relative;
+}
+std::string cell_path() { return data_path("cell/cell.yaml"); }
+std::string product_path() { return data_path("cabinet/product.yaml"); }
+
+std::shared_ptr<const core::Cell> reference_cell() {
+  static const std::shared_ptr<const core::Cell> cell = core::Cell::load(cell_path());
+  return cell;
+}
+
+std::string temp_dir(const std::string& name) {
+  const auto dir = std::filesystem::path(HILA_TEST_TMP_DIR) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+std::string write_file(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = (std::filesystem::path(dir) / name).string();
+  std::ofstream out(path);
+  out << text;
+  return path;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+core::Pose random_pose(std::mt19937_64& rng, double position_range) {
+  std::uniform_real_distribution<double> u(-position_range, position_range);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
+  q.normalize();
+  core::Pose pose = core::Pose::Identity();
+  pose.linear() = q.toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(u(rng), u(rng), u(rng));
+  return pose;
+}
+
+void expect_input_error(const std::function<void()>& fn,
+                        std::initializer_list<std::string> fragments) {
+  try {
+    fn();
+    ADD_FAILURE() << "expected hila::core::InputError, nothing was thrown";
+  } catch (const core::InputError& e) {
+    const std::string message = e.what();
+    for (const auto& fragment : fragments) {
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "message '" << message << "' lacks '" << fragment << "'";
+    }
+  }
+}
+
+}  // namespace hila::test

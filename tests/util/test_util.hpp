@@ -1,0 +1,35 @@
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <initializer_list>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/pose.hpp"
+
+namespace hila::test {
+
+std::string data_path(const std::string& relative);  // under meshes/
+std::string cell_path();                               // meshes/cell/cell.yaml
+std::string product_path();                            // meshes/cabinet/product.yaml
+
+// The reference cell, loaded once per test binary.
+std::shared_ptr<const core::Cell> reference_cell();
+
+// A fresh, empty directory for this test (removed and recreated on every call).
+std::string temp_dir(const std::string& name);
+// Writes `text` to `dir/name` and returns the path.
+std::string write_file(const std::string& dir, const std::string& name, const std::string& text);
+std::string read_file(const std::string& path);
+
+core::Pose random_pose(std::mt19937_64& rng, double position_range = 1.0);
+
+// Runs `fn`, expects core::InputError whose message contains every fragment.
+void expect_input_error(const std::function<void()>& fn,
+                        std::initializer_list<std::string> fragments);
+
+}  // namespace hila::test
