@@ -285,10 +285,10 @@ Eigen::VectorXd Cell::human_neutral() const {
   return spec_.human_neutral.size() ? spec_.human_neutral : human_.neutral_configuration();
 }
 
-CellScene build_cell_scene(const Cell& cell) {
+CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options) {
   CellScene scene;
   scene.robot = add_robot(scene.model, cell.robot(), "");
-  scene.human = add_robot(scene.model, cell.human(), "human/");
+  scene.human = add_robot(scene.model, cell.human(), "human/", !options.human_moves);
   for (const auto& o : cell.spec().obstacles) {
     GeometrySpec box;
     box.type = GeometrySpec::Type::Box;

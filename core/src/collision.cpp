@@ -142,8 +142,9 @@ struct CollisionDataImpl {
   std::vector<ShapeTag> tags;
   fcl::DynamicAABBTreeCollisionManagerd static_manager;
   fcl::DynamicAABBTreeCollisionManagerd moving_manager;
-  bool moving_dirty = true;
-  bool static_dirty = true;
+  // Objects whose pose changed since the last query: only these are re-fitted in the trees.
+  std::vector<fcl::CollisionObjectd*> changed_moving;
+  std::vector<fcl::CollisionObjectd*> changed_static;
 };
 
 CollisionData::CollisionData(const CollisionModel& model)
@@ -184,18 +185,17 @@ CollisionData& CollisionData::operator=(CollisionData&&) noexcept = default;
 
 void CollisionData::set_body_pose(int body, const Pose& pose) {
   auto& d = *impl_;
+  // Planning moves one arm at a time: skipping unchanged bodies keeps the tree update small.
+  if (d.body_poses[body].matrix() == pose.matrix()) return;
   d.body_poses[body] = pose;
   const auto& offsets = d.model->bodies[body].offsets;
   const auto& objs = d.body_objects[body];
+  auto& changed = d.model->bodies[body].is_static ? d.changed_static : d.changed_moving;
   for (std::size_t s = 0; s < objs.size(); ++s) {
     auto& object = *d.objects[objs[s]];
     object.setTransform(pose * offsets[s]);
     object.computeAABB();
-  }
-  if (d.model->bodies[body].is_static) {
-    d.static_dirty = true;
-  } else {
-    d.moving_dirty = true;
+    changed.push_back(&object);
   }
 }
 
@@ -254,13 +254,13 @@ bool distance_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, voi
 }
 
 void refresh(CollisionDataImpl& d) {
-  if (d.moving_dirty) {
-    d.moving_manager.update();
-    d.moving_dirty = false;
+  if (!d.changed_moving.empty()) {
+    d.moving_manager.update(d.changed_moving);
+    d.changed_moving.clear();
   }
-  if (d.static_dirty) {
-    d.static_manager.update();
-    d.static_dirty = false;
+  if (!d.changed_static.empty()) {
+    d.static_manager.update(d.changed_static);
+    d.changed_static.clear();
   }
 }
 
@@ -301,13 +301,14 @@ std::string describe_pair(const CollisionModel& model, const CollisionPair& pair
   return model.body_name(pair.body_a) + " <-> " + model.body_name(pair.body_b);
 }
 
-RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std::string& prefix) {
+RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std::string& prefix,
+                      bool is_static) {
   RobotBodies bodies;
   bodies.link_to_body.assign(robot.links().size(), -1);
   for (std::size_t l = 0; l < robot.links().size(); ++l) {
     const Link& link = robot.links()[l];
     if (link.collisions.empty()) continue;
-    bodies.link_to_body[l] = model.add_body(prefix + link.name, link.collisions, false);
+    bodies.link_to_body[l] = model.add_body(prefix + link.name, link.collisions, is_static);
   }
   for (std::size_t l = 0; l < robot.links().size(); ++l) {
     if (bodies.link_to_body[l] < 0) continue;

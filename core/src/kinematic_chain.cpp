@@ -14,21 +14,6 @@ Eigen::Matrix3d align_to_z(const Eigen::Vector3d& axis) {
   return Eigen::Quaterniond::FromTwoVectors(axis, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
-// pose := pose * Rz(q), touching only the two affected columns.
-inline void post_rotate_z(Pose& pose, double q) {
-  const double c = std::cos(q);
-  const double s = std::sin(q);
-  auto r = pose.linear();
-  const Eigen::Vector3d x = r.col(0);
-  const Eigen::Vector3d y = r.col(1);
-  pose.linear().col(0) = c * x + s * y;
-  pose.linear().col(1) = c * y - s * x;
-}
-
-inline void post_translate_z(Pose& pose, double q) {
-  pose.translation() += q * pose.linear().col(2);
-}
-
 }  // namespace
 
 KinematicChain::KinematicChain(const RobotModel& model, const std::string& base_link,
@@ -66,7 +51,9 @@ KinematicChain::KinematicChain(const RobotModel& model, const std::string& base_
     const Eigen::Matrix3d a = align_to_z(joint.axis);
     Pose pre = Pose::Identity();
     pre.linear() = a.transpose();
-    fixed_.push_back(accumulated * joint.origin * pre);
+    const Pose before = accumulated * joint.origin * pre;
+    fixed_rotation_.push_back(before.linear());
+    fixed_translation_.push_back(before.translation());
     accumulated = Pose::Identity();
     accumulated.linear() = a;
     joint_types_.push_back(joint.type == JointType::Prismatic ? JointType::Prismatic
@@ -76,7 +63,31 @@ KinematicChain::KinematicChain(const RobotModel& model, const std::string& base_
     lower.push_back(joint.lower);
     upper.push_back(joint.upper);
   }
-  fixed_.push_back(accumulated);
+  fixed_rotation_.push_back(accumulated.linear());
+  fixed_translation_.push_back(accumulated.translation());
+  for (Eigen::Matrix3d& r : fixed_rotation_) {
+    SignedPermutation sp;
+    sp.valid = true;
+    for (int j = 0; j < 3 && sp.valid; ++j) {
+      int nonzero = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double v = r(k, j);
+        if (std::abs(v) < 1e-12) continue;
+        if (std::abs(std::abs(v) - 1.0) > 1e-12) sp.valid = false;
+        sp.perm[j] = k;
+        sp.sign[j] = v > 0 ? 1.0 : -1.0;
+        ++nonzero;
+      }
+      if (nonzero != 1) sp.valid = false;
+    }
+    if (sp.valid) {
+      // Snap to the exact permutation (URDF rpy round-trips leave 1e-17 residues).
+      r.setZero();
+      for (int j = 0; j < 3; ++j) r(sp.perm[j], j) = sp.sign[j];
+      sp.identity = r == Eigen::Matrix3d::Identity();
+    }
+    fixed_permutation_.push_back(sp);
+  }
   lower_ = Eigen::Map<Eigen::VectorXd>(lower.data(), static_cast<Eigen::Index>(lower.size()));
   upper_ = Eigen::Map<Eigen::VectorXd>(upper.data(), static_cast<Eigen::Index>(upper.size()));
 }
@@ -86,18 +97,74 @@ bool KinematicChain::within_limits(const Eigen::VectorXd& q, double tolerance) c
          (q.array() <= upper_.array() + tolerance).all();
 }
 
+namespace {
+
+// Walks the chain: for each joint i, `visit(i, r, p)` sees the frame of joint i (z = axis)
+// before its motion; returns the tip frame in (r, p).
+template <typename Perm, typename Visit>
+inline void walk_chain(const std::vector<Eigen::Matrix3d>& fixed_r,
+                       const std::vector<Eigen::Vector3d>& fixed_p,
+                       const std::vector<Perm>& fixed_perm, const std::vector<JointType>& types,
+                       const Eigen::VectorXd& q, Eigen::Matrix3d& r, Eigen::Vector3d& p,
+                       Visit&& visit) {
+  r = fixed_r[0];
+  p = fixed_p[0];
+  const int n = static_cast<int>(types.size());
+  // All sines and cosines first: they are independent, so the CPU overlaps them instead of
+  // waiting for each inside the dependent chain of products.
+  constexpr int kStack = 16;
+  double sin_stack[kStack];
+  double cos_stack[kStack];
+  std::vector<double> sin_heap;
+  std::vector<double> cos_heap;
+  double* sines = sin_stack;
+  double* cosines = cos_stack;
+  if (n > kStack) {
+    sin_heap.resize(n);
+    cos_heap.resize(n);
+    sines = sin_heap.data();
+    cosines = cos_heap.data();
+  }
+  for (int i = 0; i < n; ++i) ::sincos(q[i], &sines[i], &cosines[i]);
+  for (int i = 0; i < n; ++i) {
+    visit(i, r, p);
+    // T <- T * M(q_i) * F_{i+1}; a revolute M = Rz(q) mixes only columns 0 and 1 of R.
+    if (types[i] == JointType::Revolute) {
+      const double s = sines[i];
+      const double c = cosines[i];
+      const Eigen::Vector3d x = r.col(0);
+      const Eigen::Vector3d y = r.col(1);
+      r.col(0) = c * x + s * y;
+      r.col(1) = c * y - s * x;
+    } else {
+      p.noalias() += q[i] * r.col(2);
+    }
+    p.noalias() += r * fixed_p[i + 1];
+    const Perm& sp = fixed_perm[i + 1];
+    if (sp.identity) {
+      // Parallel consecutive axes (DH alpha = 0): nothing to do.
+    } else if (sp.valid) {
+      const Eigen::Matrix3d old = r;
+      for (int j = 0; j < 3; ++j) r.col(j) = sp.sign[j] * old.col(sp.perm[j]);
+    } else {
+      const Eigen::Matrix3d next = r * fixed_r[i + 1];
+      r = next;
+    }
+  }
+}
+
+}  // namespace
+
 Pose KinematicChain::fk(const Eigen::VectorXd& q) const {
   assert(q.size() == dof());
-  Pose t = fixed_[0];
-  for (int i = 0; i < dof(); ++i) {
-    if (joint_types_[i] == JointType::Revolute) {
-      post_rotate_z(t, q[i]);
-    } else {
-      post_translate_z(t, q[i]);
-    }
-    t = t * fixed_[i + 1];
-  }
-  return t;
+  Pose tip = Pose::Identity();
+  Eigen::Matrix3d r;
+  Eigen::Vector3d p;
+  walk_chain(fixed_rotation_, fixed_translation_, fixed_permutation_, joint_types_, q, r, p,
+             [](int, const Eigen::Matrix3d&, const Eigen::Vector3d&) {});
+  tip.linear() = r;
+  tip.translation() = p;
+  return tip;
 }
 
 void KinematicChain::fk_and_jacobian(const Eigen::VectorXd& q, Pose& tip, Jacobian& jac) const {
@@ -106,21 +173,19 @@ void KinematicChain::fk_and_jacobian(const Eigen::VectorXd& q, Pose& tip, Jacobi
   jac.resize(6, n);
   Eigen::Matrix<double, 3, Eigen::Dynamic> axes(3, n);
   Eigen::Matrix<double, 3, Eigen::Dynamic> origins(3, n);
-  Pose t = fixed_[0];
-  for (int i = 0; i < n; ++i) {
-    axes.col(i) = t.linear().col(2);
-    origins.col(i) = t.translation();
-    if (joint_types_[i] == JointType::Revolute) {
-      post_rotate_z(t, q[i]);
-    } else {
-      post_translate_z(t, q[i]);
-    }
-    t = t * fixed_[i + 1];
-  }
-  tip = t;
+  Eigen::Matrix3d r;
+  Eigen::Vector3d p;
+  walk_chain(fixed_rotation_, fixed_translation_, fixed_permutation_, joint_types_, q, r, p,
+             [&](int i, const Eigen::Matrix3d& ri, const Eigen::Vector3d& pi) {
+               axes.col(i) = ri.col(2);
+               origins.col(i) = pi;
+             });
+  tip = Pose::Identity();
+  tip.linear() = r;
+  tip.translation() = p;
   for (int i = 0; i < n; ++i) {
     if (joint_types_[i] == JointType::Revolute) {
-      jac.block<3, 1>(0, i) = axes.col(i).cross(t.translation() - origins.col(i));
+      jac.block<3, 1>(0, i) = axes.col(i).cross(p - origins.col(i));
       jac.block<3, 1>(3, i) = axes.col(i);
     } else {
       jac.block<3, 1>(0, i) = axes.col(i);

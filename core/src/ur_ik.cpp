@@ -42,7 +42,8 @@ inline bool safe_acos(double x, double& out) {
 inline double wrap_near(double value, double seed, double lo, double hi, bool& ok) {
   // Nearest representative of value + 2*pi*k to seed, then the nearest one inside the limits.
   const double two_pi = 2.0 * kPi;
-  double v = value + two_pi * std::round((seed - value) / two_pi);
+  constexpr double kInvTwoPi = 1.0 / (2.0 * kPi);
+  double v = value + two_pi * std::floor((seed - value) * kInvTwoPi + 0.5);
   if (v >= lo && v <= hi) {
     ok = true;
     return v;
@@ -100,8 +101,6 @@ UrIk::UrIk(const KinematicChain& chain, const UrDhParameters& dh) : dh_(dh) {
 int UrIk::solve(const Pose& tcp, const Vector6d& seed, UrIkSolutions& out) const {
   out.count = 0;
   const Pose t06 = tcp * tool_inv_;
-  const auto d = d_of(dh_);
-  const auto a = a_of(dh_);
   const Eigen::Matrix3d r = t06.linear();
   const Eigen::Vector3d p = t06.translation();
 
@@ -116,7 +115,8 @@ int UrIk::solve(const Pose& tcp, const Vector6d& seed, UrIkSolutions& out) const
   int raw_count = 0;
   for (int s1 = 0; s1 < 2; ++s1) {
     const double q1 = psi + (s1 == 0 ? phi : -phi) + kPi / 2;
-    const double c1 = std::cos(q1), sn1 = std::sin(q1);
+    double sn1 = 0.0, c1 = 1.0;
+    ::sincos(q1, &sn1, &c1);
     // The joint-2 axis direction v = (s1, -c1, 0) seen from the flange gives the wrist angle in
     // atan2 form (acos near +-1 would lose half the digits at the wrist singularity):
     // cos q5 = a.v, sin q5 = +-|(n.v, o.v)|, and q6 from the direction of (n.v, -o.v).
@@ -124,34 +124,51 @@ int UrIk::solve(const Pose& tcp, const Vector6d& seed, UrIkSolutions& out) const
     const double ov = r(0, 1) * sn1 - r(1, 1) * c1;
     const double av = r(0, 2) * sn1 - r(1, 2) * c1;
     const double s5abs = std::hypot(nv, ov);
+    // Frame 1 in the base: R01 = Rz(q1) Rx(pi/2), origin (0, 0, d1).
+    Eigen::Matrix3d r01;
+    r01 << c1, 0, sn1, sn1, 0, -c1, 0, 1, 0;
+    const Eigen::Matrix3d r10 = r01.transpose();
+    const Eigen::Vector3d p1 = r10 * (p - Eigen::Vector3d(0, 0, dh_.d1));
+    const Eigen::Matrix3d r16 = r10 * r;
+    // Wrist branch s5 = +: q5, q6; branch -: -q5, q6 + pi (the same wrist orientation).
+    const double q5_plus = std::atan2(s5abs, av);
+    const double q6_plus = s5abs > 1e-12 ? std::atan2(-ov, nv) : seed[5];
+    double sn5 = 0.0, c5 = 1.0, sn6 = 0.0, c6 = 1.0;
+    ::sincos(q5_plus, &sn5, &c5);
+    ::sincos(q6_plus, &sn6, &c6);
+    // T46 = Rz(q5) Tz(d5) Rx(-pi/2) Rz(q6) Tz(d6); T14 = T16 * T46^-1.
+    Eigen::Matrix3d r46;
+    r46 << c5 * c6, -c5 * sn6, -sn5,  //
+        sn5 * c6, -sn5 * sn6, c5,     //
+        -sn6, -c6, 0;
+    const Eigen::Matrix3d r14_plus = r16 * r46.transpose();
+    // Joints 2-4 are parallel: R14 = Rz(q2+q3+q4) Rx(pi/2). The flipped wrist negates
+    // columns 0 and 2 of R14, i.e. adds pi to q2+q3+q4.
+    const double q234_plus = std::atan2(r14_plus(1, 0), r14_plus(0, 0));
     for (int s5 = 0; s5 < 2; ++s5) {
-      const double sign5 = s5 == 0 ? 1.0 : -1.0;
-      const double q5 = std::atan2(sign5 * s5abs, av);
-      double q6 = 0.0;
-      if (s5abs > 1e-12) {
-        q6 = std::atan2(-sign5 * ov, sign5 * nv);
-      } else {
-        q6 = seed[5];  // wrist singularity: q4 and q6 share one rotation; keep the seed's q6
-      }
-      const Pose t01 = dh_transform(q1, d[0], a[0], kAlpha[0]);
-      const Pose t45 = dh_transform(q5, d[4], a[4], kAlpha[4]);
-      const Pose t56 = dh_transform(q6, d[5], a[5], kAlpha[5]);
-      const Pose t14 = t01.inverse() * t06 * (t45 * t56).inverse();
-      const double px = t14.translation().x();
-      const double pz = t14.translation().y();  // frame 1's x-y plane holds the planar 2R arm
-      const double dist2 = px * px + pz * pz;
+      const bool flipped = s5 == 1;
+      const double q5 = flipped ? -q5_plus : q5_plus;
+      const double q6 = flipped ? q6_plus + kPi : q6_plus;
+      const double q234 = flipped ? q234_plus + kPi : q234_plus;
+      // Wrist-1 origin in frame 1: p14 = p16 - R14 * p46, p46 = (-d6 s5, d6 c5, d5). For the
+      // flipped wrist R14 = R14+ diag(-1, 1, -1) and s5 changes sign, so only d5 flips.
+      const Eigen::Vector3d p46(-dh_.d6 * sn5, dh_.d6 * c5, flipped ? -dh_.d5 : dh_.d5);
+      const Eigen::Vector3d p14 = p1 - r14_plus * p46;
+      // The planar 2R arm (a2, a3) in frame 1's x-y plane.
+      const double px = p14.x();
+      const double py = p14.y();
+      const double c3 = (px * px + py * py - dh_.a2 * dh_.a2 - dh_.a3 * dh_.a3) /
+                        (2.0 * dh_.a2 * dh_.a3);
       double q3abs = 0.0;
-      if (!safe_acos((dist2 - dh_.a2 * dh_.a2 - dh_.a3 * dh_.a3) / (2.0 * dh_.a2 * dh_.a3), q3abs)) {
-        continue;
-      }
+      if (!safe_acos(c3, q3abs)) continue;
+      const double sn3abs = std::sqrt(std::max(0.0, 1.0 - c3 * c3));
+      const double k1 = dh_.a2 + dh_.a3 * std::clamp(c3, -1.0, 1.0);
       for (int s3 = 0; s3 < 2; ++s3) {
         const double q3 = s3 == 0 ? q3abs : -q3abs;
-        const double q2 = std::atan2(pz, px) -
-                          std::atan2(dh_.a3 * std::sin(q3), dh_.a2 + dh_.a3 * std::cos(q3));
-        const Pose t12 = dh_transform(q2, d[1], a[1], kAlpha[1]);
-        const Pose t23 = dh_transform(q3, d[2], a[2], kAlpha[2]);
-        const Pose t34 = (t12 * t23).inverse() * t14;
-        const double q4 = std::atan2(t34.linear()(1, 0), t34.linear()(0, 0));
+        const double k2 = dh_.a3 * (s3 == 0 ? sn3abs : -sn3abs);
+        // q2 = atan2(py, px) - atan2(k2, k1) as a single atan2.
+        const double q2 = std::atan2(py * k1 - px * k2, px * k1 + py * k2);
+        const double q4 = q234 - q2 - q3;
         raw[raw_count++] << q1, q2, q3, q4, q5, q6;
       }
     }

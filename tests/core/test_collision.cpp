@@ -28,7 +28,7 @@ core::GeometrySpec sphere(double r) {
 
 struct Fixture {
   std::shared_ptr<const core::Cell> cell = test::reference_cell();
-  core::CellScene scene = core::build_cell_scene(*cell);
+  core::CellScene scene = core::build_cell_scene(*cell, {.human_moves = true});
 };
 
 Fixture& fixture() {

@@ -49,7 +49,7 @@ double human_arm_reach(const core::Cell& cell, const core::HumanArm& arm) {
 
 int run_cell_check(const CellCheckOptions& opt) {
   const auto cell = core::Cell::load(opt.cell_file);
-  const core::CellScene scene = core::build_cell_scene(*cell);
+  const core::CellScene scene = core::build_cell_scene(*cell, {.human_moves = true});
   core::CollisionData data(scene.model);
   const Eigen::VectorXd robot_q = cell->home_configuration(cell->spec().gripper.jaw_max);
   core::set_cell_state(*cell, scene, data, robot_q, cell->human_neutral());

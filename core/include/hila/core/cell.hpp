@@ -142,7 +142,13 @@ struct CellScene {
   std::vector<int> obstacles;
 };
 
-CellScene build_cell_scene(const Cell& cell);
+struct CellSceneOptions {
+  // The human is part of the static scene while the robot plans (human-human and human-table
+  // pairs are then not checked); checking the human's own posture needs it to move.
+  bool human_moves = false;
+};
+
+CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options = {});
 
 // Poses every robot and human body for the given configurations.
 void set_cell_state(const Cell& cell, const CellScene& scene, CollisionData& data,

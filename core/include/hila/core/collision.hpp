@@ -90,9 +90,11 @@ struct RobotBodies {
   std::vector<int> link_to_body;  // -1 for links without geometry
 };
 
-// Adds the robot's links as moving bodies named prefix + link name, and allows each link with
-// the nearest ancestor that has geometry (links joined through geometry-less frames touch).
-RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std::string& prefix);
+// Adds the robot's links as bodies named prefix + link name (moving unless `is_static`), and
+// allows each link with the nearest ancestor that has geometry (links joined through
+// geometry-less frames touch).
+RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std::string& prefix,
+                      bool is_static = false);
 
 // Sets every link body's pose to base * link_poses[link].
 void set_robot_pose(CollisionData& data, const RobotBodies& bodies,

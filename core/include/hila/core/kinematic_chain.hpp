@@ -44,7 +44,19 @@ class KinematicChain {
   std::vector<int> model_variables_;
   std::vector<JointType> joint_types_;
   // fixed_[0] * M(q0) * fixed_[1] * M(q1) * ... * fixed_[n], with M a motion about/along z.
-  std::vector<Pose> fixed_;
+  // Kept as separate rotation/translation so the products inline (Eigen's Transform product
+  // does not), which halves the cost of FK.
+  std::vector<Eigen::Matrix3d> fixed_rotation_;
+  std::vector<Eigen::Vector3d> fixed_translation_;
+  // When a fixed rotation is a signed axis permutation (DH alphas of 0 and +-90 degrees), the
+  // product with it is a column shuffle: column j of R*F is sign[j] * R.col(perm[j]).
+  struct SignedPermutation {
+    bool valid = false;
+    bool identity = false;
+    int perm[3] = {0, 1, 2};
+    double sign[3] = {1, 1, 1};
+  };
+  std::vector<SignedPermutation> fixed_permutation_;
   Eigen::VectorXd lower_;
   Eigen::VectorXd upper_;
 };
