@@ -306,6 +306,10 @@ CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options) {
     }
     scene.model.allow(a, b);
   }
+  for (const Arm& arm : cell.arms()) {
+    scene.arm_bodies.push_back(subtree_bodies(
+        cell.robot(), scene.robot, cell.robot().link_index(arm.spec.base_link)));
+  }
   return scene;
 }
 

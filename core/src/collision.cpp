@@ -7,6 +7,7 @@
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
+#include <algorithm>
 #include <limits>
 
 #include "hila/core/error.hpp"
@@ -145,6 +146,9 @@ struct CollisionDataImpl {
   // Objects whose pose changed since the last query: only these are re-fitted in the trees.
   std::vector<fcl::CollisionObjectd*> changed_moving;
   std::vector<fcl::CollisionObjectd*> changed_static;
+  std::vector<char> active_scratch;
+  bool moving_full_refit = false;
+  bool static_full_refit = false;
 };
 
 CollisionData::CollisionData(const CollisionModel& model)
@@ -191,6 +195,12 @@ void CollisionData::set_body_pose(int body, const Pose& pose) {
   const auto& offsets = d.model->bodies[body].offsets;
   const auto& objs = d.body_objects[body];
   auto& changed = d.model->bodies[body].is_static ? d.changed_static : d.changed_moving;
+  // Subset queries never drain the moving list; past one entry per object a full refit is
+  // cheaper than replaying the list.
+  if (changed.size() > d.objects.size()) {
+    changed.clear();
+    (d.model->bodies[body].is_static ? d.static_full_refit : d.moving_full_refit) = true;
+  }
   for (std::size_t s = 0; s < objs.size(); ++s) {
     auto& object = *d.objects[objs[s]];
     object.setTransform(pose * offsets[s]);
@@ -254,6 +264,16 @@ bool distance_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, voi
 }
 
 void refresh(CollisionDataImpl& d) {
+  if (d.moving_full_refit) {
+    d.moving_manager.update();
+    d.moving_full_refit = false;
+    d.changed_moving.clear();
+  }
+  if (d.static_full_refit) {
+    d.static_manager.update();
+    d.static_full_refit = false;
+    d.changed_static.clear();
+  }
   if (!d.changed_moving.empty()) {
     d.moving_manager.update(d.changed_moving);
     d.changed_moving.clear();
@@ -275,12 +295,69 @@ bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPai
   return ctx.hit;
 }
 
+bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
+                  CollisionPair* first) {
+  auto& d = data.impl();
+  const auto& m = model.impl();
+  if (d.static_full_refit || !d.changed_static.empty()) {
+    d.static_manager.update();
+    d.static_full_refit = false;
+    d.changed_static.clear();
+  }
+  QueryContext ctx{&m, first};
+  // Against the static scene: one tree query per shape of the active bodies.
+  for (const int b : bodies) {
+    if (!m.bodies[b].enabled) continue;
+    for (const int o : d.body_objects[b]) {
+      d.static_manager.collide(d.objects[o].get(), &ctx, collide_callback);
+      if (ctx.hit) return true;
+    }
+  }
+  // Against the other moving bodies (and among the active ones, each pair once): AABB test, then
+  // the narrow phase.
+  std::vector<char>& active = d.active_scratch;
+  active.assign(m.bodies.size(), 0);
+  for (const int b : bodies) active[b] = 1;
+  for (const int b : bodies) {
+    if (!m.bodies[b].enabled || m.bodies[b].is_static) continue;
+    for (std::size_t other = 0; other < m.bodies.size(); ++other) {
+      const int ob = static_cast<int>(other);
+      if (m.bodies[ob].is_static || (active[ob] && ob <= b) || skip_pair(m, b, ob)) continue;
+      for (const int o1 : d.body_objects[b]) {
+        const auto& box1 = d.objects[o1]->getAABB();
+        for (const int o2 : d.body_objects[ob]) {
+          if (!box1.overlap(d.objects[o2]->getAABB())) continue;
+          if (collide_callback(d.objects[o1].get(), d.objects[o2].get(), &ctx)) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
 bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
                               CollisionPair* first) {
   auto& d = data.impl();
   QueryContext ctx{&model.impl(), first};
   for (std::size_t i = 0; i < d.objects.size(); ++i) {
     for (std::size_t j = i + 1; j < d.objects.size(); ++j) {
+      if (collide_callback(d.objects[i].get(), d.objects[j].get(), &ctx)) return true;
+    }
+  }
+  return false;
+}
+
+bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
+                              const std::vector<int>& bodies, CollisionPair* first) {
+  auto& d = data.impl();
+  QueryContext ctx{&model.impl(), first};
+  std::vector<char> active(model.impl().bodies.size(), 0);
+  for (const int b : bodies) active[b] = 1;
+  for (std::size_t i = 0; i < d.objects.size(); ++i) {
+    for (std::size_t j = i + 1; j < d.objects.size(); ++j) {
+      const int a = static_cast<ShapeTag*>(d.objects[i]->getUserData())->body;
+      const int b = static_cast<ShapeTag*>(d.objects[j]->getUserData())->body;
+      if (!active[a] && !active[b]) continue;
       if (collide_callback(d.objects[i].get(), d.objects[j].get(), &ctx)) return true;
     }
   }
@@ -325,6 +402,19 @@ RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std:
     }
   }
   return bodies;
+}
+
+std::vector<int> subtree_bodies(const RobotModel& robot, const RobotBodies& bodies, int root_link) {
+  std::vector<int> out;
+  std::vector<int> stack{root_link};
+  while (!stack.empty()) {
+    const int link = stack.back();
+    stack.pop_back();
+    if (bodies.link_to_body[link] >= 0) out.push_back(bodies.link_to_body[link]);
+    for (const int j : robot.links()[link].child_joints) stack.push_back(robot.joints()[j].child_link);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 void set_robot_pose(CollisionData& data, const RobotBodies& bodies,

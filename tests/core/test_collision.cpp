@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <thread>
 
@@ -90,6 +91,38 @@ TEST(Collision, BroadPhaseAgreesWithBruteForceOnRandomConfigurations) {
     }
   }
   // Random configurations of two arms collide often, but not always: both branches are tested.
+  EXPECT_GT(colliding, 50);
+  EXPECT_LT(colliding, 580);
+}
+
+TEST(Collision, ArmSubsetQueryAgreesWithBruteForceOverItsPairs) {
+  auto& f = fixture();
+  core::CollisionData data(f.scene.model);
+  std::mt19937_64 rng(32);
+  ASSERT_EQ(f.scene.arm_bodies.size(), 2u);
+  // The left arm's bodies: its links and its gripper, nothing of the right arm.
+  const auto& left = f.scene.arm_bodies[0];
+  EXPECT_NE(std::find(left.begin(), left.end(), *f.scene.model.find_body("left_pad_l")), left.end());
+  EXPECT_EQ(std::find(left.begin(), left.end(), *f.scene.model.find_body("right_pad_l")), left.end());
+  int colliding = 0;
+  for (int i = 0; i < 600; ++i) {
+    // Alternate full-state and one-arm updates so the subset query sees stale broad-phase trees.
+    Eigen::VectorXd q = random_robot_q(*f.cell, rng);
+    if (i % 2) {
+      std::vector<core::Pose> links;
+      f.cell->robot().link_poses(q, links);
+      core::set_robot_pose(data, f.scene.robot, links);
+    } else {
+      core::set_cell_state(*f.cell, f.scene, data, q, random_human_q(*f.cell, rng));
+    }
+    const auto& arm = f.scene.arm_bodies[i % 2];
+    const bool fast = core::in_collision(f.scene.model, data, arm);
+    const bool slow = core::in_collision_brute_force(f.scene.model, data, arm);
+    ASSERT_EQ(fast, slow) << "configuration " << i;
+    colliding += fast;
+    // The whole-scene answer is at least as pessimistic as any subset's.
+    if (fast) EXPECT_TRUE(core::in_collision(f.scene.model, data));
+  }
   EXPECT_GT(colliding, 50);
   EXPECT_LT(colliding, 580);
 }

@@ -140,6 +140,7 @@ struct CellScene {
   RobotBodies robot;
   RobotBodies human;
   std::vector<int> obstacles;
+  std::vector<std::vector<int>> arm_bodies;  // per arm (Cell::arms order): links and gripper
 };
 
 struct CellSceneOptions {

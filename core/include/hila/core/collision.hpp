@@ -76,9 +76,18 @@ struct CollisionPair {
 // reports its pair.
 bool in_collision(const CollisionModel& model, CollisionData& data,
                   CollisionPair* first = nullptr);
+// Collisions involving at least one of `bodies` (against every other enabled body, static or
+// moving, and among themselves). This is the planner's query when one arm (with what it holds)
+// moves and the rest of the scene is unchanged; it needs no broad-phase tree update for the
+// moving set.
+bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
+                  CollisionPair* first = nullptr);
 // The same answer by testing every candidate pair with FCL's narrow phase (reference for tests).
 bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
                               CollisionPair* first = nullptr);
+// Brute-force reference for the subset query.
+bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
+                              const std::vector<int>& bodies, CollisionPair* first = nullptr);
 // Smallest distance over the same pairs (negative or zero when in collision).
 double min_distance(const CollisionModel& model, CollisionData& data,
                     CollisionPair* closest = nullptr);
@@ -95,6 +104,9 @@ struct RobotBodies {
 // geometry-less frames touch).
 RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std::string& prefix,
                       bool is_static = false);
+
+// Bodies of the links at and below `root_link` (an arm with its gripper, say).
+std::vector<int> subtree_bodies(const RobotModel& robot, const RobotBodies& bodies, int root_link);
 
 // Sets every link body's pose to base * link_poses[link].
 void set_robot_pose(CollisionData& data, const RobotBodies& bodies,
