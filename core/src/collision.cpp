@@ -424,4 +424,15 @@ void set_robot_pose(CollisionData& data, const RobotBodies& bodies,
   }
 }
 
+Attachment attach(CollisionModel& model, int body, int link, const Pose& link_to_body,
+                  const std::vector<int>& touching_bodies) {
+  for (const int other : touching_bodies) model.allow(body, other);
+  return Attachment{body, link, link_to_body};
+}
+
+void set_attachment_pose(CollisionData& data, const Attachment& attachment,
+                         const std::vector<Pose>& link_poses, const Pose& base) {
+  data.set_body_pose(attachment.body, base * link_poses[attachment.link] * attachment.link_to_body);
+}
+
 }  // namespace hila::core

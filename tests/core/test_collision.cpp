@@ -178,6 +178,53 @@ TEST(Collision, TableContactNamesTheTable) {
   EXPECT_EQ(core::in_collision(f.scene.model, data), core::in_collision_brute_force(f.scene.model, data));
 }
 
+TEST(Collision, HeldBoardFollowsTheGripperAndHitsTheTable) {
+  // A lateral board (587 x 295 x 10 mm) held at the middle of a long edge, 2 cm deep: thickness
+  // along the opening axis (TCP y), width along the approach (TCP z).
+  auto cell = test::reference_cell();
+  core::CellScene scene = core::build_cell_scene(*cell);
+  const int tcp_link = cell->robot().link_index("left_tcp");
+  const int board = scene.model.add_body("board", {box(0.587, 0.010, 0.295)}, false);
+  std::vector<int> gripper;
+  for (const char* name : {"left_pad_l", "left_pad_r", "left_finger_l", "left_finger_r"}) {
+    gripper.push_back(*scene.model.find_body(name));
+  }
+  const core::Attachment held =
+      core::attach(scene.model, board, tcp_link, core::make_pose({0, 0, 0.1475 - 0.02}), gripper);
+  std::vector<int> active = scene.arm_bodies[0];
+  active.push_back(board);
+
+  const core::Arm& arm = cell->arm("left");
+  std::vector<core::Pose> links;
+  Eigen::VectorXd q = cell->home_configuration(0.010);
+  cell->robot().link_poses(q, links);
+  const core::Pose base = links[cell->robot().link_index(arm.spec.base_link)];
+  core::CollisionData data(scene.model);
+  auto pose_arm = [&](double tcp_height) {
+    // Gripper pointing down, TCP `tcp_height` above the table top.
+    const core::Pose tcp = core::make_pose({0.35, 0.30, 1.094 + tcp_height}, {core::kPi, 0, 0});
+    core::UrIkSolutions sols;
+    EXPECT_GT(arm.ur_ik->solve(base.inverse() * tcp, arm.spec.home, sols), 0);
+    // The first IK solution whose arm (without the board) is collision-free.
+    for (int k = 0; k < sols.count; ++k) {
+      cell->set_arm(q, arm, sols.q[k]);
+      core::set_cell_state(*cell, scene, data, q, cell->human_neutral());
+      if (!core::in_collision(scene.model, data, scene.arm_bodies[0])) break;
+    }
+    cell->robot().link_poses(q, links);
+    core::set_attachment_pose(data, held, links);
+  };
+  pose_arm(0.40);  // the board's lower edge 12.5 cm above the table
+  EXPECT_TRUE(data.body_pose(board).isApprox(links[tcp_link] * held.link_to_body, 1e-12));
+  EXPECT_FALSE(core::in_collision(scene.model, data, active));
+  pose_arm(0.15);  // the gripper is clear, the board reaches 12.5 cm below the table top
+  core::CollisionPair pair;
+  ASSERT_TRUE(core::in_collision(scene.model, data, active, &pair));
+  EXPECT_EQ(core::describe_pair(scene.model, pair), "table <-> board");
+  EXPECT_FALSE(core::in_collision(scene.model, data, scene.arm_bodies[0]));  // the arm alone is free
+  EXPECT_EQ(core::in_collision(scene.model, data), core::in_collision_brute_force(scene.model, data));
+}
+
 TEST(Collision, DistanceBetweenPrimitivesMatchesClosedForm) {
   core::CollisionModel model;
   model.add_body("wall", {box(1.0, 1.0, 1.0)}, true, core::make_pose({0, 0, 0}));

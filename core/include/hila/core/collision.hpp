@@ -112,4 +112,19 @@ std::vector<int> subtree_bodies(const RobotModel& robot, const RobotBodies& bodi
 void set_robot_pose(CollisionData& data, const RobotBodies& bodies,
                     const std::vector<Pose>& link_poses, const Pose& base = Pose::Identity());
 
+// An object held by a robot link (a board in the gripper, the suction tool): its body follows
+// the link. Attach it with the gripper bodies it touches (pads, fingers) allowed.
+struct Attachment {
+  int body = -1;
+  int link = -1;
+  Pose link_to_body = Pose::Identity();
+};
+
+Attachment attach(CollisionModel& model, int body, int link, const Pose& link_to_body,
+                  const std::vector<int>& touching_bodies);
+
+// Sets the attached body's pose from the link's pose (base * link_poses[link] * link_to_body).
+void set_attachment_pose(CollisionData& data, const Attachment& attachment,
+                         const std::vector<Pose>& link_poses, const Pose& base = Pose::Identity());
+
 }  // namespace hila::core
