@@ -55,6 +55,43 @@ ArmSpec parse_arm(const YamlNode& node) {
   return arm;
 }
 
+PadSpec parse_pad(const YamlNode& pad) {
+  pad.expect_only({"friction", "elastic_modulus", "thickness", "radius_1", "radius_2", "width",
+                   "length"});
+  PadSpec p;
+  p.friction = pad.at("friction").as_double_in(0.01, 3.0);
+  p.elastic_modulus = pad.at("elastic_modulus").as_positive();
+  p.thickness = pad.at("thickness").as_positive();
+  p.radius_1 = pad.at("radius_1").as_positive();
+  p.radius_2 = pad.at("radius_2").as_positive();
+  p.width = pad.at("width").as_positive();
+  p.length = pad.at("length").as_positive();
+  return p;
+}
+
+HumanHandSpec parse_hand(const YamlNode& node) {
+  node.expect_only({"aperture_range", "grip_force", "pad", "finger_thickness", "finger_width",
+                    "finger_length", "palm_width", "palm_length", "palm_thickness"});
+  HumanHandSpec h;
+  const auto aperture = node.at("aperture_range").as_doubles(2);
+  if (!(aperture[0] >= 0 && aperture[1] > aperture[0] && aperture[1] < 0.3)) {
+    node.at("aperture_range").fail("[min, max] in metres with 0 <= min < max < 0.3",
+                                   "[" + format_number(aperture[0]) + ", " +
+                                       format_number(aperture[1]) + "]");
+  }
+  h.aperture_min = aperture[0];
+  h.aperture_max = aperture[1];
+  h.grip_force = node.at("grip_force").as_positive();
+  h.pad = parse_pad(node.at("pad"));
+  h.finger_thickness = node.at("finger_thickness").as_positive();
+  h.finger_width = node.at("finger_width").as_positive();
+  h.finger_length = node.at("finger_length").as_positive();
+  h.palm_width = node.at("palm_width").as_positive();
+  h.palm_length = node.at("palm_length").as_positive();
+  h.palm_thickness = node.at("palm_thickness").as_positive();
+  return h;
+}
+
 GripperSpec parse_gripper(const YamlNode& node) {
   node.expect_only({"tcp_in_flange", "opening_axis", "approach_axis", "jaw_range",
                     "grip_force_range", "grip_force", "pad", "friction_torque_capacity",
@@ -82,16 +119,7 @@ GripperSpec parse_gripper(const YamlNode& node) {
   g.grip_force_min = force[0];
   g.grip_force_max = force[1];
   g.grip_force = node.at("grip_force").as_double_in(force[0], force[1]);
-  const YamlNode pad = node.at("pad");
-  pad.expect_only({"friction", "elastic_modulus", "thickness", "radius_1", "radius_2", "width",
-                   "length"});
-  g.pad.friction = pad.at("friction").as_double_in(0.01, 3.0);
-  g.pad.elastic_modulus = pad.at("elastic_modulus").as_positive();
-  g.pad.thickness = pad.at("thickness").as_positive();
-  g.pad.radius_1 = pad.at("radius_1").as_positive();
-  g.pad.radius_2 = pad.at("radius_2").as_positive();
-  g.pad.width = pad.at("width").as_positive();
-  g.pad.length = pad.at("length").as_positive();
+  g.pad = parse_pad(node.at("pad"));
   g.friction_torque_capacity = node.at("friction_torque_capacity").as_positive();
   if (node.has("slip_step_deg")) g.slip_step_deg = node.at("slip_step_deg").as_double_in(0.01, 45);
   return g;
@@ -152,7 +180,7 @@ CellSpec load_cell_spec(const std::string& path) {
   }
 
   const YamlNode human = root.at("human");
-  human.expect_only({"urdf", "stance", "arms", "neutral_deg"});
+  human.expect_only({"urdf", "stance", "arms", "neutral_deg", "hand"});
   cell.human_urdf = human.resolve_path(human.at("urdf").as_string());
   cell.human_stance = human.at("stance").as_pose();
   const YamlNode human_arms = human.at("arms");
@@ -162,6 +190,7 @@ CellSpec load_cell_spec(const std::string& path) {
     cell.human_arms.push_back(
         {a.at("name").as_string(), a.at("base_link").as_string(), a.at("tip_link").as_string()});
   }
+  cell.human_hand = parse_hand(human.at("hand"));
   if (const auto neutral = human.find("neutral_deg")) {
     cell.human_neutral = degrees_vector(*neutral, neutral->size());
   }

@@ -63,6 +63,21 @@ struct ArmSpec {
   Eigen::VectorXd max_acceleration;  // rad/s^2
 };
 
+// The human hand as a 1-DoF gripper (paper §IV): fingertip pads of skin (mu = 0.8) closing along
+// the grasp frame's y axis with a comfortable pinch force.
+struct HumanHandSpec {
+  double aperture_min = 0.0;   // m
+  double aperture_max = 0.09;  // m, thumb-index span for a pinch
+  double grip_force = 40.0;    // N, sustained comfortable pinch per finger
+  PadSpec pad;                 // fingertip: friction, skin modulus, soft-tissue depth, radii, size
+  double finger_thickness = 0.016;  // m, along the closing axis
+  double finger_width = 0.02;       // m
+  double finger_length = 0.06;      // m, along the approach, centred on the grasp point
+  double palm_width = 0.085;        // m, across the fingers
+  double palm_length = 0.09;        // m, behind the fingertips
+  double palm_thickness = 0.03;     // m
+};
+
 struct HumanArmSpec {
   std::string name;
   std::string base_link;
@@ -86,6 +101,7 @@ struct CellSpec {
   std::string human_urdf;
   Pose human_stance = Pose::Identity();
   std::vector<HumanArmSpec> human_arms;
+  HumanHandSpec human_hand;
   Eigen::VectorXd human_neutral;  // empty: zero clamped into limits
   double gravity = 9.81;
 };
