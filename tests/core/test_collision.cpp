@@ -121,7 +121,9 @@ TEST(Collision, ArmSubsetQueryAgreesWithBruteForceOverItsPairs) {
     ASSERT_EQ(fast, slow) << "configuration " << i;
     colliding += fast;
     // The whole-scene answer is at least as pessimistic as any subset's.
-    if (fast) EXPECT_TRUE(core::in_collision(f.scene.model, data));
+    if (fast) {
+      EXPECT_TRUE(core::in_collision(f.scene.model, data));
+    }
   }
   EXPECT_GT(colliding, 50);
   EXPECT_LT(colliding, 580);

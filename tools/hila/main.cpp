@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   hila::tools::add_human_command(app, action);
   hila::tools::add_mesh_command(app, action);
   hila::tools::add_product_command(app, action);
+  hila::tools::add_build_command(app, action);
+  hila::tools::add_inspect_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,30 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace hila::db::detail {
+
+// One schema upgrade: SQL that turns a database of `from_version` into `from_version + 1`. The
+// framework updates meta.schema_version itself; the SQL only changes tables and rows.
+struct MigrationStep {
+  int from_version = 0;
+  std::string sql;
+};
+
+// The steps this build of hila knows, in order (empty for schema version 1).
+const std::vector<MigrationStep>& migration_steps();
+
+// True if `steps` hold one step for every version from `from_version` up to `to_version` - 1.
+bool can_migrate(const std::vector<MigrationStep>& steps, int from_version, int to_version);
+
+// migrate_in_place with an explicit step list and target version, so the framework can be tested
+// with synthetic steps. Throws DatabaseError when a step is missing, fails, or the file is newer.
+void migrate_with_steps(const std::string& path, const std::vector<MigrationStep>& steps,
+                        int target_version);
+
+// Runs SQL on a database file (created if missing) in one transaction. For tests and tools that
+// need hand-made databases (old versions, foreign files); hila writes through DatabaseWriter.
+void execute_script(const std::string& path, const std::string& sql);
+
+}  // namespace hila::db::detail

@@ -1,0 +1,235 @@
+#include <algorithm>
+#include <charconv>
+#include <functional>
+#include <iterator>
+#include <map>
+#include <optional>
+
+#include "hila/db/database.hpp"
+#include "hila/db/migration.hpp"
+#include "open_checks.hpp"
+#include "pose_codec.hpp"
+#include "schema.hpp"
+#include "sqlite_handle.hpp"
+
+namespace hila::db {
+
+namespace {
+
+using detail::pose_columns;
+using detail::vector_columns;
+
+// Reads rows of `table` in id order; `read_row` consumes the columns after id and part_id.
+template <typename Record>
+std::vector<Record> load_table(detail::Connection& connection, const std::string& table,
+                               const std::string& columns, const std::string& fix,
+                               const std::function<void(detail::Statement&, Record&)>& read_row) {
+  detail::Statement select(connection,
+                           "SELECT id, part_id, " + columns + " FROM " + table + " ORDER BY id",
+                           {table, "a readable hila table", fix});
+  std::vector<Record> records;
+  while (select.step()) {
+    Record record;
+    record.id = select.next_int64();
+    record.part_id = select.next_int64();
+    read_row(select, record);
+    records.push_back(std::move(record));
+  }
+  return records;
+}
+
+Eigen::Vector3d read_vector(detail::Statement& s) {
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) v[i] = s.next_double();
+  return v;
+}
+
+// A pose whose quaternion is not a unit one can only come from damage or hand edits.
+core::Pose read_pose(detail::Statement& s, const std::string& path, const std::string& table,
+                     const std::string& prefix, std::int64_t id, const std::string& fix) {
+  detail::PoseColumns columns;
+  for (double& value : columns) value = s.next_double();
+  const auto pose = detail::decode_pose(columns);
+  if (!pose) {
+    throw DatabaseError(path, table + "." + prefix + " (id " + std::to_string(id) + ")",
+                        "finite values and a unit quaternion", "something else", fix);
+  }
+  return *pose;
+}
+
+std::string short_hash(const std::string& hash) {
+  return hash.size() > 12 ? hash.substr(0, 12) + "..." : hash;
+}
+
+void check_hash(const std::string& path, const std::string& what, const std::string& key,
+                const std::string& stored, const std::optional<std::string>& expected,
+                const std::string& fix) {
+  if (!expected || *expected == stored) return;
+  throw DatabaseError(
+      path, "meta." + key, short_hash(*expected) + " (the " + what + " as it is now)",
+      short_hash(stored) + " (the " + what + " this database was built from): the " + what +
+          " changed since this database was built",
+      fix);
+}
+
+Meta parse_meta(const std::string& path, const std::map<std::string, std::string>& map,
+                int schema_version) {
+  const std::string fix = detail::rebuild_hint(path, map);
+  for (const char* key : detail::kMetaKeys) {
+    if (!map.count(key)) {
+      throw DatabaseError(path, std::string("meta.") + key, "a value", "no such key", fix);
+    }
+  }
+  Meta meta;
+  meta.schema_version = schema_version;
+  meta.hila_version = map.at("hila_version");
+  meta.product_name = map.at("product_name");
+  meta.cell_hash = map.at("cell_hash");
+  meta.product_hash = map.at("product_hash");
+  meta.settings_hash = map.at("settings_hash");
+  meta.created_at = map.at("created_at");
+  meta.cell_file = map.at("cell_file");
+  meta.product_file = map.at("product_file");
+  const std::string& seed = map.at("seed");
+  const auto [end, error] = std::from_chars(seed.data(), seed.data() + seed.size(), meta.seed);
+  if (seed.empty() || error != std::errc() || end != seed.data() + seed.size()) {
+    throw DatabaseError(path, "meta.seed", "an unsigned 64-bit integer", "'" + seed + "'", fix);
+  }
+  return meta;
+}
+
+template <typename Record>
+std::vector<Record> for_part(const std::vector<Record>& records, std::int64_t part_id) {
+  std::vector<Record> selected;
+  std::copy_if(records.begin(), records.end(), std::back_inserter(selected),
+               [&](const Record& r) { return r.part_id == part_id; });
+  return selected;
+}
+
+}  // namespace
+
+Database Database::open(const std::string& path, const OpenOptions& options) {
+  const auto connection = detail::open_hila_database(path);
+  const auto meta_map = detail::read_meta_table(*connection);
+  const int version = detail::stored_schema_version(path, meta_map);
+  const std::string fix = detail::rebuild_hint(path, meta_map);
+  detail::check_schema_version(
+      path, version, current_schema_version(),
+      detail::can_migrate(detail::migration_steps(), version, current_schema_version()), fix);
+
+  Database db;
+  db.path_ = path;
+  db.meta_ = parse_meta(path, meta_map, version);
+  check_hash(path, "cell", "cell_hash", db.meta_.cell_hash, options.expected_cell_hash, fix);
+  check_hash(path, "product", "product_hash", db.meta_.product_hash, options.expected_product_hash,
+             fix);
+
+  {
+    detail::Statement select(
+        *connection,
+        "SELECT id, name, assembly_order, mesh_file, mesh_hash, mass, volume, " +
+            vector_columns("com") + ", ixx, iyy, izz, ixy, ixz, iyz, " + vector_columns("extent") +
+            ", triangle_count, " + pose_columns("target") + ", " + pose_columns("initial") +
+            " FROM parts ORDER BY id",
+        {"parts", "a readable hila table", fix});
+    while (select.step()) {
+      PartRecord part;
+      part.id = select.next_int64();
+      part.name = select.next_text();
+      part.assembly_order = static_cast<int>(select.next_int64());
+      part.mesh_file = select.next_text();
+      part.mesh_hash = select.next_text();
+      part.mass = select.next_double();
+      part.mass_properties.volume = select.next_double();
+      part.mass_properties.com = read_vector(select);
+      Eigen::Matrix3d& inertia = part.mass_properties.inertia;
+      inertia(0, 0) = select.next_double();
+      inertia(1, 1) = select.next_double();
+      inertia(2, 2) = select.next_double();
+      inertia(0, 1) = inertia(1, 0) = select.next_double();
+      inertia(0, 2) = inertia(2, 0) = select.next_double();
+      inertia(1, 2) = inertia(2, 1) = select.next_double();
+      part.extent = read_vector(select);
+      part.triangle_count = static_cast<int>(select.next_int64());
+      part.target = read_pose(select, path, "parts", "target", part.id, fix);
+      part.initial = read_pose(select, path, "parts", "initial", part.id, fix);
+      db.parts_.push_back(std::move(part));
+    }
+  }
+
+  db.placements_ = load_table<PlacementRecord>(
+      *connection, "placements", pose_columns("part_in_plane") + ", stability", fix,
+      [&](detail::Statement& s, PlacementRecord& r) {
+        r.part_in_plane = read_pose(s, path, "placements", "part_in_plane", r.id, fix);
+        r.stability = s.next_double();
+      });
+  db.robot_grasps_ = load_table<RobotGraspRecord>(
+      *connection, "robot_grasps",
+      pose_columns("tcp") + ", jaw_width, " + vector_columns("contact_1") + ", " +
+          vector_columns("normal_1") + ", " + vector_columns("contact_2") + ", " +
+          vector_columns("normal_2") + ", quality, friction_torque_capacity, lever, theta_c_deg",
+      fix, [&](detail::Statement& s, RobotGraspRecord& r) {
+        r.tcp = read_pose(s, path, "robot_grasps", "tcp", r.id, fix);
+        r.jaw_width = s.next_double();
+        r.contact_1 = read_vector(s);
+        r.normal_1 = read_vector(s);
+        r.contact_2 = read_vector(s);
+        r.normal_2 = read_vector(s);
+        r.quality = s.next_double();
+        r.friction_torque_capacity = s.next_double();
+        r.lever = s.next_double();
+        r.theta_c_deg = s.next_double();
+      });
+  db.suction_grasps_ = load_table<SuctionGraspRecord>(
+      *connection, "suction_grasps",
+      pose_columns("cup") + ", rotation_deg, force_margin, moment_margin", fix,
+      [&](detail::Statement& s, SuctionGraspRecord& r) {
+        r.cup = read_pose(s, path, "suction_grasps", "cup", r.id, fix);
+        r.rotation_deg = s.next_double();
+        r.force_margin = s.next_double();
+        r.moment_margin = s.next_double();
+      });
+  db.human_grasps_ = load_table<HumanGraspRecord>(
+      *connection, "human_grasps",
+      pose_columns("hand") + ", aperture, " + vector_columns("contact_1") + ", " +
+          vector_columns("contact_2") + ", quality, one_hand_stable",
+      fix, [&](detail::Statement& s, HumanGraspRecord& r) {
+        r.hand = read_pose(s, path, "human_grasps", "hand", r.id, fix);
+        r.aperture = s.next_double();
+        r.contact_1 = read_vector(s);
+        r.contact_2 = read_vector(s);
+        r.quality = s.next_double();
+        r.one_hand_stable = s.next_int64() != 0;
+      });
+  return db;
+}
+
+const PartRecord& Database::part(const std::string& name) const {
+  for (const auto& p : parts_) {
+    if (p.name == name) return p;
+  }
+  std::string known;
+  for (const auto& p : parts_) known += (known.empty() ? "" : ", ") + p.name;
+  throw core::InputError(
+      path_, "parts",
+      "a part named '" + name + "' (parts: " + (known.empty() ? std::string("none") : known) + ")",
+      "no such part");
+}
+
+std::vector<PlacementRecord> Database::placements(std::int64_t part_id) const {
+  return for_part(placements_, part_id);
+}
+
+std::vector<RobotGraspRecord> Database::robot_grasps(std::int64_t part_id) const {
+  return for_part(robot_grasps_, part_id);
+}
+
+std::vector<SuctionGraspRecord> Database::suction_grasps(std::int64_t part_id) const {
+  return for_part(suction_grasps_, part_id);
+}
+
+std::vector<HumanGraspRecord> Database::human_grasps(std::int64_t part_id) const {
+  return for_part(human_grasps_, part_id);
+}
+
+}  // namespace hila::db

@@ -1,0 +1,116 @@
+#include "schema.hpp"
+
+#include "hila/db/database.hpp"
+#include "hila/db/migration.hpp"
+
+namespace hila::db {
+
+// Bump together with a new entry in migration_steps() and a schema_sql() change.
+int current_schema_version() {
+  return 1;
+}
+
+namespace detail {
+
+// Written out in full (not generated) so this file is the readable reference of the schema.
+// Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
+const std::string& schema_sql() {
+  static const std::string sql = R"sql(
+CREATE TABLE meta (
+  key TEXT PRIMARY KEY,
+  value TEXT NOT NULL
+);
+
+CREATE TABLE parts (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL UNIQUE,
+  assembly_order INTEGER NOT NULL,
+  mesh_file TEXT NOT NULL,
+  mesh_hash TEXT NOT NULL,
+  mass REAL NOT NULL,
+  volume REAL NOT NULL,
+  com_x REAL NOT NULL, com_y REAL NOT NULL, com_z REAL NOT NULL,
+  ixx REAL NOT NULL, iyy REAL NOT NULL, izz REAL NOT NULL,
+  ixy REAL NOT NULL, ixz REAL NOT NULL, iyz REAL NOT NULL,
+  extent_x REAL NOT NULL, extent_y REAL NOT NULL, extent_z REAL NOT NULL,
+  triangle_count INTEGER NOT NULL,
+  target_x REAL NOT NULL, target_y REAL NOT NULL, target_z REAL NOT NULL,
+  target_qw REAL NOT NULL, target_qx REAL NOT NULL, target_qy REAL NOT NULL,
+  target_qz REAL NOT NULL,
+  initial_x REAL NOT NULL, initial_y REAL NOT NULL, initial_z REAL NOT NULL,
+  initial_qw REAL NOT NULL, initial_qx REAL NOT NULL, initial_qy REAL NOT NULL,
+  initial_qz REAL NOT NULL
+);
+
+CREATE TABLE placements (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  part_in_plane_x REAL NOT NULL, part_in_plane_y REAL NOT NULL, part_in_plane_z REAL NOT NULL,
+  part_in_plane_qw REAL NOT NULL, part_in_plane_qx REAL NOT NULL,
+  part_in_plane_qy REAL NOT NULL, part_in_plane_qz REAL NOT NULL,
+  stability REAL NOT NULL
+);
+CREATE INDEX placements_part_id ON placements(part_id);
+
+CREATE TABLE robot_grasps (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  tcp_x REAL NOT NULL, tcp_y REAL NOT NULL, tcp_z REAL NOT NULL,
+  tcp_qw REAL NOT NULL, tcp_qx REAL NOT NULL, tcp_qy REAL NOT NULL, tcp_qz REAL NOT NULL,
+  jaw_width REAL NOT NULL,
+  contact_1_x REAL NOT NULL, contact_1_y REAL NOT NULL, contact_1_z REAL NOT NULL,
+  normal_1_x REAL NOT NULL, normal_1_y REAL NOT NULL, normal_1_z REAL NOT NULL,
+  contact_2_x REAL NOT NULL, contact_2_y REAL NOT NULL, contact_2_z REAL NOT NULL,
+  normal_2_x REAL NOT NULL, normal_2_y REAL NOT NULL, normal_2_z REAL NOT NULL,
+  quality REAL NOT NULL,
+  friction_torque_capacity REAL NOT NULL,
+  lever REAL NOT NULL,
+  theta_c_deg REAL NOT NULL
+);
+CREATE INDEX robot_grasps_part_id ON robot_grasps(part_id);
+
+CREATE TABLE suction_grasps (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  cup_x REAL NOT NULL, cup_y REAL NOT NULL, cup_z REAL NOT NULL,
+  cup_qw REAL NOT NULL, cup_qx REAL NOT NULL, cup_qy REAL NOT NULL, cup_qz REAL NOT NULL,
+  rotation_deg REAL NOT NULL,
+  force_margin REAL NOT NULL,
+  moment_margin REAL NOT NULL
+);
+CREATE INDEX suction_grasps_part_id ON suction_grasps(part_id);
+
+CREATE TABLE human_grasps (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  hand_x REAL NOT NULL, hand_y REAL NOT NULL, hand_z REAL NOT NULL,
+  hand_qw REAL NOT NULL, hand_qx REAL NOT NULL, hand_qy REAL NOT NULL, hand_qz REAL NOT NULL,
+  aperture REAL NOT NULL,
+  contact_1_x REAL NOT NULL, contact_1_y REAL NOT NULL, contact_1_z REAL NOT NULL,
+  contact_2_x REAL NOT NULL, contact_2_y REAL NOT NULL, contact_2_z REAL NOT NULL,
+  quality REAL NOT NULL,
+  one_hand_stable INTEGER NOT NULL CHECK (one_hand_stable IN (0, 1))
+);
+CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
+)sql";
+  return sql;
+}
+
+// Upgrades from older schema versions, oldest first. Schema version 1 is the first release, so
+// there is nothing to upgrade from yet. A step's SQL runs inside the migration's transaction.
+const std::vector<MigrationStep>& migration_steps() {
+  static const std::vector<MigrationStep> steps = {};
+  return steps;
+}
+
+std::string pose_columns(const std::string& prefix) {
+  return prefix + "_x, " + prefix + "_y, " + prefix + "_z, " + prefix + "_qw, " + prefix + "_qx, " +
+         prefix + "_qy, " + prefix + "_qz";
+}
+
+std::string vector_columns(const std::string& prefix) {
+  return prefix + "_x, " + prefix + "_y, " + prefix + "_z";
+}
+
+}  // namespace detail
+}  // namespace hila::db

@@ -1,0 +1,64 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/product.hpp"
+#include "hila/offline/human_grasps.hpp"
+#include "hila/offline/robot_grasps.hpp"
+#include "hila/offline/suction_grasps.hpp"
+
+namespace hila::offline {
+
+struct BuildSettings {
+  std::uint64_t seed = 1;
+  int jobs = 1;  // worker threads over parts; the content never depends on it
+  RobotGraspSettings robot;
+  SuctionSettings suction;
+  HumanGraspSettings human;
+};
+
+struct PartBuildSummary {
+  std::string name;
+  int order = 0;
+  double mass = 0.0;
+  int placements = 0;
+  int robot_grasps = 0;
+  int suction_grasps = 0;
+  int human_grasps = 0;
+  int one_hand_grasps = 0;
+  double theta_c_min_deg = 90.0;
+  double theta_c_max_deg = 90.0;
+  double seconds = 0.0;
+};
+
+struct BuildSummary {
+  std::string output;
+  std::vector<PartBuildSummary> parts;  // in assembly order
+  double seconds = 0.0;
+};
+
+// Called as each part finishes (from a worker thread, serialised): name, parts done, total.
+using BuildProgress = std::function<void(const std::string& part, int done, int total)>;
+
+// Hashes that tie a database to its inputs: the cell file and every URDF it references; the
+// product file and every mesh it references; the content-relevant settings (not `jobs`).
+std::string cell_hash(const core::CellSpec& cell);
+std::string product_hash(const core::ProductSpec& product);
+std::string settings_hash(const BuildSettings& settings);
+
+// The per-part seed: independent of the part's position in the file and of the thread that
+// builds it.
+std::uint64_t part_seed(std::uint64_t seed, const std::string& part_name, std::uint64_t stream);
+
+// Builds the product database: part analysis, robot grasps with theta_c, suction and human
+// grasps, in parallel over parts, written atomically (the previous file survives any failure).
+// Throws core::InputError for bad input, naming the file, the part and the field.
+BuildSummary build_database(const std::string& product_path, const std::string& cell_path,
+                            const std::string& output_path, const BuildSettings& settings,
+                            const BuildProgress& progress = {});
+
+}  // namespace hila::offline

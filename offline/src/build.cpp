@@ -1,0 +1,229 @@
+#include "hila/offline/build.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <ctime>
+#include <exception>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "hila/core/error.hpp"
+#include "hila/db/database.hpp"
+#include "hila/offline/part_analysis.hpp"
+
+#ifndef HILA_VERSION
+#define HILA_VERSION "unknown"
+#endif
+
+namespace hila::offline {
+
+namespace {
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError(path, "(file)", "a readable file", "cannot open");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+// Files are joined with their names and lengths so that moving bytes between files changes the
+// hash.
+std::string hash_files(const std::vector<std::string>& paths) {
+  std::string all;
+  for (const auto& p : paths) {
+    const std::string bytes = file_bytes(p);
+    all += p.substr(p.find_last_of('/') + 1) + '\0' + std::to_string(bytes.size()) + '\0' + bytes;
+  }
+  return db::sha256_hex(all);
+}
+
+std::string mesh_hash(const core::TriangleMesh& mesh) {
+  std::string bytes;
+  bytes.reserve(mesh.vertices.size() * 24 + mesh.triangles.size() * 12);
+  for (const auto& v : mesh.vertices) {
+    bytes.append(reinterpret_cast<const char*>(v.data()), 3 * sizeof(double));
+  }
+  for (const auto& t : mesh.triangles) {
+    bytes.append(reinterpret_cast<const char*>(t.data()), 3 * sizeof(int));
+  }
+  return db::sha256_hex(bytes);
+}
+
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buffer[32];
+  std::strftime(buffer, sizeof(buffer), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buffer;
+}
+
+struct PartResult {
+  db::PartRecord record;
+  std::vector<db::PlacementRecord> placements;
+  std::vector<db::RobotGraspRecord> robot;
+  std::vector<db::SuctionGraspRecord> suction;
+  std::vector<db::HumanGraspRecord> human;
+  PartBuildSummary summary;
+};
+
+PartResult build_part(const core::ProductSpec& product, std::size_t index, const core::Cell& cell,
+                      const BuildSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  const core::PartSpec& part = product.parts[index];
+  const std::string field = "parts[" + part.name + "]";
+  PartResult r;
+  const PartAnalysis analysis = analyze_part(part.name, part.mesh, part.mass);
+
+  r.record.name = part.name;
+  r.record.assembly_order = part.order;
+  r.record.mesh_file = part.mesh_file.substr(part.mesh_file.find_last_of('/') + 1);
+  r.record.mesh_hash = mesh_hash(part.mesh);
+  r.record.mass = part.mass;
+  r.record.mass_properties = analysis.mass_properties;
+  r.record.extent = part.mesh.max_corner() - part.mesh.min_corner();
+  r.record.triangle_count = static_cast<int>(part.mesh.triangles.size());
+  r.record.target = product.target_in_world(part);
+  r.record.initial = part.initial;
+  r.placements = analysis.placements;
+
+  RobotGraspSettings robot = settings.robot;
+  robot.seed = part_seed(settings.seed, part.name, 1);
+  r.robot = plan_robot_grasps(analysis.mesh, analysis, part.mass, cell, robot);
+  if (r.robot.empty()) {
+    throw core::InputError(product.file, field,
+                           "a part the gripper can hold (somewhere no wider than the " +
+                               core::format_number(cell.spec().gripper.jaw_max) + " m jaw)",
+                           "no collision-free antipodal grasp on '" + part.name + "'");
+  }
+  r.suction = plan_suction_grasps(analysis.mesh, analysis, part.mass, cell, settings.suction);
+  HumanGraspSettings human = settings.human;
+  human.seed = part_seed(settings.seed, part.name, 2);
+  r.human = plan_human_grasps(analysis.mesh, analysis, part.mass, cell, human);
+
+  auto& s = r.summary;
+  s.name = part.name;
+  s.order = part.order;
+  s.mass = part.mass;
+  s.placements = static_cast<int>(r.placements.size());
+  s.robot_grasps = static_cast<int>(r.robot.size());
+  s.suction_grasps = static_cast<int>(r.suction.size());
+  s.human_grasps = static_cast<int>(r.human.size());
+  for (const auto& g : r.human) s.one_hand_grasps += g.one_hand_stable ? 1 : 0;
+  s.theta_c_min_deg = 90.0;
+  s.theta_c_max_deg = 0.0;
+  for (const auto& g : r.robot) {
+    s.theta_c_min_deg = std::min(s.theta_c_min_deg, g.theta_c_deg);
+    s.theta_c_max_deg = std::max(s.theta_c_max_deg, g.theta_c_deg);
+  }
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace
+
+std::uint64_t part_seed(std::uint64_t seed, const std::string& part_name, std::uint64_t stream) {
+  // FNV-1a over the name, mixed with the seed and stream by SplitMix64.
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const unsigned char c : part_name) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  std::uint64_t z = h ^ (seed * 0x9E3779B97F4A7C15ULL) ^ (stream << 32);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+std::string cell_hash(const core::CellSpec& cell) {
+  return hash_files({cell.file, cell.robot_urdf, cell.suction.tool_urdf, cell.human_urdf});
+}
+
+std::string product_hash(const core::ProductSpec& product) {
+  std::vector<std::string> files{product.file};
+  for (const auto& p : product.parts) files.push_back(p.mesh_file);
+  return hash_files(files);
+}
+
+std::string settings_hash(const BuildSettings& s) {
+  std::ostringstream text;
+  text.precision(17);
+  text << "robot " << s.robot.samples << ' ' << s.robot.approach_rotations << ' '
+       << s.robot.opening_margin << ' ' << s.robot.merge_distance << ' ' << s.robot.merge_angle_deg
+       << "\nsuction " << s.suction.rotations << ' ' << s.suction.min_area_fraction << "\nhuman "
+       << s.human.samples << ' ' << s.human.approach_rotations << ' ' << s.human.opening_margin
+       << ' ' << s.human.merge_distance << ' ' << s.human.merge_angle_deg << '\n';
+  return db::sha256_hex(text.str());
+}
+
+BuildSummary build_database(const std::string& product_path, const std::string& cell_path,
+                            const std::string& output_path, const BuildSettings& settings,
+                            const BuildProgress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (settings.jobs < 1) {
+    throw core::InputError("command line", "--jobs", "a positive number of jobs",
+                           std::to_string(settings.jobs));
+  }
+  const auto cell = core::Cell::load(cell_path);
+  const core::ProductSpec product = core::load_product(product_path);
+  // Open the writer first: an unwritable destination fails before minutes of work.
+  db::DatabaseWriter writer(output_path);
+
+  const std::size_t n = product.parts.size();
+  std::vector<PartResult> results(n);
+  std::vector<std::exception_ptr> errors(n);
+  std::atomic<std::size_t> next{0};
+  std::mutex progress_mutex;
+  int done = 0;
+  auto worker = [&] {
+    for (std::size_t i = next++; i < n; i = next++) {
+      try {
+        results[i] = build_part(product, i, *cell, settings);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      ++done;
+      if (progress) progress(product.parts[i].name, done, static_cast<int>(n));
+    }
+  };
+  const int threads = std::min<int>(settings.jobs, static_cast<int>(n));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  // The first failing part in assembly order, whatever thread hit it first.
+  for (const auto& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+
+  db::Meta meta;
+  meta.hila_version = HILA_VERSION;
+  meta.product_name = product.name;
+  meta.cell_hash = cell_hash(cell->spec());
+  meta.product_hash = product_hash(product);
+  meta.settings_hash = settings_hash(settings);
+  meta.seed = settings.seed;
+  meta.created_at = utc_now();
+  meta.cell_file = cell_path.substr(cell_path.find_last_of('/') + 1);
+  meta.product_file = product_path.substr(product_path.find_last_of('/') + 1);
+  writer.write_meta(meta);
+  BuildSummary summary;
+  summary.output = output_path;
+  for (auto& r : results) {
+    const std::int64_t id = writer.add_part(r.record);
+    writer.add_placements(id, r.placements);
+    writer.add_robot_grasps(id, r.robot);
+    writer.add_suction_grasps(id, r.suction);
+    writer.add_human_grasps(id, r.human);
+    summary.parts.push_back(r.summary);
+  }
+  writer.commit();
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace hila::offline

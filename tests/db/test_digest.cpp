@@ -1,0 +1,97 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "hila/db/database.hpp"
+#include "hila/db/migration.hpp"
+#include "sample_records.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila::db;
+using namespace hila::db::test_data;
+using namespace hila::test;
+
+TEST(Digest, SameRecordsGiveTheSameDigestDespiteCreatedAtAndTemporaryName) {
+  const std::string dir = temp_dir("db_digest_same");
+  Sample a = make_sample();
+  Sample b = make_sample();
+  b.meta.created_at = "2031-01-01T00:00:00Z";
+  write_sample(dir + "/a.db", a);
+  write_sample(dir + "/b.db", b);  // another target, so another temporary file name
+  // The files differ (created_at is stored), the digests must not.
+  ASSERT_NE(read_file(dir + "/a.db"), read_file(dir + "/b.db"));
+  const std::string digest = content_digest(dir + "/a.db");
+  EXPECT_EQ(digest.size(), 64u);
+  EXPECT_EQ(digest, content_digest(dir + "/b.db"));
+  EXPECT_EQ(digest, content_digest(dir + "/a.db")) << "stable across calls";
+  EXPECT_NE(digest, sha256_hex(read_file(dir + "/a.db"))) << "not a hash of the file bytes";
+}
+
+TEST(Digest, OneUlpInOneGraspQualityChangesIt) {
+  const std::string dir = temp_dir("db_digest_ulp");
+  Sample a = make_sample();
+  Sample b = make_sample();
+  double& q = b.parts[1].robot_grasps[2].quality;
+  q = std::nextafter(q, 2.0);
+  ASSERT_NE(q, a.parts[1].robot_grasps[2].quality);
+  write_sample(dir + "/a.db", a);
+  write_sample(dir + "/b.db", b);
+  EXPECT_NE(content_digest(dir + "/a.db"), content_digest(dir + "/b.db"));
+}
+
+TEST(Digest, EveryKindOfChangeIsSeen) {
+  const std::string dir = temp_dir("db_digest_changes");
+  const Sample base = make_sample();
+  write_sample(dir + "/base.db", base);
+  const std::string reference = content_digest(dir + "/base.db");
+
+  std::vector<std::pair<std::string, Sample>> variants;
+  auto add = [&](const std::string& name, auto change) {
+    Sample s = make_sample();
+    change(s);
+    variants.emplace_back(name, s);
+  };
+  add("meta seed", [](Sample& s) { s.meta.seed -= 1; });
+  add("meta cell hash", [](Sample& s) { s.meta.cell_hash[0] = 'x'; });
+  add("part name", [](Sample& s) { s.parts[0].part.name += " "; });
+  add("flag", [](Sample& s) {
+    s.parts[1].human_grasps[0].one_hand_stable = !s.parts[1].human_grasps[0].one_hand_stable;
+  });
+  add("a placement less", [](Sample& s) { s.parts[0].placements.pop_back(); });
+  add("records moved between parts", [](Sample& s) {
+    s.parts[1].suction_grasps = s.parts[0].suction_grasps;
+    s.parts[0].suction_grasps.clear();
+  });
+  add("part order", [](Sample& s) { std::swap(s.parts[0], s.parts[1]); });
+  for (const auto& [name, sample] : variants) {
+    const std::string path = dir + "/variant.db";
+    write_sample(path, sample);
+    EXPECT_NE(content_digest(path), reference) << name;
+  }
+}
+
+TEST(Digest, IndependentOfTheFileName) {
+  const std::string dir = temp_dir("db_digest_rename");
+  write_sample(dir + "/a.db", make_sample());
+  const std::string before = content_digest(dir + "/a.db");
+  std::filesystem::rename(dir + "/a.db", dir + "/elsewhere.sqlite");
+  EXPECT_EQ(content_digest(dir + "/elsewhere.sqlite"), before);
+}
+
+TEST(Digest, CreatedAtIsTheOnlyIgnoredMetaKey) {
+  const std::string dir = temp_dir("db_digest_meta");
+  write_sample(dir + "/a.db", make_sample());
+  const std::string before = content_digest(dir + "/a.db");
+  detail::execute_script(dir + "/a.db", "UPDATE meta SET value = 'x' WHERE key = 'created_at'");
+  EXPECT_EQ(content_digest(dir + "/a.db"), before);
+  detail::execute_script(dir + "/a.db", "UPDATE meta SET value = 'x' WHERE key = 'hila_version'");
+  EXPECT_NE(content_digest(dir + "/a.db"), before);
+}
+
+TEST(Digest, RefusesNonHilaFiles) {
+  const std::string dir = temp_dir("db_digest_foreign");
+  expect_input_error([&] { content_digest(write_file(dir, "t.db", "hello")); },
+                     {"t.db", "expected a hila database (SQLite)"});
+  expect_input_error([&] { content_digest(dir + "/missing.db"); }, {"no such file"});
+}

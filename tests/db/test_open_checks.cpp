@@ -1,0 +1,207 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "hila/db/database.hpp"
+#include "hila/db/migration.hpp"
+#include "open_checks.hpp"
+#include "sample_records.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila::db;
+using namespace hila::db::test_data;
+using namespace hila::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A valid database of a few hundred pages, so a page in the middle holds grasp rows.
+std::string write_large(const std::string& dir) {
+  Sample sample = make_sample();
+  auto& grasps = sample.parts[0].robot_grasps;
+  const auto base = grasps;
+  for (int i = 0; i < 400; ++i) grasps.insert(grasps.end(), base.begin(), base.end());
+  const std::string path = dir + "/p.db";
+  write_sample(path, sample);
+  return path;
+}
+
+std::string write_small(const std::string& dir) {
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  return path;
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// Database::open and content_digest must both refuse the file with these fragments.
+void expect_refused(const std::string& path, std::initializer_list<std::string> fragments) {
+  expect_input_error([&] { Database::open(path); }, fragments);
+  expect_input_error([&] { content_digest(path); }, {path});
+}
+
+}  // namespace
+
+TEST(OpenChecks, MissingFileIsNotCreated) {
+  const std::string path = temp_dir("db_open_missing") + "/p.db";
+  expect_refused(path, {path + ": (file)", "no such file", "hila build PRODUCT.yaml -o " + path});
+  EXPECT_FALSE(fs::exists(path));
+}
+
+TEST(OpenChecks, Directory) {
+  const std::string dir = temp_dir("db_open_directory");
+  expect_refused(dir, {dir, "a directory"});
+}
+
+TEST(OpenChecks, EmptyFile) {
+  const std::string path = write_file(temp_dir("db_open_empty"), "p.db", "");
+  expect_refused(path, {path + ": (file)", "expected a hila database (SQLite), got an empty file",
+                        "rebuild with: hila build PRODUCT.yaml -o " + path});
+}
+
+TEST(OpenChecks, TruncatedToHalf) {
+  const std::string path = write_small(temp_dir("db_open_truncated"));
+  fs::resize_file(path, fs::file_size(path) / 2);
+  expect_refused(path, {path, "a truncated SQLite file", "its header says", "rebuild with"});
+}
+
+TEST(OpenChecks, TruncatedInsideTheHeader) {
+  const std::string dir = temp_dir("db_open_truncated_header");
+  const std::string path = write_small(dir);
+  fs::resize_file(path, 50);
+  expect_refused(path, {path, "truncated", "shorter than the 100-byte header"});
+  fs::resize_file(path, 10);  // a prefix of the magic string
+  expect_refused(path, {path, "a truncated SQLite file (10 bytes)"});
+}
+
+TEST(OpenChecks, TextFile) {
+  const std::string path =
+      write_file(temp_dir("db_open_text"), "p.db", "name: cabinet\nparts: []\n");
+  expect_refused(path, {path,
+                        "expected a hila database (SQLite), got a text file starting with "
+                        "\"name: cabinet parts: []\"",
+                        "check the path"});
+}
+
+TEST(OpenChecks, BinaryForeignFile) {
+  const std::string path = temp_dir("db_open_binary") + "/p.db";
+  write_bytes(path, std::string("\x7f"
+                                "ELF\x02\x01\x01\x00",
+                                8) +
+                        std::string(200, '\0'));
+  expect_refused(path, {path, "208-byte file that is not SQLite (it starts with 7f 45 4c 46 02"});
+}
+
+TEST(OpenChecks, SqliteFileWithoutHilaTables) {
+  const std::string path = temp_dir("db_open_foreign_sqlite") + "/p.db";
+  detail::execute_script(path, "CREATE TABLE addresses (street TEXT); CREATE TABLE b (x);");
+  expect_refused(path,
+                 {path + ": meta", "without it (tables: addresses, b)", "not written by hila"});
+}
+
+TEST(OpenChecks, CorruptPageInTheMiddle) {
+  const std::string path = write_large(temp_dir("db_open_corrupt"));
+  const auto size = fs::file_size(path);
+  constexpr std::uintmax_t kPage = 4096;  // SQLite's default page size
+  ASSERT_GT(size / kPage, 20u) << "need a multi-page database";
+  ASSERT_NO_THROW(Database::open(path));
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>((size / kPage / 2) * kPage));
+    const std::string garbage(kPage, '\xa5');
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  ASSERT_EQ(fs::file_size(path), size) << "same size: only the integrity check can notice";
+  expect_refused(path, {path + ": (integrity)", "expected an intact hila database (SQLite)",
+                        "rebuild with: hila build"});
+}
+
+TEST(OpenChecks, OlderSchemaVersion) {
+  const std::string path = write_small(temp_dir("db_open_older"));
+  detail::execute_script(path, "UPDATE meta SET value = '0' WHERE key = 'schema_version'");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta.schema_version", "this hila reads (schema version 1)",
+                      "written by schema version 0 (an older hila)",
+                      "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
+  // Schema 1 has no migration steps, so the message must not offer one.
+  try {
+    Database::open(path);
+  } catch (const DatabaseError& e) {
+    EXPECT_EQ(std::string(e.what()).find("migrate"), std::string::npos) << e.what();
+  }
+}
+
+TEST(OpenChecks, NewerSchemaVersion) {
+  const std::string path = write_small(temp_dir("db_open_newer"));
+  detail::execute_script(path, "UPDATE meta SET value = '2' WHERE key = 'schema_version'");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta.schema_version", "written by schema version 2 (a newer hila)",
+                      "upgrade hila, or rebuild with: hila build"});
+}
+
+TEST(OpenChecks, OlderVersionWithAMigrationPathSaysSo) {
+  expect_input_error([] { detail::check_schema_version("p.db", 0, 1, true, "rebuild with: X"); },
+                     {"p.db: meta.schema_version", "rebuild with: X, or migrate it in place"});
+  EXPECT_NO_THROW(detail::check_schema_version("p.db", 3, 3, false, ""));
+}
+
+TEST(OpenChecks, BadMetaValues) {
+  const std::string dir = temp_dir("db_open_meta");
+  const std::string path = write_small(dir);
+  const std::string pristine = read_file(path);
+  const auto reset = [&] { write_bytes(path, pristine); };
+
+  detail::execute_script(path, "UPDATE meta SET value = '1x' WHERE key = 'schema_version'");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta.schema_version", "expected an integer", "'1x'"});
+  reset();
+  detail::execute_script(path, "DELETE FROM meta WHERE key = 'schema_version'");
+  expect_input_error([&] { Database::open(path); }, {"meta.schema_version", "no such key"});
+  reset();
+  detail::execute_script(path, "DELETE FROM meta WHERE key = 'product_hash'");
+  expect_input_error([&] { Database::open(path); }, {"meta.product_hash", "no such key"});
+  reset();
+  detail::execute_script(path, "UPDATE meta SET value = '-1' WHERE key = 'seed'");
+  expect_input_error([&] { Database::open(path); },
+                     {"meta.seed", "an unsigned 64-bit integer", "'-1'"});
+  reset();
+  EXPECT_NO_THROW(Database::open(path));
+}
+
+TEST(OpenChecks, MissingTable) {
+  const std::string path = write_small(temp_dir("db_open_missing_table"));
+  detail::execute_script(path, "DROP TABLE human_grasps");
+  expect_refused(path, {path + ": human_grasps", "no such table: human_grasps", "rebuild with"});
+}
+
+TEST(OpenChecks, DamagedQuaternion) {
+  const std::string path = write_small(temp_dir("db_open_quaternion"));
+  detail::execute_script(path, "UPDATE robot_grasps SET tcp_qw = 0.5 WHERE id = 2");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": robot_grasps.tcp (id 2)", "a unit quaternion"});
+}
+
+TEST(OpenChecks, OpeningChangesNothingOnDisk) {
+  const std::string dir = temp_dir("db_open_readonly");
+  const std::string path = write_small(dir);
+  const std::string before = read_file(path);
+  Database::open(path);
+  content_digest(path);
+  EXPECT_EQ(read_file(path), before);
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
+  EXPECT_EQ(names, std::vector<std::string>{"p.db"}) << "no journal or lock files";
+}
+
+TEST(OpenChecks, CheckSqliteFileAcceptsAValidDatabase) {
+  const std::string path = write_small(temp_dir("db_open_valid"));
+  EXPECT_NO_THROW(detail::check_sqlite_file(path));
+  EXPECT_EQ(detail::rebuild_hint("x.db"), "rebuild with: hila build PRODUCT.yaml -o x.db");
+  EXPECT_EQ(detail::rebuild_hint("x.db", {{"product_file", "p.yaml"}}),
+            "rebuild with: hila build p.yaml -o x.db");
+  EXPECT_EQ(detail::rebuild_hint("x.db", {{"product_file", "p.yaml"}, {"cell_file", "c.yaml"}}),
+            "rebuild with: hila build p.yaml -o x.db");
+}

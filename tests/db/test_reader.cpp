@@ -1,0 +1,236 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "hila/db/database.hpp"
+#include "sample_records.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila::db;
+using namespace hila::db::test_data;
+using namespace hila::test;
+
+namespace {
+
+// Doubles must come back bit-exact (SQLite REAL is an IEEE double); only poses go through a
+// quaternion and are compared to 1e-12.
+void expect_same(const PartRecord& a, const PartRecord& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.assembly_order, b.assembly_order);
+  EXPECT_EQ(a.mesh_file, b.mesh_file);
+  EXPECT_EQ(a.mesh_hash, b.mesh_hash);
+  EXPECT_EQ(a.mass, b.mass);
+  EXPECT_EQ(a.mass_properties.volume, b.mass_properties.volume);
+  EXPECT_EQ(a.mass_properties.com, b.mass_properties.com);
+  EXPECT_EQ(a.mass_properties.inertia, b.mass_properties.inertia);
+  EXPECT_EQ(a.extent, b.extent);
+  EXPECT_EQ(a.triangle_count, b.triangle_count);
+  EXPECT_LT(pose_error(a.target, b.target), 1e-12);
+  EXPECT_LT(pose_error(a.initial, b.initial), 1e-12);
+}
+
+}  // namespace
+
+class ReaderRoundTrip : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // One directory per test: ctest runs the tests of this fixture in parallel processes.
+    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    path_ = temp_dir("db_reader_" + test) + "/p.db";
+    sample_ = make_sample();
+    ids_ = write_sample(path_, sample_);
+  }
+  std::string path_;
+  Sample sample_;
+  std::vector<std::int64_t> ids_;
+};
+
+TEST_F(ReaderRoundTrip, Meta) {
+  const Database db = Database::open(path_);
+  const Meta& m = db.meta();
+  const Meta& e = sample_.meta;
+  EXPECT_EQ(m.schema_version, current_schema_version());
+  EXPECT_EQ(m.hila_version, e.hila_version);
+  EXPECT_EQ(m.product_name, e.product_name);
+  EXPECT_EQ(m.cell_hash, e.cell_hash);
+  EXPECT_EQ(m.product_hash, e.product_hash);
+  EXPECT_EQ(m.settings_hash, e.settings_hash);
+  EXPECT_EQ(m.seed, e.seed) << "2^64 - 1 must survive";
+  EXPECT_EQ(m.created_at, e.created_at);
+  EXPECT_EQ(m.cell_file, e.cell_file);
+  EXPECT_EQ(m.product_file, e.product_file);
+  EXPECT_EQ(db.path(), path_);
+}
+
+TEST_F(ReaderRoundTrip, PartsWithIdsInOrder) {
+  const Database db = Database::open(path_);
+  ASSERT_EQ(db.parts().size(), sample_.parts.size());
+  EXPECT_EQ(ids_, (std::vector<std::int64_t>{1, 2}));
+  for (std::size_t k = 0; k < sample_.parts.size(); ++k) {
+    SCOPED_TRACE(sample_.parts[k].part.name);
+    EXPECT_EQ(db.parts()[k].id, ids_[k]);
+    expect_same(db.parts()[k], sample_.parts[k].part);
+  }
+  EXPECT_EQ(db.parts()[0].name, "Gehäuse-ß-部品-🔩") << "UTF-8 names survive";
+}
+
+TEST_F(ReaderRoundTrip, Placements) {
+  const Database db = Database::open(path_);
+  for (std::size_t k = 0; k < sample_.parts.size(); ++k) {
+    const auto got = db.placements(ids_[k]);
+    const auto& want = sample_.parts[k].placements;
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      EXPECT_EQ(got[i].part_id, ids_[k]);
+      EXPECT_LT(pose_error(got[i].part_in_plane, want[i].part_in_plane), 1e-12);
+      EXPECT_EQ(got[i].stability, want[i].stability);
+    }
+  }
+}
+
+TEST_F(ReaderRoundTrip, RobotGrasps) {
+  const Database db = Database::open(path_);
+  for (std::size_t k = 0; k < sample_.parts.size(); ++k) {
+    const auto got = db.robot_grasps(ids_[k]);
+    const auto& want = sample_.parts[k].robot_grasps;
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      SCOPED_TRACE(i);
+      EXPECT_EQ(got[i].part_id, ids_[k]);
+      EXPECT_LT(pose_error(got[i].tcp, want[i].tcp), 1e-12);
+      EXPECT_EQ(got[i].jaw_width, want[i].jaw_width);
+      EXPECT_EQ(got[i].contact_1, want[i].contact_1);
+      EXPECT_EQ(got[i].normal_1, want[i].normal_1);
+      EXPECT_EQ(got[i].contact_2, want[i].contact_2);
+      EXPECT_EQ(got[i].normal_2, want[i].normal_2);
+      EXPECT_EQ(got[i].quality, want[i].quality);
+      EXPECT_EQ(got[i].friction_torque_capacity, want[i].friction_torque_capacity);
+      EXPECT_EQ(got[i].lever, want[i].lever);
+      EXPECT_EQ(got[i].theta_c_deg, want[i].theta_c_deg);
+    }
+  }
+  EXPECT_TRUE(std::isinf(db.robot_grasps(ids_[0])[0].friction_torque_capacity));
+}
+
+TEST_F(ReaderRoundTrip, SuctionGrasps) {
+  const Database db = Database::open(path_);
+  const auto got = db.suction_grasps(ids_[0]);
+  const auto& want = sample_.parts[0].suction_grasps;
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(got[i].part_id, ids_[0]);
+    EXPECT_LT(pose_error(got[i].cup, want[i].cup), 1e-12);
+    EXPECT_EQ(got[i].rotation_deg, want[i].rotation_deg);
+    EXPECT_EQ(got[i].force_margin, want[i].force_margin);
+    EXPECT_EQ(got[i].moment_margin, want[i].moment_margin) << "subnormal survives";
+  }
+  EXPECT_TRUE(db.suction_grasps(ids_[1]).empty()) << "part 2 has none";
+}
+
+TEST_F(ReaderRoundTrip, HumanGrasps) {
+  const Database db = Database::open(path_);
+  for (std::size_t k = 0; k < sample_.parts.size(); ++k) {
+    const auto got = db.human_grasps(ids_[k]);
+    const auto& want = sample_.parts[k].human_grasps;
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      EXPECT_EQ(got[i].part_id, ids_[k]);
+      EXPECT_LT(pose_error(got[i].hand, want[i].hand), 1e-12);
+      EXPECT_EQ(got[i].aperture, want[i].aperture);
+      EXPECT_EQ(got[i].contact_1, want[i].contact_1);
+      EXPECT_EQ(got[i].contact_2, want[i].contact_2);
+      EXPECT_EQ(got[i].quality, want[i].quality);
+      EXPECT_EQ(got[i].one_hand_stable, want[i].one_hand_stable);
+    }
+  }
+  // Both values of the flag are present, so a constant reader would fail.
+  EXPECT_NE(db.human_grasps(ids_[0])[0].one_hand_stable,
+            db.human_grasps(ids_[0])[1].one_hand_stable);
+}
+
+TEST_F(ReaderRoundTrip, PerPartFilteringKeepsIdOrderAcrossInterleavedWrites) {
+  // Records of two parts written alternately: ids interleave, each part's list stays ordered.
+  const std::string path = temp_dir("db_reader_interleaved") + "/p.db";
+  {
+    DatabaseWriter writer(path);
+    writer.write_meta(sample_.meta);
+    const auto a = writer.add_part(sample_.parts[0].part);
+    const auto b = writer.add_part(sample_.parts[1].part);
+    for (int round = 0; round < 3; ++round) {
+      RobotGraspRecord g;
+      g.quality = round;
+      writer.add_robot_grasps(a, {g});
+      g.quality = 10 + round;
+      writer.add_robot_grasps(b, {g});
+    }
+    writer.commit();
+  }
+  const Database db = Database::open(path);
+  const auto a = db.robot_grasps(1);
+  const auto b = db.robot_grasps(2);
+  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(b.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(a[i].id, 2 * i + 1);
+    EXPECT_EQ(a[i].quality, i);
+    EXPECT_EQ(b[i].id, 2 * i + 2);
+    EXPECT_EQ(b[i].quality, 10 + i);
+  }
+  EXPECT_TRUE(db.robot_grasps(3).empty());
+  EXPECT_TRUE(db.placements(0).empty());
+}
+
+TEST_F(ReaderRoundTrip, PartByName) {
+  const Database db = Database::open(path_);
+  EXPECT_EQ(db.part("door panel 'left'").id, 2);
+  EXPECT_EQ(db.part("Gehäuse-ß-部品-🔩").id, 1);
+  expect_input_error([&] { db.part("lid"); }, {path_, "a part named 'lid'", "door panel 'left'"});
+}
+
+TEST_F(ReaderRoundTrip, MatchingHashesOpen) {
+  OpenOptions options;
+  options.expected_cell_hash = sample_.meta.cell_hash;
+  options.expected_product_hash = sample_.meta.product_hash;
+  EXPECT_NO_THROW(Database::open(path_, options));
+}
+
+TEST_F(ReaderRoundTrip, CellHashMismatchSaysWhatChangedAndHowToRebuild) {
+  OpenOptions options;
+  options.expected_cell_hash = std::string(64, 'd');
+  expect_input_error([&] { Database::open(path_, options); },
+                     {path_ + ": meta.cell_hash", "the cell changed since this database was built",
+                      "cccccccccccc...", "dddddddddddd...",
+                      "rebuild with: hila build meshes/cabinet/product.yaml -o " + path_});
+}
+
+TEST_F(ReaderRoundTrip, ProductHashMismatchSaysWhatChangedAndHowToRebuild) {
+  OpenOptions options;
+  options.expected_cell_hash = sample_.meta.cell_hash;
+  options.expected_product_hash = std::string(64, 'b');
+  expect_input_error(
+      [&] { Database::open(path_, options); },
+      {path_ + ": meta.product_hash", "the product changed since this database was built",
+       "rebuild with: hila build"});
+}
+
+TEST_F(ReaderRoundTrip, DatabaseIsAValueThatOutlivesTheFile) {
+  // Fully loaded at open: removing the file afterwards does not matter.
+  const Database db = Database::open(path_);
+  std::filesystem::remove(path_);
+  const Database copy = db;
+  EXPECT_EQ(copy.robot_grasps(ids_[0]).size(), sample_.parts[0].robot_grasps.size());
+}
+
+TEST(Reader, EmptyDatabaseOpens) {
+  const std::string path = temp_dir("db_reader_empty") + "/p.db";
+  {
+    DatabaseWriter writer(path);
+    writer.write_meta(Meta{});
+    writer.commit();
+  }
+  const Database db = Database::open(path);
+  EXPECT_TRUE(db.parts().empty());
+  EXPECT_EQ(db.meta().seed, 0u);
+  expect_input_error([&] { db.part("x"); }, {"parts: none"});
+}

@@ -1,0 +1,171 @@
+#include "hila/offline/build.hpp"
+
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+#include "hila/core/error.hpp"
+#include "hila/db/database.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Smaller sampling keeps the suite quick; the bundled defaults are exercised by the demo/bench.
+offline::BuildSettings quick_settings(std::uint64_t seed = 7, int jobs = 1) {
+  offline::BuildSettings s;
+  s.seed = seed;
+  s.jobs = jobs;
+  s.robot.samples = 500;
+  s.human.samples = 300;
+  return s;
+}
+
+std::string build(const std::string& dir, const std::string& name, const offline::BuildSettings& s) {
+  const std::string out = dir + "/" + name;
+  offline::build_database(test::product_path(), test::cell_path(), out, s);
+  return out;
+}
+
+std::vector<std::string> files_in(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A copy of the cabinet product in `dir` with one line replaced (meshes referenced absolutely).
+std::string product_variant(const std::string& dir, const std::string& from, const std::string& to) {
+  std::string text = test::read_file(test::product_path());
+  for (const char* mesh : {"shelf.stl", "lateral.stl", "back_panel.stl"}) {
+    const std::string rel = std::string("mesh: ") + mesh;
+    for (auto at = text.find(rel); at != std::string::npos; at = text.find(rel, at + 1)) {
+      text.replace(at, rel.size(), "mesh: " + test::data_path(std::string("cabinet/") + mesh));
+    }
+  }
+  if (!from.empty()) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  }
+  return test::write_file(dir, "product.yaml", text);
+}
+
+}  // namespace
+
+TEST(Build, CabinetDatabaseHoldsEveryBoardWithGraspsOfEachKind) {
+  const std::string dir = test::temp_dir("build_cabinet");
+  const std::string out = build(dir, "cabinet.hila", quick_settings());
+  const auto database = db::Database::open(out);
+  ASSERT_EQ(database.parts().size(), 7u);
+  EXPECT_EQ(database.meta().product_name, "cabinet");
+  EXPECT_EQ(database.meta().seed, 7u);
+  for (const auto& part : database.parts()) {
+    EXPECT_FALSE(database.robot_grasps(part.id).empty()) << part.name;
+    EXPECT_EQ(database.suction_grasps(part.id).size(), 24u) << part.name;
+    EXPECT_FALSE(database.human_grasps(part.id).empty()) << part.name;
+    EXPECT_FALSE(database.placements(part.id).empty()) << part.name;
+    EXPECT_NEAR(part.mass_properties.volume, part.extent.prod(), 1e-12) << part.name;
+  }
+  EXPECT_EQ(database.meta().cell_hash, offline::cell_hash(core::load_cell_spec(test::cell_path())));
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"cabinet.hila"}));  // no temporary left
+}
+
+TEST(Build, SameSeedSameDigestForAnyNumberOfJobs) {
+  const std::string dir = test::temp_dir("build_digest");
+  const std::string a = build(dir, "a.hila", quick_settings(7, 1));
+  const std::string b = build(dir, "b.hila", quick_settings(7, 2));
+  const std::string c = build(dir, "c.hila", quick_settings(8, 2));
+  EXPECT_EQ(db::content_digest(a), db::content_digest(b));
+  EXPECT_NE(db::content_digest(a), db::content_digest(c));
+}
+
+TEST(Build, AFailedBuildLeavesThePreviousDatabaseUntouched) {
+  const std::string dir = test::temp_dir("build_failure");
+  const std::string out = build(dir, "cabinet.hila", quick_settings());
+  const std::string before = db::content_digest(out);
+  const std::string bad = product_variant(dir, "mass: 0.22", "mass: 0");
+  test::expect_input_error(
+      [&] { offline::build_database(bad, test::cell_path(), out, quick_settings()); },
+      {bad, "mass", "positive"});
+  EXPECT_EQ(db::content_digest(out), before);
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"cabinet.hila", "product.yaml"}));
+}
+
+TEST(Build, ABuildKilledMidwayLeavesThePreviousDatabaseUntouched) {
+  const std::string dir = test::temp_dir("build_killed");
+  const std::string out = build(dir, "cabinet.hila", quick_settings());
+  const std::string before = db::content_digest(out);
+  for (const int delay_ms : {5, 60, 250}) {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      offline::BuildSettings slow = quick_settings(9, 1);
+      slow.robot.samples = 3000;
+      try {
+        offline::build_database(test::product_path(), test::cell_path(), out, slow);
+      } catch (...) {
+      }
+      _exit(0);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    kill(child, SIGKILL);
+    int status = 0;
+    waitpid(child, &status, 0);
+    // Whatever the moment, the target is the old database (or, had the child finished, a
+    // complete new one): it opens and its digest is one of the two.
+    const auto database = db::Database::open(out);
+    EXPECT_EQ(database.parts().size(), 7u);
+    if (WIFSIGNALED(status)) {
+      EXPECT_EQ(db::content_digest(out), before) << delay_ms;
+    }
+  }
+  // The killed writers' temporaries are swept by the next build.
+  build(dir, "cabinet.hila", quick_settings());
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"cabinet.hila"}));
+  EXPECT_EQ(db::content_digest(out), before);
+}
+
+TEST(Build, BadInputsAreClearErrors) {
+  const std::string dir = test::temp_dir("build_bad");
+  const std::string out = dir + "/out.hila";
+  // Millimetre meshes declared as metres.
+  const std::string metres = product_variant(dir, "mesh_unit: mm", "mesh_unit: m");
+  test::expect_input_error([&] { offline::build_database(metres, test::cell_path(), out, quick_settings()); },
+                           {metres, "mesh_unit", "mm"});
+  // An open mesh: a box with one triangle missing.
+  core::TriangleMesh open_box = core::make_box_mesh({0.3, 0.2, 0.01});
+  open_box.triangles.pop_back();
+  core::write_mesh(open_box, dir + "/open.obj", "obj");
+  const std::string open_product = product_variant(dir, "", "");
+  std::string text = test::read_file(open_product);
+  const std::string first = "mesh: " + test::data_path("cabinet/shelf.stl");
+  text.replace(text.find(first), first.size(), "mesh: " + dir + "/open.obj");
+  text.replace(text.find("mesh_unit: mm"), 13, "mesh_unit: m");
+  test::write_file(dir, "product.yaml", text);
+  test::expect_input_error([&] { offline::build_database(open_product, test::cell_path(), out, quick_settings()); },
+                           {"base", "closed"});
+  // A destination folder that does not exist: refused before any work.
+  test::expect_input_error(
+      [&] { offline::build_database(test::product_path(), test::cell_path(), dir + "/no/such/dir/x.hila", quick_settings()); },
+      {"no/such/dir"});
+  EXPECT_FALSE(fs::exists(out));
+  // Zero jobs.
+  offline::BuildSettings zero = quick_settings();
+  zero.jobs = 0;
+  test::expect_input_error([&] { offline::build_database(test::product_path(), test::cell_path(), out, zero); },
+                           {"--jobs"});
+}
+
+TEST(Build, PartSeedsDependOnNameAndSeedOnly) {
+  EXPECT_EQ(offline::part_seed(1, "base", 1), offline::part_seed(1, "base", 1));
+  EXPECT_NE(offline::part_seed(1, "base", 1), offline::part_seed(2, "base", 1));
+  EXPECT_NE(offline::part_seed(1, "base", 1), offline::part_seed(1, "top", 1));
+  EXPECT_NE(offline::part_seed(1, "base", 1), offline::part_seed(1, "base", 2));
+}

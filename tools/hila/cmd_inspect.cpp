@@ -1,0 +1,156 @@
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "hila/core/error.hpp"
+#include "hila/db/database.hpp"
+
+#include <cmath>
+
+namespace hila::tools {
+
+namespace {
+struct InspectOptions {
+  std::string database;
+  std::string what = "summary";
+  std::string part;
+  bool json = false;
+};
+
+double round_to(double v, double unit) { return std::round(v / unit) * unit; }
+
+nlohmann::json summary_json(const db::Database& database) {
+  nlohmann::json out;
+  const auto& m = database.meta();
+  out["database"] = database.path();
+  out["product"] = m.product_name;
+  out["schema_version"] = m.schema_version;
+  out["hila_version"] = m.hila_version;
+  out["seed"] = m.seed;
+  out["created_at"] = m.created_at;
+  out["parts"] = nlohmann::json::array();
+  for (const auto& part : database.parts()) {
+    const auto robot = database.robot_grasps(part.id);
+    const auto human = database.human_grasps(part.id);
+    double lo = 90.0, hi = 0.0;
+    for (const auto& g : robot) {
+      lo = std::min(lo, g.theta_c_deg);
+      hi = std::max(hi, g.theta_c_deg);
+    }
+    int one_hand = 0;
+    for (const auto& g : human) one_hand += g.one_hand_stable ? 1 : 0;
+    out["parts"].push_back({{"name", part.name},
+                            {"order", part.assembly_order},
+                            {"mass", part.mass},
+                            {"volume", part.mass_properties.volume},
+                            {"placements", database.placements(part.id).size()},
+                            {"robot_grasps", robot.size()},
+                            {"suction_grasps", database.suction_grasps(part.id).size()},
+                            {"human_grasps", human.size()},
+                            {"human_one_hand_grasps", one_hand},
+                            {"theta_c_min_deg", robot.empty() ? 0.0 : lo},
+                            {"theta_c_max_deg", robot.empty() ? 0.0 : hi}});
+  }
+  return out;
+}
+
+nlohmann::json grasps_json(const db::Database& database, const std::string& part_name) {
+  const auto& part = database.part(part_name);
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& g : database.robot_grasps(part.id)) {
+    rows.push_back({{"id", g.id}, {"kind", "robot"}, {"width", round_to(g.jaw_width, 1e-6)},
+                    {"quality", round_to(g.quality, 1e-4)}, {"theta_c_deg", g.theta_c_deg},
+                    {"lever", round_to(g.lever, 1e-6)}});
+  }
+  for (const auto& g : database.suction_grasps(part.id)) {
+    rows.push_back({{"id", g.id}, {"kind", "suction"}, {"width", nullptr},
+                    {"quality", round_to(g.moment_margin, 1e-4)}, {"theta_c_deg", nullptr},
+                    {"rotation_deg", g.rotation_deg}});
+  }
+  for (const auto& g : database.human_grasps(part.id)) {
+    rows.push_back({{"id", g.id}, {"kind", "human"}, {"width", round_to(g.aperture, 1e-6)},
+                    {"quality", round_to(g.quality, 1e-4)}, {"theta_c_deg", nullptr},
+                    {"one_hand_stable", g.one_hand_stable}});
+  }
+  return {{"part", part_name}, {"grasps", rows}};
+}
+
+int run_inspect(const InspectOptions& opt) {
+  if (opt.what == "digest") {
+    const std::string digest = db::content_digest(opt.database);
+    if (opt.json) {
+      std::cout << nlohmann::json{{"database", opt.database}, {"digest", digest}}.dump(2) << "\n";
+    } else {
+      std::cout << digest << "\n";
+    }
+    return 0;
+  }
+  const db::Database database = db::Database::open(opt.database);
+  if (opt.what == "grasps") {
+    if (opt.part.empty()) {
+      throw core::InputError("command line", "--part", "the name of a part", "nothing");
+    }
+    const auto j = grasps_json(database, opt.part);
+    if (opt.json) {
+      std::cout << j.dump(2) << "\n";
+      return 0;
+    }
+    std::cout << "grasps of " << opt.part << " (" << j["grasps"].size() << ")\n";
+    std::cout << "      id  kind      width m  quality  theta_c deg\n";
+    for (const auto& g : j["grasps"]) {
+      std::cout << std::setw(8) << g["id"].get<std::int64_t>() << "  " << std::left
+                << std::setw(8) << g["kind"].get<std::string>() << std::right;
+      if (g["width"].is_null()) {
+        std::cout << std::setw(9) << "-";
+      } else {
+        std::cout << std::setw(9) << std::fixed << std::setprecision(4) << g["width"].get<double>();
+      }
+      std::cout << std::setw(9) << std::setprecision(3) << g["quality"].get<double>();
+      if (g["theta_c_deg"].is_null()) {
+        std::cout << std::setw(13) << "-";
+      } else {
+        std::cout << std::setw(13) << std::setprecision(0) << g["theta_c_deg"].get<double>();
+      }
+      std::cout << "\n";
+    }
+    return 0;
+  }
+  if (opt.what != "summary") {
+    throw core::InputError("command line", "what", "summary, grasps or digest", "'" + opt.what + "'");
+  }
+  const auto j = summary_json(database);
+  if (opt.json) {
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "database " << database.path() << ": product " << j["product"].get<std::string>()
+            << ", schema " << j["schema_version"].get<int>() << ", seed "
+            << j["seed"].get<std::uint64_t>() << ", built " << j["created_at"].get<std::string>()
+            << "\n";
+  std::cout << "  #  part            mass  robot  suction  human (1-hand)  theta_c deg\n";
+  for (const auto& p : j["parts"]) {
+    std::cout << "  " << p["order"].get<int>() << "  " << std::left << std::setw(14)
+              << p["name"].get<std::string>() << std::right << std::setw(6) << std::fixed
+              << std::setprecision(2) << p["mass"].get<double>() << std::setw(7)
+              << p["robot_grasps"].get<int>() << std::setw(9) << p["suction_grasps"].get<int>()
+              << std::setw(7) << p["human_grasps"].get<int>() << " (" << std::setw(4)
+              << p["human_one_hand_grasps"].get<int>() << ")   " << std::setprecision(0)
+              << p["theta_c_min_deg"].get<double>() << "-" << p["theta_c_max_deg"].get<double>()
+              << "\n";
+  }
+  return 0;
+}
+}  // namespace
+
+void add_inspect_command(CLI::App& app, Action& action) {
+  auto opt = std::make_shared<InspectOptions>();
+  auto* inspect = app.add_subcommand("inspect", "Show what a product database holds");
+  inspect->add_option("database", opt->database, "database file")->required();
+  inspect->add_option("what", opt->what, "summary (default), grasps or digest")->capture_default_str();
+  inspect->add_option("--part", opt->part, "part name (for grasps)");
+  inspect->add_flag("--json", opt->json, "print JSON");
+  inspect->callback([opt, &action] { action = [opt] { return run_inspect(*opt); }; });
+}
+
+}  // namespace hila::tools
