@@ -169,3 +169,17 @@ TEST(Build, PartSeedsDependOnNameAndSeedOnly) {
   EXPECT_NE(offline::part_seed(1, "base", 1), offline::part_seed(1, "top", 1));
   EXPECT_NE(offline::part_seed(1, "base", 1), offline::part_seed(1, "base", 2));
 }
+
+TEST(Build, APartTooLargeForAnyGraspIsNamed) {
+  const std::string dir = test::temp_dir("build_too_large");
+  core::write_mesh(core::make_box_mesh({0.2, 0.2, 0.2}), dir + "/crate.obj", "obj");
+  std::string text = test::read_file(product_variant(dir, "", ""));
+  const std::string first = "mesh: " + test::data_path("cabinet/shelf.stl");
+  text.replace(text.find(first), first.size(), "mesh: " + dir + "/crate.obj");
+  text.replace(text.find("mesh_unit: mm"), 13, "mesh_unit: m");
+  const std::string product = test::write_file(dir, "product.yaml", text);
+  test::expect_input_error(
+      [&] { offline::build_database(product, test::cell_path(), dir + "/x.hila", quick_settings()); },
+      {product, "base", "no collision-free antipodal grasp"});
+  EXPECT_FALSE(fs::exists(dir + "/x.hila"));
+}

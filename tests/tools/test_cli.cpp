@@ -125,3 +125,63 @@ TEST(Cli, MeshBoxAndProductCheck) {
   EXPECT_EQ(j["targets_collision_free"], true);
   EXPECT_EQ(j["initial_collision_free"], true);
 }
+
+TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
+  const std::string dir = test::temp_dir("cli_build");
+  const std::string out = dir + "/cabinet.hila";
+  const CommandRun build = run("build " + test::product_path() + " --cell " + test::cell_path() +
+                               " -o " + out + " --seed 3 --jobs 2");
+  ASSERT_EQ(build.status, 0) << build.out;
+  // Not a terminal: no progress lines, just the summary.
+  EXPECT_EQ(build.out.find("\r"), std::string::npos);
+  EXPECT_NE(build.out.find("lateral_right"), std::string::npos);
+
+  const CommandRun summary = run("inspect " + out + " --json");
+  ASSERT_EQ(summary.status, 0) << summary.out;
+  const auto j = nlohmann::json::parse(json_part(summary.out));
+  ASSERT_EQ(j["parts"].size(), 7u);
+  EXPECT_EQ(j["seed"], 3);
+  for (const auto& p : j["parts"]) {
+    EXPECT_GT(p["robot_grasps"].get<int>(), 0) << p["name"];
+    EXPECT_LE(p["theta_c_min_deg"].get<double>(), p["theta_c_max_deg"].get<double>());
+  }
+  // The heavy laterals are slip-constrained, the back panels are not.
+  EXPECT_LT(j["parts"][1]["theta_c_min_deg"].get<double>(), 22.0);
+  EXPECT_EQ(j["parts"][2]["theta_c_min_deg"].get<double>(), 90.0);
+
+  const CommandRun grasps = run("inspect " + out + " grasps --part top --json");
+  ASSERT_EQ(grasps.status, 0) << grasps.out;
+  const auto g = nlohmann::json::parse(json_part(grasps.out));
+  int robot = 0;
+  for (const auto& row : g["grasps"]) robot += row["kind"] == "robot";
+  EXPECT_EQ(robot, j["parts"][5]["robot_grasps"].get<int>());
+
+  const CommandRun digest1 = run("inspect " + out + " digest");
+  ASSERT_EQ(digest1.status, 0);
+  EXPECT_EQ(digest1.out.size(), 65u);  // 64 hex digits and a newline
+  ASSERT_EQ(run("build " + test::product_path() + " --cell " + test::cell_path() + " -o " + dir +
+                "/again.hila --seed 3 --jobs 1")
+                .status,
+            0);
+  EXPECT_EQ(run("inspect " + dir + "/again.hila digest").out, digest1.out);
+}
+
+TEST(Cli, BuildAndInspectBadInputs) {
+  const std::string dir = test::temp_dir("cli_build_bad");
+  // Unknown part, foreign file, missing database, missing output folder, bad jobs.
+  const std::string text_file = test::write_file(dir, "notes.hila", "not a database\n");
+  const CommandRun foreign = run("inspect " + text_file);
+  EXPECT_EQ(foreign.status, 2);
+  EXPECT_NE(foreign.out.find("notes.hila"), std::string::npos) << foreign.out;
+  const CommandRun missing = run("inspect " + dir + "/none.hila");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.out.find("none.hila"), std::string::npos) << missing.out;
+  const CommandRun no_dir = run("build " + test::product_path() + " -o " + dir + "/no/dir/x.hila");
+  EXPECT_EQ(no_dir.status, 2);
+  EXPECT_NE(no_dir.out.find("no/dir"), std::string::npos) << no_dir.out;
+  EXPECT_NE(run("build " + test::product_path() + " -o " + dir + "/x.hila --jobs 0").status, 0);
+  ASSERT_EQ(run("build " + test::product_path() + " -o " + dir + "/ok.hila").status, 0);
+  const CommandRun part = run("inspect " + dir + "/ok.hila grasps --part drawer");
+  EXPECT_EQ(part.status, 2);
+  EXPECT_NE(part.out.find("drawer"), std::string::npos) << part.out;
+}
