@@ -1,5 +1,6 @@
 #include "hila/offline/grasp_common.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hila::offline {
@@ -71,6 +72,40 @@ bool HandPartChecker::collides(const core::Pose& grasp_in_part, double opening) 
   data_->set_body_pose(finger_neg_,
                        grasp_in_part * core::make_pose(Eigen::Vector3d(0, -0.5 * opening, 0)));
   return core::in_collision(model_, *data_);
+}
+
+std::vector<TwoFingerGrasp> plan_two_finger_grasps(const core::TriangleMesh& mesh,
+                                                   const Eigen::Vector3d& com,
+                                                   const HandGeometry& hand,
+                                                   const TwoFingerSettings& settings) {
+  const SurfaceQuery surface(mesh);
+  const std::vector<ContactPair> pairs = sample_antipodal_pairs(surface, settings.antipodal);
+  HandPartChecker checker(hand, mesh);
+  const double half_extent = 0.5 * (mesh.max_corner() - mesh.min_corner()).maxCoeff();
+  std::vector<TwoFingerGrasp> candidates;
+  for (const ContactPair& pair : pairs) {
+    const double opening = std::min(pair.width + settings.opening_margin, settings.max_opening);
+    for (const core::Pose& frame : grasp_frames_about_axis(pair, settings.approach_rotations)) {
+      if (checker.collides(frame, opening)) continue;
+      TwoFingerGrasp g;
+      g.pair = pair;
+      g.frame = frame;
+      g.lever = axis_lever(com, pair.centre, pair.axis);
+      g.quality = 0.5 * pair.alignment + 0.5 * (1.0 - std::min(1.0, g.lever / half_extent));
+      candidates.push_back(g);
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const TwoFingerGrasp& a, const TwoFingerGrasp& b) { return a.quality > b.quality; });
+  std::vector<core::Pose> poses;
+  poses.reserve(candidates.size());
+  for (const auto& g : candidates) poses.push_back(g.frame);
+  std::vector<TwoFingerGrasp> kept;
+  for (const int i : distinct_poses(poses, settings.merge_distance,
+                                    core::deg_to_rad(settings.merge_angle_deg))) {
+    kept.push_back(candidates[static_cast<std::size_t>(i)]);
+  }
+  return kept;
 }
 
 double axis_lever(const Eigen::Vector3d& com, const Eigen::Vector3d& point_on_axis,

@@ -44,44 +44,28 @@ std::vector<db::HumanGraspRecord> plan_human_grasps(const core::TriangleMesh& me
                                                     const core::Cell& cell,
                                                     const HumanGraspSettings& settings) {
   const auto& hand = cell.spec().human_hand;
-  const SurfaceQuery surface(mesh);
-  AntipodalSettings antipodal;
-  antipodal.samples = settings.samples;
-  antipodal.friction = hand.pad.friction;
-  antipodal.min_width = hand.aperture_min;
-  antipodal.max_width = hand.aperture_max - settings.opening_margin;
-  antipodal.seed = settings.seed;
-  const std::vector<ContactPair> pairs = sample_antipodal_pairs(surface, antipodal);
-
-  HandPartChecker checker(human_hand_geometry(hand), mesh);
-  const Eigen::Vector3d com = analysis.mass_properties.com;
-  const double half_extent = 0.5 * (mesh.max_corner() - mesh.min_corner()).maxCoeff();
-  std::vector<db::HumanGraspRecord> candidates;
-  for (const ContactPair& pair : pairs) {
-    const double opening = std::min(pair.width + settings.opening_margin, hand.aperture_max);
-    for (const core::Pose& frame : grasp_frames_about_axis(pair, settings.approach_rotations)) {
-      if (checker.collides(frame, opening)) continue;
-      db::HumanGraspRecord g;
-      g.hand = frame;
-      g.aperture = pair.width;
-      g.contact_1 = pair.first.point;
-      g.contact_2 = pair.second.point;
-      const double lever = axis_lever(com, pair.centre, pair.axis);
-      g.quality = 0.5 * pair.alignment + 0.5 * (1.0 - std::min(1.0, lever / half_extent));
-      g.one_hand_stable = one_hand_holds(hand, mass, cell.spec().gravity, lever);
-      candidates.push_back(g);
-    }
-  }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const db::HumanGraspRecord& a, const db::HumanGraspRecord& b) {
-                     return a.quality > b.quality;
-                   });
-  std::vector<core::Pose> poses;
-  for (const auto& g : candidates) poses.push_back(g.hand);
+  TwoFingerSettings two;
+  two.antipodal.samples = settings.samples;
+  two.antipodal.friction = hand.pad.friction;
+  two.antipodal.min_width = hand.aperture_min;
+  two.antipodal.max_width = hand.aperture_max - settings.opening_margin;
+  two.antipodal.seed = settings.seed;
+  two.approach_rotations = settings.approach_rotations;
+  two.opening_margin = settings.opening_margin;
+  two.max_opening = hand.aperture_max;
+  two.merge_distance = settings.merge_distance;
+  two.merge_angle_deg = settings.merge_angle_deg;
   std::vector<db::HumanGraspRecord> grasps;
-  for (const int i : distinct_poses(poses, settings.merge_distance,
-                                    core::deg_to_rad(settings.merge_angle_deg))) {
-    grasps.push_back(candidates[static_cast<std::size_t>(i)]);
+  for (const TwoFingerGrasp& t : plan_two_finger_grasps(mesh, analysis.mass_properties.com,
+                                                        human_hand_geometry(hand), two)) {
+    db::HumanGraspRecord g;
+    g.hand = t.frame;
+    g.aperture = t.pair.width;
+    g.contact_1 = t.pair.first.point;
+    g.contact_2 = t.pair.second.point;
+    g.quality = t.quality;
+    g.one_hand_stable = one_hand_holds(hand, mass, cell.spec().gravity, t.lever);
+    grasps.push_back(g);
   }
   return grasps;
 }

@@ -64,51 +64,34 @@ std::vector<db::RobotGraspRecord> plan_robot_grasps(const core::TriangleMesh& me
                                                     const core::Cell& cell,
                                                     const RobotGraspSettings& settings) {
   const auto& gripper = cell.spec().gripper;
-  const SurfaceQuery surface(mesh);
-  AntipodalSettings antipodal;
-  antipodal.samples = settings.samples;
-  antipodal.friction = gripper.pad.friction;
-  antipodal.min_width = gripper.jaw_min;
-  antipodal.max_width = gripper.jaw_max - settings.opening_margin;
-  antipodal.seed = settings.seed;
-  const std::vector<ContactPair> pairs = sample_antipodal_pairs(surface, antipodal);
-
-  HandPartChecker checker(gripper_geometry(cell, cell.arms().front().spec.name), mesh);
+  TwoFingerSettings two;
+  two.antipodal.samples = settings.samples;
+  two.antipodal.friction = gripper.pad.friction;
+  two.antipodal.min_width = gripper.jaw_min;
+  two.antipodal.max_width = gripper.jaw_max - settings.opening_margin;
+  two.antipodal.seed = settings.seed;
+  two.approach_rotations = settings.approach_rotations;
+  two.opening_margin = settings.opening_margin;
+  two.max_opening = gripper.jaw_max;
+  two.merge_distance = settings.merge_distance;
+  two.merge_angle_deg = settings.merge_angle_deg;
   const Eigen::Vector3d com = analysis.mass_properties.com;
-  const double half_extent = 0.5 * (mesh.max_corner() - mesh.min_corner()).maxCoeff();
   const double capacity = gripper_torque_capacity(cell);
-
-  std::vector<db::RobotGraspRecord> candidates;
-  for (const ContactPair& pair : pairs) {
-    const double opening = std::min(pair.width + settings.opening_margin, gripper.jaw_max);
-    for (const core::Pose& frame : grasp_frames_about_axis(pair, settings.approach_rotations)) {
-      if (checker.collides(frame, opening)) continue;
-      db::RobotGraspRecord g;
-      g.tcp = frame;
-      g.jaw_width = pair.width;
-      g.contact_1 = pair.first.point;
-      g.normal_1 = pair.first.normal;
-      g.contact_2 = pair.second.point;
-      g.normal_2 = pair.second.normal;
-      g.lever = axis_lever(com, pair.centre, pair.axis);
-      g.friction_torque_capacity = capacity;
-      g.theta_c_deg = grasp_theta_c(cell, mass, com, pair.centre, pair.axis);
-      g.quality = 0.5 * pair.alignment + 0.5 * (1.0 - std::min(1.0, g.lever / half_extent));
-      candidates.push_back(g);
-    }
-  }
-  // Best first; ties broken by position so the order never depends on hash or thread order.
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const db::RobotGraspRecord& a, const db::RobotGraspRecord& b) {
-                     return a.quality > b.quality;
-                   });
-  std::vector<core::Pose> poses;
-  poses.reserve(candidates.size());
-  for (const auto& g : candidates) poses.push_back(g.tcp);
   std::vector<db::RobotGraspRecord> grasps;
-  for (const int i : distinct_poses(poses, settings.merge_distance,
-                                    core::deg_to_rad(settings.merge_angle_deg))) {
-    grasps.push_back(candidates[static_cast<std::size_t>(i)]);
+  for (const TwoFingerGrasp& t : plan_two_finger_grasps(
+           mesh, com, gripper_geometry(cell, cell.arms().front().spec.name), two)) {
+    db::RobotGraspRecord g;
+    g.tcp = t.frame;
+    g.jaw_width = t.pair.width;
+    g.contact_1 = t.pair.first.point;
+    g.normal_1 = t.pair.first.normal;
+    g.contact_2 = t.pair.second.point;
+    g.normal_2 = t.pair.second.normal;
+    g.lever = t.lever;
+    g.quality = t.quality;
+    g.friction_torque_capacity = capacity;
+    g.theta_c_deg = grasp_theta_c(cell, mass, com, t.pair.centre, t.pair.axis);
+    grasps.push_back(g);
   }
   return grasps;
 }

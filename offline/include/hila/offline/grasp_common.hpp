@@ -65,6 +65,31 @@ class HandPartChecker {
   std::unique_ptr<core::CollisionData> data_;
 };
 
+// A two-finger grasp found by plan_two_finger_grasps.
+struct TwoFingerGrasp {
+  ContactPair pair;
+  core::Pose frame = core::Pose::Identity();  // grasp frame in the part frame
+  double lever = 0.0;                         // CoM distance from the grasp axis
+  double quality = 0.0;
+};
+
+struct TwoFingerSettings {
+  AntipodalSettings antipodal;
+  int approach_rotations = 12;
+  double opening_margin = 0.005;  // the hand opens to width + margin (at most max_opening)
+  double max_opening = 0.085;
+  double merge_distance = 0.01;
+  double merge_angle_deg = 20.0;
+};
+
+// The grasp planner shared by the robot gripper and the human hand: antipodal pairs, frames about
+// each axis, hand-part collision check, quality = 0.5 * alignment + 0.5 * (1 - lever / half the
+// part's largest extent), best first (stable order), near-duplicates merged.
+std::vector<TwoFingerGrasp> plan_two_finger_grasps(const core::TriangleMesh& mesh,
+                                                   const Eigen::Vector3d& com,
+                                                   const HandGeometry& hand,
+                                                   const TwoFingerSettings& settings);
+
 // Distance of the centre of mass from the grasp axis line (the lever of the gravity torque).
 double axis_lever(const Eigen::Vector3d& com, const Eigen::Vector3d& point_on_axis,
                   const Eigen::Vector3d& axis);
