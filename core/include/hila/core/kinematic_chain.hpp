@@ -29,6 +29,8 @@ class KinematicChain {
   const Eigen::VectorXd& lower_limits() const { return lower_; }
   const Eigen::VectorXd& upper_limits() const { return upper_; }
   bool within_limits(const Eigen::VectorXd& q, double tolerance = 0.0) const;
+  // Where the first joint's axis passes through, in the base frame (the shoulder of an arm).
+  Eigen::Vector3d first_joint_position() const { return fixed_translation_.front(); }
 
   // Tip pose in the base frame.
   Pose fk(const Eigen::VectorXd& q) const;
