@@ -32,8 +32,9 @@ int remove_stale_temporaries(const std::string& target) noexcept {
     const std::string rest = name.substr(prefix.size());
     const auto dash = rest.find('-');
     if (dash == std::string::npos || dash == 0) continue;
+    const std::string pid_text = rest.substr(0, dash);
     char* end = nullptr;
-    const long pid = std::strtol(rest.substr(0, dash).c_str(), &end, 10);
+    const long pid = std::strtol(pid_text.c_str(), &end, 10);
     if (end == nullptr || *end != '\0' || pid <= 0) continue;
     // kill(pid, 0) fails with ESRCH only when no such process exists.
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
