@@ -1,0 +1,141 @@
+#include "hila/offline/comfort_map.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "hila/core/generic_ik.hpp"
+#include "hila/offline/comfort.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+const core::KinematicChain& right_arm() { return test::reference_cell()->human_arms()[1].chain; }
+
+offline::ComfortMapSettings small_settings() {
+  offline::ComfortMapSettings s;
+  s.spacing = 0.06;
+  s.orientations = 100;
+  s.samples = 100000;
+  s.seed = 11;
+  return s;
+}
+
+const offline::ComfortMap& small_map() {
+  static const offline::ComfortMap map = offline::ComfortMap::build(right_arm(), small_settings());
+  return map;
+}
+}  // namespace
+
+TEST(ComfortMap, OrientationsAreUnitAndSpreadEvenly) {
+  const auto set = offline::spread_orientations(128);
+  ASSERT_EQ(set.size(), 128u);
+  double min_gap = core::kPi;
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    EXPECT_NEAR(set[i].norm(), 1.0, 1e-12);
+    for (std::size_t k = i + 1; k < set.size(); ++k) {
+      min_gap = std::min(min_gap, set[i].angularDistance(set[k]));
+    }
+  }
+  // Covering: every random rotation is within 50 degrees of one of the 128; no two are closer
+  // than 10 degrees.
+  std::mt19937_64 rng(1);
+  double worst = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Quaterniond q(test::random_pose(rng).linear());
+    worst = std::max(worst, q.angularDistance(set[offline::nearest_orientation(set, q)]));
+  }
+  EXPECT_LT(core::rad_to_deg(worst), 50.0);
+  EXPECT_GT(core::rad_to_deg(min_gap), 10.0);
+}
+
+TEST(ComfortMap, FastIndexEqualsTheSvdIndex) {
+  std::mt19937_64 rng(2);
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::VectorXd q = core::random_configuration(right_arm(), rng);
+    const core::Jacobian j = right_arm().jacobian(q);
+    EXPECT_NEAR(offline::comfort_index_fast(j, 0.6), offline::comfort_index(j, 0.6), 1e-7);
+  }
+}
+
+TEST(ComfortMap, EveryBinHoldsTheBestQOfTheSamplesThatLandedInIt) {
+  // Replay the build's sample stream and bin by brute force.
+  const auto& map = small_map();
+  const auto settings = small_settings();
+  const auto& arm = right_arm();
+  const double reach = offline::characteristic_length(arm);
+  std::vector<std::uint8_t> expected(map.values().size(), 0);
+  std::mt19937_64 rng(settings.seed);
+  const std::size_t n_orient = map.orientations().size();
+  for (long s = 0; s < settings.samples; ++s) {
+    const Eigen::VectorXd q = core::random_configuration(arm, rng);
+    const core::Pose tip = arm.fk(q);
+    const double quality = offline::comfort_index(arm.jacobian(q), reach);
+    const Eigen::Vector3i node = map.nearest_node(tip.translation());
+    // Brute-force nearest orientation by angle.
+    std::size_t best = 0;
+    double best_angle = 10.0;
+    const Eigen::Quaterniond rq(tip.linear());
+    for (std::size_t o = 0; o < n_orient; ++o) {
+      const double a = rq.angularDistance(map.orientations()[o]);
+      if (a < best_angle) {
+        best_angle = a;
+        best = o;
+      }
+    }
+    const std::size_t cell = (static_cast<std::size_t>(node.x()) * map.dims().y() + node.y()) * map.dims().z() + node.z();
+    auto& slot = expected[cell * n_orient + best];
+    slot = std::max<std::uint8_t>(slot, static_cast<std::uint8_t>(std::lround(quality * 255.0)));
+  }
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i) differing += expected[i] != map.values()[i];
+  // SVD vs eigenvalue rounding can move a value across a 1/255 step on rare ties.
+  EXPECT_LE(differing, expected.size() / 10000);
+  EXPECT_GT(std::count_if(map.values().begin(), map.values().end(), [](auto v) { return v > 0; }), 1000);
+}
+
+TEST(ComfortMap, LookupAtANodeIsItsBinAndOutsideTheGridIsZero) {
+  const auto& map = small_map();
+  std::mt19937_64 rng(3);
+  int checked = 0;
+  for (int i = 0; i < 200000 && checked < 50; ++i) {
+    const Eigen::Vector3i node(1 + rng() % (map.dims().x() - 2), 1 + rng() % (map.dims().y() - 2),
+                               1 + rng() % (map.dims().z() - 2));
+    const int o = static_cast<int>(rng() % map.orientations().size());
+    if (map.bin(node, o) == 0.0) continue;
+    core::Pose pose = core::Pose::Identity();
+    pose.linear() = map.orientations()[static_cast<std::size_t>(o)].toRotationMatrix();
+    pose.translation() = map.node_position(node);
+    EXPECT_NEAR(map.lookup(pose), map.bin(node, o), 1e-12);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 50);
+  EXPECT_EQ(map.lookup(core::make_pose({5, 5, 5})), 0.0);
+}
+
+TEST(ComfortMap, AgreesWithDirectEvaluationAtReachablePoses) {
+  // The map is a max over a bin (6 cm here, ~30 degrees): near, not equal, to the best Q of
+  // the exact pose found by IK.
+  const auto& map = small_map();
+  const auto& arm = right_arm();
+  std::mt19937_64 rng(4);
+  std::vector<double> errors;
+  for (int i = 0; i < 60; ++i) {
+    const Eigen::VectorXd q = core::random_configuration(arm, rng);
+    const core::Pose pose = arm.fk(q);
+    const auto direct = offline::best_comfort(arm, pose, q);
+    ASSERT_TRUE(direct.reachable);
+    errors.push_back(std::abs(map.lookup(pose) - direct.quality));
+  }
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.1);
+}
+
+TEST(ComfortMap, SameSeedSameMap) {
+  const auto again = offline::ComfortMap::build(right_arm(), small_settings());
+  EXPECT_EQ(again.values(), small_map().values());
+  EXPECT_GT(small_map().coverage(), 0.0);
+  EXPECT_LT(small_map().coverage(), 1.0);
+}
