@@ -1,7 +1,8 @@
 // One full-arm collision check against the cell: FK of every robot link, pose update of the
 // moving bodies, FCL broad phase + narrow phase. Configurations are seeded random left-arm poses
 // that are collision-free (the common case while planning), and ones that collide.
-// Run: build/release/bench/bench_collision --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// Run: build/release/bench/bench_collision --benchmark_repetitions=5
+// --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -44,7 +45,8 @@ template <typename Query>
 void check_loop(benchmark::State& state, const std::vector<Eigen::VectorXd>& configs, Query query) {
   const auto& p = problem();
   core::CollisionData data(p.scene.model);
-  core::set_cell_state(*p.cell, p.scene, data, p.cell->home_configuration(), p.cell->human_neutral());
+  core::set_cell_state(*p.cell, p.scene, data, p.cell->home_configuration(),
+                       p.cell->human_neutral());
   std::vector<core::Pose> links;
   std::size_t i = 0;
   for (auto _ : state) {
@@ -81,7 +83,8 @@ BENCHMARK(BM_WholeSceneCheckFree);
 // The arm's pairs one by one with FCL's narrow phase, no broad phase: the baseline.
 void BM_BruteForceArmCheckFree(benchmark::State& state) {
   check_loop(state, problem().free_configs, [](core::CollisionData& data) {
-    return core::in_collision_brute_force(problem().scene.model, data, problem().scene.arm_bodies[0]);
+    return core::in_collision_brute_force(problem().scene.model, data,
+                                          problem().scene.arm_bodies[0]);
   });
 }
 BENCHMARK(BM_BruteForceArmCheckFree);

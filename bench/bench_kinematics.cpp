@@ -50,7 +50,8 @@ KDL::Chain kdl_chain(const core::UrDhParameters& dh) {
   const double alpha[6] = {core::kPi / 2, 0, 0, core::kPi / 2, -core::kPi / 2, 0};
   KDL::Chain chain;
   for (int i = 0; i < 6; ++i) {
-    chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame::DH(a[i], alpha[i], d[i], 0)));
+    chain.addSegment(
+        KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame::DH(a[i], alpha[i], d[i], 0)));
   }
   chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), KDL::Frame(KDL::Vector(0, 0, 0.20))));
   return chain;

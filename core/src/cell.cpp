@@ -56,8 +56,8 @@ ArmSpec parse_arm(const YamlNode& node) {
 }
 
 PadSpec parse_pad(const YamlNode& pad) {
-  pad.expect_only({"friction", "elastic_modulus", "thickness", "radius_1", "radius_2", "width",
-                   "length"});
+  pad.expect_only(
+      {"friction", "elastic_modulus", "thickness", "radius_1", "radius_2", "width", "length"});
   PadSpec p;
   p.friction = pad.at("friction").as_double_in(0.01, 3.0);
   p.elastic_modulus = pad.at("elastic_modulus").as_positive();
@@ -75,9 +75,9 @@ HumanHandSpec parse_hand(const YamlNode& node) {
   HumanHandSpec h;
   const auto aperture = node.at("aperture_range").as_doubles(2);
   if (!(aperture[0] >= 0 && aperture[1] > aperture[0] && aperture[1] < 0.3)) {
-    node.at("aperture_range").fail("[min, max] in metres with 0 <= min < max < 0.3",
-                                   "[" + format_number(aperture[0]) + ", " +
-                                       format_number(aperture[1]) + "]");
+    node.at("aperture_range")
+        .fail("[min, max] in metres with 0 <= min < max < 0.3",
+              "[" + format_number(aperture[0]) + ", " + format_number(aperture[1]) + "]");
   }
   h.aperture_min = aperture[0];
   h.aperture_max = aperture[1];
@@ -102,13 +102,15 @@ GripperSpec parse_gripper(const YamlNode& node) {
   g.opening_axis = node.at("opening_axis").as_unit_vec3();
   g.approach_axis = node.at("approach_axis").as_unit_vec3();
   if (std::abs(g.opening_axis.dot(g.approach_axis)) > 1e-6) {
-    node.at("approach_axis").fail("an axis perpendicular to opening_axis", "a non-perpendicular one");
+    node.at("approach_axis")
+        .fail("an axis perpendicular to opening_axis", "a non-perpendicular one");
   }
   const auto jaw = node.at("jaw_range").as_doubles(2);
   if (!(jaw[0] >= 0 && jaw[1] > jaw[0] && jaw[1] < 0.5)) {
-    node.at("jaw_range").fail("[min, max] in metres with 0 <= min < max < 0.5",
-                              "[" + format_number(jaw[0]) + ", " + format_number(jaw[1]) + "]" +
-                                  (jaw[1] >= 0.5 ? " (millimetres?)" : ""));
+    node.at("jaw_range")
+        .fail("[min, max] in metres with 0 <= min < max < 0.5",
+              "[" + format_number(jaw[0]) + ", " + format_number(jaw[1]) + "]" +
+                  (jaw[1] >= 0.5 ? " (millimetres?)" : ""));
   }
   g.jaw_min = jaw[0];
   g.jaw_max = jaw[1];
@@ -147,7 +149,8 @@ CellSpec load_cell_spec(const std::string& path) {
   if (const auto allowed = robot.find("allowed_collisions")) {
     for (std::size_t i = 0; i < allowed->size(); ++i) {
       const YamlNode pair = allowed->at(i);
-      if (!pair.is_sequence() || pair.size() != 2) pair.fail("a pair [body, body]", "something else");
+      if (!pair.is_sequence() || pair.size() != 2)
+        pair.fail("a pair [body, body]", "something else");
       cell.allowed_collisions.emplace_back(pair.at(0).as_string(), pair.at(1).as_string());
     }
   }
@@ -172,7 +175,8 @@ CellSpec load_cell_spec(const std::string& path) {
       box.name = o.at("name").as_string();
       box.size = o.at("box").as_vec3();
       for (int k = 0; k < 3; ++k) {
-        if (!(box.size[k] > 0)) o.at("box").fail("three positive side lengths", "a non-positive side");
+        if (!(box.size[k] > 0))
+          o.at("box").fail("three positive side lengths", "a non-positive side");
       }
       box.pose = o.at("pose").as_pose();
       cell.obstacles.push_back(box);
@@ -231,8 +235,8 @@ std::shared_ptr<const Cell> Cell::load(const std::string& path) {
     for (const auto& [name, values] : per_joint) {
       if (values->size() != chain.dof()) {
         throw InputError(path, field + name,
-                         std::to_string(chain.dof()) + " values (one per joint of " +
-                             a.base_link + " -> " + a.tip_link + ")",
+                         std::to_string(chain.dof()) + " values (one per joint of " + a.base_link +
+                             " -> " + a.tip_link + ")",
                          std::to_string(values->size()));
       }
     }
@@ -246,7 +250,8 @@ std::shared_ptr<const Cell> Cell::load(const std::string& path) {
         ik.emplace(chain, *a.ur_dh);
       } catch (const InputError& e) {
         throw InputError(path, field + ".kinematics",
-                         "UR DH parameters matching " + spec.robot_urdf, std::string("'") + e.what() + "'");
+                         "UR DH parameters matching " + spec.robot_urdf,
+                         std::string("'") + e.what() + "'");
       }
     }
     // The jaw joint must be an independent prismatic joint of the robot.
@@ -259,8 +264,8 @@ std::shared_ptr<const Cell> Cell::load(const std::string& path) {
       }
     }
     if (!found || finger_variable < 0) {
-      throw InputError(path, field + ".finger_joint",
-                       "an independent joint of " + spec.robot_urdf, "'" + a.finger_joint + "'");
+      throw InputError(path, field + ".finger_joint", "an independent joint of " + spec.robot_urdf,
+                       "'" + a.finger_joint + "'");
     }
     cell->arms_.push_back(Arm{a, std::move(chain), std::move(ik), finger_variable});
   }
@@ -293,7 +298,8 @@ const Arm& Cell::arm(const std::string& name) const {
 
 void Cell::set_arm(Eigen::VectorXd& robot_q, const Arm& arm, const Eigen::VectorXd& arm_q) const {
   const auto& vars = arm.chain.model_variables();
-  for (std::size_t i = 0; i < vars.size(); ++i) robot_q[vars[i]] = arm_q[static_cast<Eigen::Index>(i)];
+  for (std::size_t i = 0; i < vars.size(); ++i)
+    robot_q[vars[i]] = arm_q[static_cast<Eigen::Index>(i)];
 }
 
 void Cell::set_jaw(Eigen::VectorXd& robot_q, const Arm& arm, double opening) const {
@@ -336,8 +342,8 @@ CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options) {
     scene.model.allow(a, b);
   }
   for (const Arm& arm : cell.arms()) {
-    scene.arm_bodies.push_back(subtree_bodies(
-        cell.robot(), scene.robot, cell.robot().link_index(arm.spec.base_link)));
+    scene.arm_bodies.push_back(
+        subtree_bodies(cell.robot(), scene.robot, cell.robot().link_index(arm.spec.base_link)));
   }
   return scene;
 }

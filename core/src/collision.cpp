@@ -7,6 +7,7 @@
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
+
 #include <algorithm>
 #include <limits>
 
@@ -76,8 +77,7 @@ CollisionModel& CollisionModel::operator=(CollisionModel&&) noexcept = default;
 int CollisionModel::add_body(const std::string& name, const std::vector<GeometrySpec>& shapes,
                              bool is_static, const Pose& pose) {
   if (find_body(name)) {
-    throw InputError("collision scene", "body '" + name + "'", "a unique body name",
-                     "a duplicate");
+    throw InputError("collision scene", "body '" + name + "'", "a unique body name", "a duplicate");
   }
   BodyModel body;
   body.name = name;
@@ -93,8 +93,8 @@ int CollisionModel::add_body(const std::string& name, const std::vector<Geometry
   return num_bodies() - 1;
 }
 
-int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& mesh,
-                                  bool is_static, const Pose& pose) {
+int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& mesh, bool is_static,
+                                  const Pose& pose) {
   const int id = add_body(name, {}, is_static, pose);
   impl_->bodies[id].geometries.push_back(make_mesh_geometry(mesh, Eigen::Vector3d::Ones()));
   impl_->bodies[id].offsets.push_back(Pose::Identity());
@@ -114,13 +114,27 @@ void CollisionModel::allow(const std::string& a, const std::string& b) {
   allow(*ia, *ib);
 }
 
-void CollisionModel::set_enabled(int body, bool enabled) { impl_->bodies[body].enabled = enabled; }
-int CollisionModel::num_bodies() const { return static_cast<int>(impl_->bodies.size()); }
-const std::string& CollisionModel::body_name(int body) const { return impl_->bodies[body].name; }
-bool CollisionModel::is_static(int body) const { return impl_->bodies[body].is_static; }
-bool CollisionModel::is_enabled(int body) const { return impl_->bodies[body].enabled; }
-bool CollisionModel::allowed(int a, int b) const { return impl_->allowed[a][b]; }
-const Pose& CollisionModel::initial_pose(int body) const { return impl_->bodies[body].initial_pose; }
+void CollisionModel::set_enabled(int body, bool enabled) {
+  impl_->bodies[body].enabled = enabled;
+}
+int CollisionModel::num_bodies() const {
+  return static_cast<int>(impl_->bodies.size());
+}
+const std::string& CollisionModel::body_name(int body) const {
+  return impl_->bodies[body].name;
+}
+bool CollisionModel::is_static(int body) const {
+  return impl_->bodies[body].is_static;
+}
+bool CollisionModel::is_enabled(int body) const {
+  return impl_->bodies[body].enabled;
+}
+bool CollisionModel::allowed(int a, int b) const {
+  return impl_->allowed[a][b];
+}
+const Pose& CollisionModel::initial_pose(int body) const {
+  return impl_->bodies[body].initial_pose;
+}
 
 std::optional<int> CollisionModel::find_body(const std::string& name) const {
   for (int i = 0; i < num_bodies(); ++i) {
@@ -209,7 +223,9 @@ void CollisionData::set_body_pose(int body, const Pose& pose) {
   }
 }
 
-const Pose& CollisionData::body_pose(int body) const { return impl_->body_poses[body]; }
+const Pose& CollisionData::body_pose(int body) const {
+  return impl_->body_poses[body];
+}
 
 namespace {
 
@@ -411,7 +427,8 @@ std::vector<int> subtree_bodies(const RobotModel& robot, const RobotBodies& bodi
     const int link = stack.back();
     stack.pop_back();
     if (bodies.link_to_body[link] >= 0) out.push_back(bodies.link_to_body[link]);
-    for (const int j : robot.links()[link].child_joints) stack.push_back(robot.joints()[j].child_link);
+    for (const int j : robot.links()[link].child_joints)
+      stack.push_back(robot.joints()[j].child_link);
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -420,7 +437,8 @@ std::vector<int> subtree_bodies(const RobotModel& robot, const RobotBodies& bodi
 void set_robot_pose(CollisionData& data, const RobotBodies& bodies,
                     const std::vector<Pose>& link_poses, const Pose& base) {
   for (std::size_t l = 0; l < bodies.link_to_body.size(); ++l) {
-    if (bodies.link_to_body[l] >= 0) data.set_body_pose(bodies.link_to_body[l], base * link_poses[l]);
+    if (bodies.link_to_body[l] >= 0)
+      data.set_body_pose(bodies.link_to_body[l], base * link_poses[l]);
   }
 }
 

@@ -17,7 +17,9 @@ std::string num(double v) {
   return buf;
 }
 
-std::string vec(double x, double y, double z) { return num(x) + " " + num(y) + " " + num(z); }
+std::string vec(double x, double y, double z) {
+  return num(x) + " " + num(y) + " " + num(z);
+}
 
 std::string origin(double x, double y, double z, double r = 0, double p = 0, double yaw = 0) {
   return "<origin xyz=\"" + vec(x, y, z) + "\" rpy=\"" + vec(r, p, yaw) + "\"/>";
@@ -40,9 +42,9 @@ std::string sphere(double radius, double x, double y, double z) {
 
 struct JointSpec {
   const char* name;
-  double ax, ay, az;      // axis for the left arm; the right arm mirrors y-dependent terms
+  double ax, ay, az;  // axis for the left arm; the right arm mirrors y-dependent terms
   double lower_deg, upper_deg;
-  double velocity;        // rad/s
+  double velocity;  // rad/s
 };
 
 }  // namespace
@@ -67,7 +69,9 @@ HumanDimensions human_dimensions(const HumanBodySpec& spec) {
   return d;
 }
 
-std::string human_grasp_link(const std::string& side) { return side + "_hand_grasp"; }
+std::string human_grasp_link(const std::string& side) {
+  return side + "_hand_grasp";
+}
 
 std::string generate_human_urdf(const HumanBodySpec& spec) {
   const HumanDimensions d = human_dimensions(spec);
@@ -78,8 +82,7 @@ std::string generate_human_urdf(const HumanBodySpec& spec) {
   s << "<robot name=\"human\">\n";
   // Legs and pelvis as one body standing on the floor.
   s << "  <link name=\"base\">"
-    << box(0.12 * d.stature, 0.19 * d.stature, d.hip_height, 0, 0, d.hip_height / 2)
-    << "</link>\n";
+    << box(0.12 * d.stature, 0.19 * d.stature, d.hip_height, 0, 0, d.hip_height / 2) << "</link>\n";
   // Torso flexion (bending forward) about the hip's lateral axis.
   s << "  <joint name=\"torso_flexion\" type=\"revolute\"><parent link=\"base\"/>"
     << "<child link=\"torso\"/>" << origin(0, 0, d.hip_height)
@@ -94,24 +97,24 @@ std::string generate_human_urdf(const HumanBodySpec& spec) {
   // Ranges of motion (degrees) after the ergonomics literature (e.g. NASA-STD-3000 / Kapandji).
   const JointSpec arm[7] = {
       {"shoulder_flexion", 0, -1, 0, -50, 180, 2.0},   // forward raise positive
-      {"shoulder_abduction", 1, 0, 0, -30, 180, 2.0},   // sideways raise positive
-      {"shoulder_rotation", 0, 0, 1, -90, 90, 2.5},     // about the upper arm
-      {"elbow_flexion", 0, -1, 0, 0, 145, 3.0},
-      {"forearm_pronation", 0, 0, 1, -85, 80, 3.0},
-      {"wrist_flexion", -1, 0, 0, -70, 80, 3.0},        // toward the palm positive
-      {"wrist_deviation", 0, -1, 0, -30, 20, 3.0},      // radial (toward the thumb) positive
+      {"shoulder_abduction", 1, 0, 0, -30, 180, 2.0},  // sideways raise positive
+      {"shoulder_rotation", 0, 0, 1, -90, 90, 2.5},    // about the upper arm
+      {"elbow_flexion", 0, -1, 0, 0, 145, 3.0},       {"forearm_pronation", 0, 0, 1, -85, 80, 3.0},
+      {"wrist_flexion", -1, 0, 0, -70, 80, 3.0},    // toward the palm positive
+      {"wrist_deviation", 0, -1, 0, -30, 20, 3.0},  // radial (toward the thumb) positive
   };
   for (const std::string side : {"left", "right"}) {
     const double m = side == "left" ? 1.0 : -1.0;  // mirror across the sagittal plane
     std::string parent = "torso";
     for (int j = 0; j < 7; ++j) {
       const JointSpec& js = arm[j];
-      const std::string child = side + "_" + (j < 2 ? std::string(js.name) + "_link"
-                                              : j == 2 ? std::string("upper_arm")
-                                              : j == 3 ? std::string("elbow_link")
-                                              : j == 4 ? std::string("forearm")
-                                              : j == 5 ? std::string("wrist_link")
-                                                       : std::string("hand"));
+      const std::string child = side + "_" +
+                                (j < 2    ? std::string(js.name) + "_link"
+                                 : j == 2 ? std::string("upper_arm")
+                                 : j == 3 ? std::string("elbow_link")
+                                 : j == 4 ? std::string("forearm")
+                                 : j == 5 ? std::string("wrist_link")
+                                          : std::string("hand"));
       double oz = 0.0, oy = 0.0;
       if (j == 0) {
         oy = m * d.shoulder_half_width;
@@ -122,10 +125,10 @@ std::string generate_human_urdf(const HumanBodySpec& spec) {
       // Axes that move the arm across the sagittal plane (abduction, wrist flexion) mirror.
       const double ax = (j == 1 || j == 5) ? m * js.ax : js.ax;
       s << "  <joint name=\"" << side << "_" << js.name << "\" type=\"revolute\"><parent link=\""
-        << parent << "\"/><child link=\"" << child << "\"/>" << origin(0, oy, oz)
-        << "<axis xyz=\"" << vec(ax, js.ay, js.az) << "\"/><limit lower=\""
-        << num(deg_to_rad(js.lower_deg)) << "\" upper=\"" << num(deg_to_rad(js.upper_deg))
-        << "\" velocity=\"" << num(js.velocity) << "\" effort=\"50\"/></joint>\n";
+        << parent << "\"/><child link=\"" << child << "\"/>" << origin(0, oy, oz) << "<axis xyz=\""
+        << vec(ax, js.ay, js.az) << "\"/><limit lower=\"" << num(deg_to_rad(js.lower_deg))
+        << "\" upper=\"" << num(deg_to_rad(js.upper_deg)) << "\" velocity=\"" << num(js.velocity)
+        << "\" effort=\"50\"/></joint>\n";
       s << "  <link name=\"" << child << "\">";
       if (j == 2) s << cylinder_z(0.045 * d.stature / 1.722, -d.upper_arm + 0.03, -0.03);
       if (j == 4) s << cylinder_z(0.035 * d.stature / 1.722, -d.forearm + 0.02, -0.02);

@@ -1,12 +1,12 @@
 #include "hila/core/mesh.hpp"
 
-#include <Eigen/Geometry>
-
-#include <assimp/Exporter.hpp>
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+
+#include <Eigen/Geometry>
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
 #include <filesystem>
 #include <memory>
 
@@ -27,8 +27,8 @@ Eigen::Vector3d TriangleMesh::max_corner() const {
 }
 
 namespace {
-void append_node(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent,
-                 double scale, TriangleMesh& out) {
+void append_node(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, double scale,
+                 TriangleMesh& out) {
   const aiMatrix4x4 transform = parent * node->mTransformation;
   for (unsigned m = 0; m < node->mNumMeshes; ++m) {
     const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
@@ -62,11 +62,12 @@ TriangleMesh load_mesh(const std::string& path, double unit_scale) {
   Assimp::Importer importer;
   // Drop normals, colours and texture coordinates first so that vertices weld by position alone
   // (an STL repeats every corner once per face).
-  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
-                                                          aiComponent_COLORS | aiComponent_TEXCOORDS);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                aiProcess_SortByPType);
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
+                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                  aiComponent_COLORS | aiComponent_TEXCOORDS);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_RemoveComponent | aiProcess_Triangulate |
+                                  aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw InputError(path, "(file)", "a mesh readable by assimp",
                      std::string("'") + importer.GetErrorString() + "'");

@@ -47,15 +47,18 @@ ProductSpec load_product(const std::string& path) {
     part.name = p.at("name").as_string();
     if (!names.insert(part.name).second) p.at("name").fail("a unique part name", "a duplicate");
     part.mesh_file = p.resolve_path(p.at("mesh").as_string());
-    part.unit_scale = unit_scale_from_name(p.at("mesh_unit").as_string(), path, p.path() + ".mesh_unit");
+    part.unit_scale =
+        unit_scale_from_name(p.at("mesh_unit").as_string(), path, p.path() + ".mesh_unit");
     part.mass = p.at("mass").as_positive();
-    if (part.mass > 100.0) p.at("mass").fail("a mass in kilograms below 100 (grams given?)", format_number(part.mass));
+    if (part.mass > 100.0)
+      p.at("mass").fail("a mass in kilograms below 100 (grams given?)", format_number(part.mass));
     part.target = p.at("target").as_pose();
     check_pose(part.target, path, p.path() + ".target");
     part.initial = p.at("initial").as_pose();
     check_pose(part.initial, path, p.path() + ".initial");
     part.order = p.at("order").as_int();
-    if (!orders.insert(part.order).second) p.at("order").fail("a unique assembly order", "a duplicate");
+    if (!orders.insert(part.order).second)
+      p.at("order").fail("a unique assembly order", "a duplicate");
     try {
       part.mesh = load_mesh(part.mesh_file, part.unit_scale);
     } catch (const InputError& e) {

@@ -1,14 +1,15 @@
 #include "hila/core/robot_model.hpp"
 
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
 #include <algorithm>
 #include <cassert>
-#include <console_bridge/console.h>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <sstream>
-#include <urdf_parser/urdf_parser.h>
 
 #include "hila/core/error.hpp"
 
@@ -30,10 +31,9 @@ class CaptureHandler : public console_bridge::OutputHandler {
 Pose to_pose(const urdf::Pose& p) {
   Pose pose = Pose::Identity();
   pose.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
-  pose.linear() =
-      Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z)
-          .normalized()
-          .toRotationMatrix();
+  pose.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z)
+                      .normalized()
+                      .toRotationMatrix();
   return pose;
 }
 
@@ -74,9 +74,9 @@ GeometrySpec to_geometry(const urdf::Geometry& g, const Pose& origin, const std:
       spec.radius = c.radius;
       spec.length = c.length;
       if (!(c.radius > 0 && c.length > 0)) {
-        throw InputError(source, field, "a cylinder with positive radius and length",
-                         "radius " + format_number(c.radius) + ", length " +
-                             format_number(c.length));
+        throw InputError(
+            source, field, "a cylinder with positive radius and length",
+            "radius " + format_number(c.radius) + ", length " + format_number(c.length));
       }
       break;
     }
@@ -85,8 +85,7 @@ GeometrySpec to_geometry(const urdf::Geometry& g, const Pose& origin, const std:
       spec.type = GeometrySpec::Type::Sphere;
       spec.radius = s.radius;
       if (!(s.radius > 0)) {
-        throw InputError(source, field, "a sphere with positive radius",
-                         format_number(s.radius));
+        throw InputError(source, field, "a sphere with positive radius", format_number(s.radius));
       }
       break;
     }
@@ -114,8 +113,7 @@ RobotModel RobotModel::load_urdf_file(const std::string& path) {
   if (!in) throw InputError(path, "(file)", "a readable URDF file", "cannot open");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  return load_urdf_string(buffer.str(), path,
-                          std::filesystem::path(path).parent_path().string());
+  return load_urdf_string(buffer.str(), path, std::filesystem::path(path).parent_path().string());
 }
 
 RobotModel RobotModel::load_urdf_string(const std::string& xml, const std::string& source_name,
@@ -165,10 +163,18 @@ RobotModel RobotModel::load_urdf_string(const std::string& xml, const std::strin
           joint.origin = to_pose(uj->parent_to_joint_origin_transform);
           joint.axis = Eigen::Vector3d(uj->axis.x, uj->axis.y, uj->axis.z);
           switch (uj->type) {
-            case urdf::Joint::REVOLUTE: joint.type = JointType::Revolute; break;
-            case urdf::Joint::CONTINUOUS: joint.type = JointType::Continuous; break;
-            case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
-            case urdf::Joint::FIXED: joint.type = JointType::Fixed; break;
+            case urdf::Joint::REVOLUTE:
+              joint.type = JointType::Revolute;
+              break;
+            case urdf::Joint::CONTINUOUS:
+              joint.type = JointType::Continuous;
+              break;
+            case urdf::Joint::PRISMATIC:
+              joint.type = JointType::Prismatic;
+              break;
+            case urdf::Joint::FIXED:
+              joint.type = JointType::Fixed;
+              break;
             default:
               throw InputError(source_name, "joint '" + uj->name + "' type",
                                "fixed, revolute, continuous or prismatic",
@@ -188,8 +194,7 @@ RobotModel RobotModel::load_urdf_string(const std::string& xml, const std::strin
               joint.upper = uj->limits->upper;
               joint.velocity_limit = uj->limits->velocity;
               if (!(joint.lower <= joint.upper)) {
-                throw InputError(source_name, "joint '" + uj->name + "' limit",
-                                 "lower <= upper",
+                throw InputError(source_name, "joint '" + uj->name + "' limit", "lower <= upper",
                                  format_number(joint.lower) + " > " + format_number(joint.upper));
               }
             }
@@ -228,7 +233,8 @@ RobotModel RobotModel::load_urdf_string(const std::string& xml, const std::strin
   for (const Joint& joint : model.joints_) {
     if (joint.mimic_joint >= 0 && model.joints_[joint.mimic_joint].variable < 0) {
       throw InputError(source_name, "joint '" + joint.name + "' mimic",
-                       "a movable, non-mimic joint", "'" + model.joints_[joint.mimic_joint].name + "'");
+                       "a movable, non-mimic joint",
+                       "'" + model.joints_[joint.mimic_joint].name + "'");
     }
   }
   return model;
@@ -236,8 +242,7 @@ RobotModel RobotModel::load_urdf_string(const std::string& xml, const std::strin
 
 int RobotModel::link_index(const std::string& name, const std::string& field) const {
   if (auto id = find_link(name)) return *id;
-  throw InputError(source_, field, "the name of a link of robot '" + name_ + "'",
-                   "'" + name + "'");
+  throw InputError(source_, field, "the name of a link of robot '" + name_ + "'", "'" + name + "'");
 }
 
 std::optional<int> RobotModel::find_link(const std::string& name) const {

@@ -23,7 +23,8 @@ bool soft_finger_holds(const SoftFingerPad& pad, double normal_force, double tan
                        double normal_torque) {
   if (normal_force <= 0.0) return tangential_force == 0.0 && normal_torque == 0.0;
   const double e = winkler_eccentricity(pad, normal_force);
-  const double lhs = tangential_force * tangential_force + (normal_torque * normal_torque) / (e * e);
+  const double lhs =
+      tangential_force * tangential_force + (normal_torque * normal_torque) / (e * e);
   const double rhs = pad.friction * pad.friction * normal_force * normal_force;
   return lhs <= rhs;
 }

@@ -73,8 +73,8 @@ Pose ur_dh_fk(const UrDhParameters& dh, const Vector6d& q) {
 
 UrIk::UrIk(const KinematicChain& chain, const UrDhParameters& dh) : dh_(dh) {
   if (chain.dof() != 6) {
-    throw InputError(chain.base_link() + " -> " + chain.tip_link(), "dof",
-                     "a 6-joint UR chain", std::to_string(chain.dof()) + " joints");
+    throw InputError(chain.base_link() + " -> " + chain.tip_link(), "dof", "a 6-joint UR chain",
+                     std::to_string(chain.dof()) + " joints");
   }
   const Vector6d zero = Vector6d::Zero();
   tool_ = ur_dh_fk(dh_, zero).inverse() * chain.fk(zero);
@@ -157,8 +157,8 @@ int UrIk::solve(const Pose& tcp, const Vector6d& seed, UrIkSolutions& out) const
       // The planar 2R arm (a2, a3) in frame 1's x-y plane.
       const double px = p14.x();
       const double py = p14.y();
-      const double c3 = (px * px + py * py - dh_.a2 * dh_.a2 - dh_.a3 * dh_.a3) /
-                        (2.0 * dh_.a2 * dh_.a3);
+      const double c3 =
+          (px * px + py * py - dh_.a2 * dh_.a2 - dh_.a3 * dh_.a3) / (2.0 * dh_.a2 * dh_.a3);
       double q3abs = 0.0;
       if (!safe_acos(c3, q3abs)) continue;
       const double sn3abs = std::sqrt(std::max(0.0, 1.0 - c3 * c3));
@@ -177,7 +177,8 @@ int UrIk::solve(const Pose& tcp, const Vector6d& seed, UrIkSolutions& out) const
   for (int k = 0; k < raw_count; ++k) {
     Vector6d q;
     bool all_ok = true;
-    for (int i = 0; i < 6 && all_ok; ++i) q[i] = wrap_near(raw[k][i], seed[i], lower_[i], upper_[i], all_ok);
+    for (int i = 0; i < 6 && all_ok; ++i)
+      q[i] = wrap_near(raw[k][i], seed[i], lower_[i], upper_[i], all_ok);
     if (!all_ok) continue;
     bool duplicate = false;
     for (int m = 0; m < out.count && !duplicate; ++m) {

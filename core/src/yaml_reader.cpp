@@ -35,8 +35,7 @@ YamlNode YamlNode::load_file(const std::string& path) {
     }
     return YamlNode(root, std::make_shared<const std::string>(path), "");
   } catch (const YAML::Exception& e) {
-    throw InputError(path, "line " + std::to_string(e.mark.line + 1), "well-formed YAML",
-                     e.msg);
+    throw InputError(path, "line " + std::to_string(e.mark.line + 1), "well-formed YAML", e.msg);
   }
 }
 
@@ -48,7 +47,9 @@ YamlNode YamlNode::from_string(const std::string& text, const std::string& name)
   }
 }
 
-std::string YamlNode::describe() const { return short_repr(node_); }
+std::string YamlNode::describe() const {
+  return short_repr(node_);
+}
 
 void YamlNode::fail(const std::string& expected, const std::string& got) const {
   throw InputError(*file_, path_.empty() ? "(document)" : path_, expected, got);
@@ -86,15 +87,19 @@ std::size_t YamlNode::size() const {
   return node_.size();
 }
 
-bool YamlNode::is_map() const { return node_.IsMap(); }
-bool YamlNode::is_sequence() const { return node_.IsSequence(); }
+bool YamlNode::is_map() const {
+  return node_.IsMap();
+}
+bool YamlNode::is_sequence() const {
+  return node_.IsSequence();
+}
 
 void YamlNode::expect_only(std::initializer_list<const char*> allowed) const {
   if (!node_.IsMap()) fail("a map", describe());
   for (const auto& kv : node_) {
     const std::string key = kv.first.as<std::string>();
-    const bool known = std::any_of(allowed.begin(), allowed.end(),
-                                   [&](const char* a) { return key == a; });
+    const bool known =
+        std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; });
     if (!known) {
       std::string list;
       for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);

@@ -31,8 +31,7 @@ ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& ha
   core::GenericIkSettings ik;
   ik.max_attempts = 1;  // restarts are ours, so that every solution is scored
   for (int attempt = 0; attempt < settings.ik_attempts; ++attempt) {
-    const Eigen::VectorXd start =
-        attempt == 0 ? seed_joints : core::random_configuration(arm, rng);
+    const Eigen::VectorXd start = attempt == 0 ? seed_joints : core::random_configuration(arm, rng);
     const core::GenericIkResult r = core::solve_ik(arm, hand_in_base, start, rng, ik);
     if (!r.success) continue;
     const double q = comfort_index(arm.jacobian(r.q), length);

@@ -11,7 +11,7 @@
 namespace hila::offline {
 
 std::vector<Eigen::Quaterniond> spread_orientations(int count) {
-  constexpr double kPhi = 1.4142135623730951;   // sqrt(2)
+  constexpr double kPhi = 1.4142135623730951;    // sqrt(2)
   constexpr double kPsi = 1.533751168755204288;  // root of x^4 = x + 4
   std::vector<Eigen::Quaterniond> out;
   out.reserve(static_cast<std::size_t>(count));
@@ -120,7 +120,8 @@ ComfortMap ComfortMap::build(const core::KinematicChain& arm, const ComfortMapSe
     const Eigen::VectorXd q = core::random_configuration(arm, rng);
     arm.fk_and_jacobian(q, tip, jac);
     const double quality = comfort_index_fast(jac, reach);
-    const auto value = static_cast<std::uint8_t>(std::lround(std::clamp(quality, 0.0, 1.0) * 255.0));
+    const auto value =
+        static_cast<std::uint8_t>(std::lround(std::clamp(quality, 0.0, 1.0) * 255.0));
     const int o = nearest_orientation(map.orientations_, Eigen::Quaterniond(tip.linear()));
     std::uint8_t& slot = map.values_[map.index(map.nearest_node(tip.translation()), o)];
     slot = std::max(slot, value);

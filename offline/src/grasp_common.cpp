@@ -95,14 +95,15 @@ std::vector<TwoFingerGrasp> plan_two_finger_grasps(const core::TriangleMesh& mes
       candidates.push_back(g);
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const TwoFingerGrasp& a, const TwoFingerGrasp& b) { return a.quality > b.quality; });
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const TwoFingerGrasp& a, const TwoFingerGrasp& b) { return a.quality > b.quality; });
   std::vector<core::Pose> poses;
   poses.reserve(candidates.size());
   for (const auto& g : candidates) poses.push_back(g.frame);
   std::vector<TwoFingerGrasp> kept;
-  for (const int i : distinct_poses(poses, settings.merge_distance,
-                                    core::deg_to_rad(settings.merge_angle_deg))) {
+  for (const int i :
+       distinct_poses(poses, settings.merge_distance, core::deg_to_rad(settings.merge_angle_deg))) {
     kept.push_back(candidates[static_cast<std::size_t>(i)]);
   }
   return kept;

@@ -26,8 +26,10 @@ HandGeometry human_hand_geometry(const core::HumanHandSpec& hand) {
   HandGeometry g;
   // Fingers: slabs whose inner faces are at +-opening/2, centred on the grasp point.
   const double half = 0.5 * hand.finger_thickness;
-  g.finger_pos.push_back(box(hand.finger_width, hand.finger_thickness, hand.finger_length, {0, half, 0}));
-  g.finger_neg.push_back(box(hand.finger_width, hand.finger_thickness, hand.finger_length, {0, -half, 0}));
+  g.finger_pos.push_back(
+      box(hand.finger_width, hand.finger_thickness, hand.finger_length, {0, half, 0}));
+  g.finger_neg.push_back(
+      box(hand.finger_width, hand.finger_thickness, hand.finger_length, {0, -half, 0}));
   // Palm behind the fingertips (toward the wrist, -z), spanning the closed hand.
   g.fixed.push_back(box(hand.palm_width, hand.palm_thickness, hand.palm_length,
                         {0, 0, -0.5 * hand.finger_length - 0.5 * hand.palm_length}));
@@ -56,8 +58,8 @@ std::vector<db::HumanGraspRecord> plan_human_grasps(const core::TriangleMesh& me
   two.merge_distance = settings.merge_distance;
   two.merge_angle_deg = settings.merge_angle_deg;
   std::vector<db::HumanGraspRecord> grasps;
-  for (const TwoFingerGrasp& t : plan_two_finger_grasps(mesh, analysis.mass_properties.com,
-                                                        human_hand_geometry(hand), two)) {
+  for (const TwoFingerGrasp& t :
+       plan_two_finger_grasps(mesh, analysis.mass_properties.com, human_hand_geometry(hand), two)) {
     db::HumanGraspRecord g;
     g.hand = t.frame;
     g.aperture = t.pair.width;

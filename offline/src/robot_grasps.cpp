@@ -27,11 +27,12 @@ HandGeometry gripper_geometry(const core::Cell& cell, const std::string& arm_nam
   while (!stack.empty()) {
     const int link = stack.back();
     stack.pop_back();
-    for (const int j : robot.links()[link].child_joints) stack.push_back(robot.joints()[j].child_link);
+    for (const int j : robot.links()[link].child_joints)
+      stack.push_back(robot.joints()[j].child_link);
     const auto& shapes = robot.links()[link].collisions;
     if (shapes.empty()) continue;
-    const double moved = (tcp_inv * open[link]).translation().y() -
-                         (tcp_inv * closed[link]).translation().y();
+    const double moved =
+        (tcp_inv * open[link]).translation().y() - (tcp_inv * closed[link]).translation().y();
     auto& group = moved > 0.25 * kProbe    ? hand.finger_pos
                   : moved < -0.25 * kProbe ? hand.finger_neg
                                            : hand.fixed;
@@ -55,7 +56,8 @@ double grasp_theta_c(const core::Cell& cell, double mass, const Eigen::Vector3d&
                      const Eigen::Vector3d& contact_centre, const Eigen::Vector3d& axis) {
   core::RelaxationSettings relax;
   relax.step_deg = cell.spec().gripper.slip_step_deg;
-  return core::relaxation_limit_deg(mass, cell.spec().gravity, axis_lever(com, contact_centre, axis),
+  return core::relaxation_limit_deg(mass, cell.spec().gravity,
+                                    axis_lever(com, contact_centre, axis),
                                     gripper_torque_capacity(cell), relax);
 }
 

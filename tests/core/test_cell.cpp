@@ -82,7 +82,8 @@ TEST(Cell, ReferenceCellLoads) {
   ASSERT_EQ(cell->spec().obstacles.size(), 1u);
   EXPECT_EQ(cell->spec().obstacles[0].name, "table");
   EXPECT_EQ(cell->spec().allowed_collisions.size(), 8u);
-  EXPECT_LT((cell->spec().human_stance.translation() - Eigen::Vector3d(1.15, 0, 0.1)).norm(), 1e-12);
+  EXPECT_LT((cell->spec().human_stance.translation() - Eigen::Vector3d(1.15, 0, 0.1)).norm(),
+            1e-12);
   EXPECT_TRUE(is_valid_pose(cell->spec().human_stance));
 }
 
@@ -200,16 +201,16 @@ TEST(Cell, HomeOutsideLimits) {
 }
 
 TEST(Cell, NanInHumanStance) {
-  const std::string text =
-      replace_once(cell_text(), "stance: {xyz: [1.15, 0.0, 0.1]", "stance: {xyz: [1.15, .nan, 0.1]");
+  const std::string text = replace_once(cell_text(), "stance: {xyz: [1.15, 0.0, 0.1]",
+                                        "stance: {xyz: [1.15, .nan, 0.1]");
   const std::string path = write_cell("stance_nan", text);
   expect_input_error([&] { Cell::load(path); }, {path, "human.stance.xyz[1]", "finite"});
 }
 
 TEST(Cell, NonOrthonormalStanceRotation) {
-  const std::string text =
-      replace_once(cell_text(), "stance: {xyz: [1.15, 0.0, 0.1], rpy_deg: [0, 0, 180]}",
-                   "stance: {xyz: [1.15, 0.0, 0.1], rotation: [[-1, 0, 0], [0, -1.1, 0], [0, 0, 1]]}");
+  const std::string text = replace_once(
+      cell_text(), "stance: {xyz: [1.15, 0.0, 0.1], rpy_deg: [0, 0, 180]}",
+      "stance: {xyz: [1.15, 0.0, 0.1], rotation: [[-1, 0, 0], [0, -1.1, 0], [0, 0, 1]]}");
   const std::string path = write_cell("stance_rotation", text);
   expect_input_error([&] { Cell::load(path); }, {path, "human.stance.rotation", "orthonormal"});
 }
@@ -228,8 +229,8 @@ TEST(Cell, WrongUrDhValue) {
 }
 
 TEST(Cell, AllowedCollisionWithUnknownLink) {
-  const std::string text = replace_once(cell_text(), "- [left_pad_l, left_pad_r]",
-                                        "- [left_pad_l, left_pad_rr]");
+  const std::string text =
+      replace_once(cell_text(), "- [left_pad_l, left_pad_r]", "- [left_pad_l, left_pad_rr]");
   const std::string path = write_cell("allowed", text);
   const auto cell = Cell::load(path);  // names are checked when the scene is built
   expect_input_error([&] { build_cell_scene(*cell); },

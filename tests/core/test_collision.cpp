@@ -1,11 +1,10 @@
-#include "hila/core/collision.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <thread>
 
+#include "hila/core/collision.hpp"
 #include "hila/core/generic_ik.hpp"
 #include "util/test_util.hpp"
 
@@ -102,8 +101,10 @@ TEST(Collision, ArmSubsetQueryAgreesWithBruteForceOverItsPairs) {
   ASSERT_EQ(f.scene.arm_bodies.size(), 2u);
   // The left arm's bodies: its links and its gripper, nothing of the right arm.
   const auto& left = f.scene.arm_bodies[0];
-  EXPECT_NE(std::find(left.begin(), left.end(), *f.scene.model.find_body("left_pad_l")), left.end());
-  EXPECT_EQ(std::find(left.begin(), left.end(), *f.scene.model.find_body("right_pad_l")), left.end());
+  EXPECT_NE(std::find(left.begin(), left.end(), *f.scene.model.find_body("left_pad_l")),
+            left.end());
+  EXPECT_EQ(std::find(left.begin(), left.end(), *f.scene.model.find_body("right_pad_l")),
+            left.end());
   int colliding = 0;
   for (int i = 0; i < 600; ++i) {
     // Alternate full-state and one-arm updates so the subset query sees stale broad-phase trees.
@@ -177,7 +178,8 @@ TEST(Collision, TableContactNamesTheTable) {
     EXPECT_NE(names.find("left_"), std::string::npos) << names;
   }
   // Whatever the pose, the two phases agree.
-  EXPECT_EQ(core::in_collision(f.scene.model, data), core::in_collision_brute_force(f.scene.model, data));
+  EXPECT_EQ(core::in_collision(f.scene.model, data),
+            core::in_collision_brute_force(f.scene.model, data));
 }
 
 TEST(Collision, HeldBoardFollowsTheGripperAndHitsTheTable) {
@@ -223,8 +225,10 @@ TEST(Collision, HeldBoardFollowsTheGripperAndHitsTheTable) {
   core::CollisionPair pair;
   ASSERT_TRUE(core::in_collision(scene.model, data, active, &pair));
   EXPECT_EQ(core::describe_pair(scene.model, pair), "table <-> board");
-  EXPECT_FALSE(core::in_collision(scene.model, data, scene.arm_bodies[0]));  // the arm alone is free
-  EXPECT_EQ(core::in_collision(scene.model, data), core::in_collision_brute_force(scene.model, data));
+  EXPECT_FALSE(
+      core::in_collision(scene.model, data, scene.arm_bodies[0]));  // the arm alone is free
+  EXPECT_EQ(core::in_collision(scene.model, data),
+            core::in_collision_brute_force(scene.model, data));
 }
 
 TEST(Collision, DistanceBetweenPrimitivesMatchesClosedForm) {

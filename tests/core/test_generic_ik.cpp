@@ -1,9 +1,8 @@
-#include "hila/core/generic_ik.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
 
+#include "hila/core/generic_ik.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;

@@ -1,7 +1,6 @@
-#include "hila/core/human_model.hpp"
-
 #include <gtest/gtest.h>
 
+#include "hila/core/human_model.hpp"
 #include "hila/core/kinematic_chain.hpp"
 #include "hila/core/robot_model.hpp"
 #include "util/test_util.hpp"
@@ -51,8 +50,7 @@ TEST(HumanModel, GeneratedUrdfHasTwoSevenDofArmsWithTheRightLengths) {
 }
 
 TEST(HumanModel, JointLimitsComeFromTheRangeOfMotionTable) {
-  const auto model =
-      core::RobotModel::load_urdf_string(core::generate_human_urdf({}), "human");
+  const auto model = core::RobotModel::load_urdf_string(core::generate_human_urdf({}), "human");
   const auto& elbow = model.joints()[model.joint_index("right_elbow_flexion")];
   EXPECT_NEAR(elbow.lower, 0.0, 1e-6);
   EXPECT_NEAR(elbow.upper, core::deg_to_rad(145), 1e-6);
@@ -67,10 +65,19 @@ TEST(HumanModel, CommittedDefaultHumanMatchesTheGenerator) {
 }
 
 TEST(HumanModel, RejectsImplausibleStature) {
-  test::expect_input_error([] { core::human_dimensions({1722.0, core::Sex::Male}); },
-                           {"stature", "millimetres"});
-  test::expect_input_error([] { core::human_dimensions({0.0, core::Sex::Female}); },
-                           {"stature", "[1.30, 2.20]"});
-  test::expect_input_error([] { core::human_dimensions({std::nan(""), core::Sex::Male}); },
-                           {"stature", "nan"});
+  test::expect_input_error(
+      [] {
+        core::human_dimensions({1722.0, core::Sex::Male});
+      },
+      {"stature", "millimetres"});
+  test::expect_input_error(
+      [] {
+        core::human_dimensions({0.0, core::Sex::Female});
+      },
+      {"stature", "[1.30, 2.20]"});
+  test::expect_input_error(
+      [] {
+        core::human_dimensions({std::nan(""), core::Sex::Male});
+      },
+      {"stature", "nan"});
 }

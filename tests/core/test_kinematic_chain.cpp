@@ -1,10 +1,9 @@
-#include "hila/core/kinematic_chain.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "hila/core/generic_ik.hpp"
+#include "hila/core/kinematic_chain.hpp"
 #include "hila/core/ur_ik.hpp"
 #include "util/test_util.hpp"
 
@@ -13,7 +12,9 @@ using hila::core::deg_to_rad;
 
 namespace {
 
-const core::Arm& left_arm() { return test::reference_cell()->arm("left"); }
+const core::Arm& left_arm() {
+  return test::reference_cell()->arm("left");
+}
 
 // UR3 DH values of DESIGN §4, written out so the tests do not reuse the code under test.
 constexpr double kD1 = 0.1519, kA2 = -0.24365, kA3 = -0.21325, kD4 = 0.11235, kD5 = 0.08535,

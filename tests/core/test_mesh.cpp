@@ -211,6 +211,6 @@ TEST(Mesh, NonPositiveUnitScaleIsRejected) {
 TEST(Mesh, WriteToUnwritablePathThrows) {
   const std::string dir = temp_dir("mesh_unwritable");
   const std::string path = dir + "/no/such/folder/box.stl";
-  expect_input_error(
-      [&] { write_mesh(make_box_mesh(Eigen::Vector3d(1, 1, 1)), path, "stlb"); }, {path});
+  expect_input_error([&] { write_mesh(make_box_mesh(Eigen::Vector3d(1, 1, 1)), path, "stlb"); },
+                     {path});
 }

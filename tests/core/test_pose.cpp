@@ -14,7 +14,9 @@ using namespace hila::test;
 namespace {
 
 // Smallest signed difference between two angles.
-double angle_diff(double a, double b) { return std::remainder(a - b, 2.0 * kPi); }
+double angle_diff(double a, double b) {
+  return std::remainder(a - b, 2.0 * kPi);
+}
 
 }  // namespace
 
@@ -49,11 +51,10 @@ TEST(Pose, RpyConventionIsFixedXThenYThenZ) {
   EXPECT_LT((pitch * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 1e-12);
   // Combined: R = Rz(yaw) * Ry(pitch) * Rx(roll) (roll applied first, about the fixed x axis).
   const Eigen::Vector3d rpy(0.3, -0.4, 1.1);
-  const Eigen::Matrix3d expected =
-      (Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d expected = (Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitY()) *
+                                    Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix();
   EXPECT_LT((rpy_to_matrix(rpy) - expected).cwiseAbs().maxCoeff(), 1e-15);
 }
 
@@ -152,7 +153,8 @@ TEST(Pose, RotationDistanceOfKnownAngle) {
   const Eigen::Matrix3d half = Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitX()).toRotationMatrix();
   EXPECT_NEAR(rotation_distance(identity, half), kPi, 1e-9);
   // 1.9 * pi about an axis is 0.1 * pi the other way.
-  const Eigen::Matrix3d big = Eigen::AngleAxisd(1.9 * kPi, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Matrix3d big =
+      Eigen::AngleAxisd(1.9 * kPi, Eigen::Vector3d::UnitY()).toRotationMatrix();
   EXPECT_NEAR(rotation_distance(identity, big), 0.1 * kPi, 1e-9);
 
   // Independent of the common frame: d(R, R * Rel) = angle(Rel).

@@ -54,9 +54,8 @@ std::string write_product(const std::string& dir, const std::string& text) {
   return write_file(dir, "product.yaml", text);
 }
 
-const std::vector<std::string> kNames = {"base",         "lateral_right", "back_lower",
-                                         "shelf_middle", "lateral_left",  "top",
-                                         "back_upper"};
+const std::vector<std::string> kNames = {
+    "base", "lateral_right", "back_lower", "shelf_middle", "lateral_left", "top", "back_upper"};
 
 // All boards at their targets as moving mesh bodies, plus the cell's table as a static box.
 struct AssemblyScene {
@@ -110,10 +109,9 @@ TEST(Product, CabinetLoads) {
   EXPECT_EQ(p.part("lateral_right").mesh_file, data_path("cabinet/lateral.stl"));
   // target_in_world composes the assembly frame.
   const PartSpec& top = p.part("top");
-  EXPECT_LT((p.target_in_world(top).translation() -
-             (p.assembly_frame * top.target.translation()))
-                .norm(),
-            1e-12);
+  EXPECT_LT(
+      (p.target_in_world(top).translation() - (p.assembly_frame * top.target.translation())).norm(),
+      1e-12);
 }
 
 TEST(Product, MeshExtentsInMetres) {
@@ -130,7 +128,7 @@ TEST(Product, MeshExtentsInMetres) {
   for (const PartSpec& part : p.parts) {
     const Eigen::Vector3d extent = part.mesh.max_corner() - part.mesh.min_corner();
     EXPECT_GT(extent.minCoeff(), 0.002) << part.name;  // back panels are 3 mm, boards 10 mm
-    EXPECT_LT(extent.maxCoeff(), 0.7) << part.name;     // and well below a metre long
+    EXPECT_LT(extent.maxCoeff(), 0.7) << part.name;    // and well below a metre long
   }
   // Same mesh file, same geometry.
   EXPECT_EQ(p.part("base").mesh.vertices, p.part("top").mesh.vertices);
@@ -213,8 +211,8 @@ TEST(Product, MetreMeshDeclaredAsMillimetres) {
   // A 0.4 x 0.3 x 0.01 box written in metres but declared mm: 0.4 mm across.
   const std::string dir = temp_dir("product_m_as_mm");
   write_mesh(make_box_mesh(Eigen::Vector3d(0.4, 0.3, 0.01)), dir + "/board_m.stl", "stlb");
-  const std::string text = replace_once(
-      product_text(), "mesh: " + data_path("cabinet/shelf.stl"), "mesh: board_m.stl");
+  const std::string text =
+      replace_once(product_text(), "mesh: " + data_path("cabinet/shelf.stl"), "mesh: board_m.stl");
   const std::string path = write_product(dir, text);
   expect_input_error([&] { load_product(path); }, {path, "parts[0].mesh_unit", "5 mm"});
 }
@@ -223,9 +221,8 @@ TEST(Product, BadMass) {
   struct Case {
     std::string value, fragment;
   };
-  const std::vector<Case> cases = {
-      {"0", "positive"}, {"-1", "positive"}, {".nan", "finite"}, {"nan", "finite"},
-      {"800", "below 100"}, {"heavy", "a number"}};
+  const std::vector<Case> cases = {{"0", "positive"}, {"-1", "positive"},   {".nan", "finite"},
+                                   {"nan", "finite"}, {"800", "below 100"}, {"heavy", "a number"}};
   for (std::size_t i = 0; i < cases.size(); ++i) {
     SCOPED_TRACE("mass: " + cases[i].value);
     const std::string text = replace_once(product_text(), "mass: 1.8", "mass: " + cases[i].value);
@@ -253,8 +250,8 @@ TEST(Product, OtherMeshUnitsScale) {
 
 TEST(Product, MissingMeshFile) {
   const std::string dir = temp_dir("product_missing_mesh");
-  const std::string text = replace_once(
-      product_text(), "mesh: " + data_path("cabinet/lateral.stl"), "mesh: no_such_board.stl");
+  const std::string text = replace_once(product_text(), "mesh: " + data_path("cabinet/lateral.stl"),
+                                        "mesh: no_such_board.stl");
   const std::string path = write_product(dir, text);
   expect_input_error([&] { load_product(path); },
                      {dir + "/no_such_board.stl", "no such file", path, "parts[1].mesh"});
@@ -263,11 +260,10 @@ TEST(Product, MissingMeshFile) {
 TEST(Product, EmptyMesh) {
   const std::string dir = temp_dir("product_empty_mesh");
   write_file(dir, "points.obj", "v 0 0 0\nv 100 0 0\nv 0 100 0\n");
-  const std::string text = replace_once(
-      product_text(), "mesh: " + data_path("cabinet/lateral.stl"), "mesh: points.obj");
+  const std::string text =
+      replace_once(product_text(), "mesh: " + data_path("cabinet/lateral.stl"), "mesh: points.obj");
   const std::string path = write_product(dir, text);
-  expect_input_error([&] { load_product(path); },
-                     {dir + "/points.obj", path, "parts[1].mesh"});
+  expect_input_error([&] { load_product(path); }, {dir + "/points.obj", path, "parts[1].mesh"});
 }
 
 TEST(Product, DuplicateOrder) {
@@ -294,10 +290,12 @@ TEST(Product, NanInTargetPose) {
 }
 
 TEST(Product, NonOrthonormalTargetRotation) {
-  const std::string text = replace_once(product_text(), "rotation: [[0, 1, 0], [0, 0, 1], [1, 0, 0]]",
-                                        "rotation: [[0, 1, 0], [0, 0, 1], [1, 0, 0.2]]");
+  const std::string text =
+      replace_once(product_text(), "rotation: [[0, 1, 0], [0, 0, 1], [1, 0, 0]]",
+                   "rotation: [[0, 1, 0], [0, 0, 1], [1, 0, 0.2]]");
   const std::string path = write_product(temp_dir("product_bad_rotation"), text);
-  expect_input_error([&] { load_product(path); }, {path, "parts[1].target.rotation", "orthonormal"});
+  expect_input_error([&] { load_product(path); },
+                     {path, "parts[1].target.rotation", "orthonormal"});
 }
 
 TEST(Product, DuplicatePartName) {

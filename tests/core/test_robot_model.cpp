@@ -12,7 +12,9 @@ using namespace hila::test;
 
 namespace {
 
-std::string urdf_path() { return data_path("cell/dual_ur3.urdf"); }
+std::string urdf_path() {
+  return data_path("cell/dual_ur3.urdf");
+}
 
 const RobotModel& dual_ur3() {
   static const RobotModel model = RobotModel::load_urdf_file(urdf_path());
@@ -111,8 +113,10 @@ TEST(RobotModel, MimicFingersMoveSymmetricallyAlongPalmY) {
   model.link_poses(q, poses);
   ASSERT_EQ(poses.size(), model.links().size());
   const Pose& palm = poses[model.link_index("left_gripper_palm")];
-  const Eigen::Vector3d pad_l = palm.inverse() * poses[model.link_index("left_pad_l")].translation();
-  const Eigen::Vector3d pad_r = palm.inverse() * poses[model.link_index("left_pad_r")].translation();
+  const Eigen::Vector3d pad_l =
+      palm.inverse() * poses[model.link_index("left_pad_l")].translation();
+  const Eigen::Vector3d pad_r =
+      palm.inverse() * poses[model.link_index("left_pad_r")].translation();
   EXPECT_NEAR(pad_l.y(), half_opening, 1e-12);
   EXPECT_NEAR(pad_r.y(), -half_opening, 1e-12);
   EXPECT_NEAR(pad_l.x(), pad_r.x(), 1e-12);
@@ -169,7 +173,8 @@ TEST(RobotModel, JointToUnknownLinkThrows) {
   EXPECT_EQ(model.links().size(), 2u);
 
   const std::string bad = small_urdf("<box size=\"0.1 0.1 0.1\"/>", "ghost");
-  expect_input_error([&] { RobotModel::load_urdf_string(bad, "ghost.urdf"); }, {"ghost.urdf", "a valid URDF document", "ghost"});
+  expect_input_error([&] { RobotModel::load_urdf_string(bad, "ghost.urdf"); },
+                     {"ghost.urdf", "a valid URDF document", "ghost"});
 }
 
 TEST(RobotModel, ZeroRadiusCylinderRejected) {
@@ -182,9 +187,9 @@ TEST(RobotModel, ZeroRadiusCylinderRejected) {
   EXPECT_DOUBLE_EQ(shapes[0].length, 0.2);
 
   const std::string zero = small_urdf("<cylinder radius=\"0\" length=\"0.2\"/>", "arm");
-  expect_input_error([&] { RobotModel::load_urdf_string(zero, "zero_radius.urdf"); },
-                     {"zero_radius.urdf", "link 'base' collision geometry", "positive radius",
-                      "radius 0"});
+  expect_input_error(
+      [&] { RobotModel::load_urdf_string(zero, "zero_radius.urdf"); },
+      {"zero_radius.urdf", "link 'base' collision geometry", "positive radius", "radius 0"});
   const std::string zero_box = small_urdf("<box size=\"0.1 0 0.1\"/>", "arm");
   expect_input_error([&] { RobotModel::load_urdf_string(zero_box, "flat_box.urdf"); },
                      {"flat_box.urdf", "link 'base'", "positive finite sides"});
@@ -203,8 +208,10 @@ TEST(RobotModel, AdjacentLinks) {
   EXPECT_FALSE(model.adjacent(base, upper));
   EXPECT_FALSE(model.adjacent(shoulder, forearm));
   // Siblings under the palm are not adjacent to each other.
-  EXPECT_FALSE(model.adjacent(model.link_index("left_finger_l"), model.link_index("left_finger_r")));
-  EXPECT_TRUE(model.adjacent(model.link_index("left_gripper_palm"), model.link_index("left_finger_l")));
+  EXPECT_FALSE(
+      model.adjacent(model.link_index("left_finger_l"), model.link_index("left_finger_r")));
+  EXPECT_TRUE(
+      model.adjacent(model.link_index("left_gripper_palm"), model.link_index("left_finger_l")));
   // Left and right arms never touch through a joint.
   EXPECT_FALSE(model.adjacent(shoulder, model.link_index("right_shoulder_link")));
 }

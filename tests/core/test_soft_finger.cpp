@@ -1,11 +1,10 @@
-#include "hila/core/soft_finger.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "hila/core/pose.hpp"
+#include "hila/core/soft_finger.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -60,7 +59,7 @@ TEST(SoftFinger, MaximumGravityTorqueIsTheMaximumOverAzimuths) {
       const Eigen::Vector3d v = axis.cross(u);
       const Eigen::Vector3d com = r * (std::cos(azimuth) * u + std::sin(azimuth) * v);
       best = std::max(best, std::abs(core::gravity_torque_about_axis(axis, Eigen::Vector3d::Zero(),
-                                                                      com, m, gravity / kG * kG)));
+                                                                     com, m, gravity / kG * kG)));
     }
     EXPECT_NEAR(best, core::max_gravity_torque(m, kG, r, theta), 1e-4) << theta_deg;
   }
@@ -69,15 +68,15 @@ TEST(SoftFinger, MaximumGravityTorqueIsTheMaximumOverAzimuths) {
 TEST(SoftFinger, GravityTorqueHandWorked) {
   // Axis along x through the origin, CoM 0.1 m along y, gravity -z: tau = x . (0.1 y x -m g z)
   // = -0.1 m g.
-  EXPECT_NEAR(core::gravity_torque_about_axis(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(),
-                                              Eigen::Vector3d(0, 0.1, 0), 2.0,
-                                              Eigen::Vector3d(0, 0, -kG)),
-              -0.1 * 2.0 * kG, 1e-12);
+  EXPECT_NEAR(
+      core::gravity_torque_about_axis(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(),
+                                      Eigen::Vector3d(0, 0.1, 0), 2.0, Eigen::Vector3d(0, 0, -kG)),
+      -0.1 * 2.0 * kG, 1e-12);
   // CoM on the axis line: no torque.
-  EXPECT_NEAR(core::gravity_torque_about_axis(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(),
-                                              Eigen::Vector3d(0.3, 0, 0), 2.0,
-                                              Eigen::Vector3d(0, 0, -kG)),
-              0.0, 1e-12);
+  EXPECT_NEAR(
+      core::gravity_torque_about_axis(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(),
+                                      Eigen::Vector3d(0.3, 0, 0), 2.0, Eigen::Vector3d(0, 0, -kG)),
+      0.0, 1e-12);
 }
 
 TEST(SoftFinger, WinklerEccentricityHandWorked) {

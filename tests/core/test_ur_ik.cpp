@@ -1,10 +1,9 @@
-#include "hila/core/ur_ik.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "hila/core/generic_ik.hpp"
+#include "hila/core/ur_ik.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -13,7 +12,9 @@ using core::Vector6d;
 
 namespace {
 
-const core::Arm& arm(const std::string& name) { return test::reference_cell()->arm(name); }
+const core::Arm& arm(const std::string& name) {
+  return test::reference_cell()->arm(name);
+}
 
 double pose_gap(const core::Pose& a, const core::Pose& b) {
   return (a.matrix() - b.matrix()).cwiseAbs().maxCoeff();
@@ -94,10 +95,20 @@ TEST(UrIk, RoundTripNearSingularities) {
     Vector6d q = random_q(rng);
     const double eps = std::pow(10.0, -std::uniform_int_distribution<int>(3, 9)(rng));
     switch (i % 4) {
-      case 0: q[4] = eps; break;                   // wrist singularity (q5 ~ 0)
-      case 1: q[4] = kPi - eps; break;             // wrist singularity (q5 ~ pi)
-      case 2: q[2] = eps; break;                   // elbow stretched (q3 ~ 0)
-      case 3: q[1] = -kPi / 2; q[2] = eps; q[3] = -kPi / 2; break;  // near upright
+      case 0:
+        q[4] = eps;
+        break;  // wrist singularity (q5 ~ 0)
+      case 1:
+        q[4] = kPi - eps;
+        break;  // wrist singularity (q5 ~ pi)
+      case 2:
+        q[2] = eps;
+        break;  // elbow stretched (q3 ~ 0)
+      case 3:
+        q[1] = -kPi / 2;
+        q[2] = eps;
+        q[3] = -kPi / 2;
+        break;  // near upright
     }
     round_trip(arm("left"), q, random_q(rng), stats, 1e-3);
   }
@@ -150,7 +161,8 @@ TEST(UrIk, MissesNoSolutionFoundByGenericIkFromManyRestarts) {
       if (!result.success) continue;
       ++generic_successes;
       bool found = false;
-      for (int k = 0; k < sols.count && !found; ++k) found = same_modulo_2pi(sols.q[k], result.q, 1e-6);
+      for (int k = 0; k < sols.count && !found; ++k)
+        found = same_modulo_2pi(sols.q[k], result.q, 1e-6);
       if (found) {
         ++matched;
       } else {

@@ -124,7 +124,8 @@ TEST(YamlReader, WrongTypeNamesFieldAndValue) {
   const YamlNode part = root.at("part");
   expect_input_error([&] { part.at("mass").as_double(); },
                      {path, "part.mass", "expected a number", "got 'heavy'"});
-  expect_input_error([&] { part.at("order").as_int(); }, {path, "part.order", "an integer", "'1.5'"});
+  expect_input_error([&] { part.at("order").as_int(); },
+                     {path, "part.order", "an integer", "'1.5'"});
   expect_input_error([&] { part.at("flag").as_bool(); }, {path, "part.flag", "true or false"});
   expect_input_error([&] { part.at("xyz").as_vec3(); },
                      {path, "part.xyz", "a list of 3 numbers", "a list of 2 items"});
@@ -172,8 +173,11 @@ TEST(YamlReader, ExpectOnlyRejectsUnknownField) {
                                       "  - {name: base, masss: 0.8}\n");
   const YamlNode part = root.at("parts").at(0);
   EXPECT_NO_THROW(part.expect_only({"name", "masss"}));
-  expect_input_error([&] { part.expect_only({"name", "mass", "order"}); },
-                     {path, "parts[0].masss", "unknown field 'masss'", "name, mass, order"});
+  expect_input_error(
+      [&] {
+        part.expect_only({"name", "mass", "order"});
+      },
+      {path, "parts[0].masss", "unknown field 'masss'", "name, mass, order"});
   expect_input_error([&] { root.expect_only({"name"}); }, {path, "parts", "unknown field 'parts'"});
 }
 
@@ -200,9 +204,10 @@ TEST(YamlReader, PoseWithQuaternion) {
   const std::string w = std::to_string(std::cos(a / 2));
   const std::string z = std::to_string(std::sin(a / 2));
   const auto [path, root] =
-      load_text("pose_quat", "good: {xyz: [0, 0, 1], quat_wxyz: [" + w + ", 0, 0, " + z + "]}\n"
-                             "bad: {xyz: [0, 0, 1], quat_wxyz: [1, 1, 0, 0]}\n"
-                             "short: {xyz: [0, 0, 1], quat_wxyz: [1, 0, 0]}\n");
+      load_text("pose_quat", "good: {xyz: [0, 0, 1], quat_wxyz: [" + w + ", 0, 0, " + z +
+                                 "]}\n"
+                                 "bad: {xyz: [0, 0, 1], quat_wxyz: [1, 1, 0, 0]}\n"
+                                 "short: {xyz: [0, 0, 1], quat_wxyz: [1, 0, 0]}\n");
   const Pose good = root.at("good").as_pose();
   const Eigen::Matrix3d expected =
       Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();

@@ -1,15 +1,14 @@
-#include "hila/offline/build.hpp"
-
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <csignal>
 #include <filesystem>
-#include <sys/wait.h>
 #include <thread>
-#include <unistd.h>
 
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
+#include "hila/offline/build.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -27,7 +26,8 @@ offline::BuildSettings quick_settings(std::uint64_t seed = 7, int jobs = 1) {
   return s;
 }
 
-std::string build(const std::string& dir, const std::string& name, const offline::BuildSettings& s) {
+std::string build(const std::string& dir, const std::string& name,
+                  const offline::BuildSettings& s) {
   const std::string out = dir + "/" + name;
   offline::build_database(test::product_path(), test::cell_path(), out, s);
   return out;
@@ -41,7 +41,8 @@ std::vector<std::string> files_in(const std::string& dir) {
 }
 
 // A copy of the cabinet product in `dir` with one line replaced (meshes referenced absolutely).
-std::string product_variant(const std::string& dir, const std::string& from, const std::string& to) {
+std::string product_variant(const std::string& dir, const std::string& from,
+                            const std::string& to) {
   std::string text = test::read_file(test::product_path());
   for (const char* mesh : {"shelf.stl", "lateral.stl", "back_panel.stl"}) {
     const std::string rel = std::string("mesh: ") + mesh;
@@ -137,8 +138,9 @@ TEST(Build, BadInputsAreClearErrors) {
   const std::string out = dir + "/out.hila";
   // Millimetre meshes declared as metres.
   const std::string metres = product_variant(dir, "mesh_unit: mm", "mesh_unit: m");
-  test::expect_input_error([&] { offline::build_database(metres, test::cell_path(), out, quick_settings()); },
-                           {metres, "mesh_unit", "mm"});
+  test::expect_input_error(
+      [&] { offline::build_database(metres, test::cell_path(), out, quick_settings()); },
+      {metres, "mesh_unit", "mm"});
   // An open mesh: a box with one triangle missing.
   core::TriangleMesh open_box = core::make_box_mesh({0.3, 0.2, 0.01});
   open_box.triangles.pop_back();
@@ -149,18 +151,23 @@ TEST(Build, BadInputsAreClearErrors) {
   text.replace(text.find(first), first.size(), "mesh: " + dir + "/open.obj");
   text.replace(text.find("mesh_unit: mm"), 13, "mesh_unit: m");
   test::write_file(dir, "product.yaml", text);
-  test::expect_input_error([&] { offline::build_database(open_product, test::cell_path(), out, quick_settings()); },
-                           {"base", "closed"});
+  test::expect_input_error(
+      [&] { offline::build_database(open_product, test::cell_path(), out, quick_settings()); },
+      {"base", "closed"});
   // A destination folder that does not exist: refused before any work.
   test::expect_input_error(
-      [&] { offline::build_database(test::product_path(), test::cell_path(), dir + "/no/such/dir/x.hila", quick_settings()); },
+      [&] {
+        offline::build_database(test::product_path(), test::cell_path(),
+                                dir + "/no/such/dir/x.hila", quick_settings());
+      },
       {"no/such/dir"});
   EXPECT_FALSE(fs::exists(out));
   // Zero jobs.
   offline::BuildSettings zero = quick_settings();
   zero.jobs = 0;
-  test::expect_input_error([&] { offline::build_database(test::product_path(), test::cell_path(), out, zero); },
-                           {"--jobs"});
+  test::expect_input_error(
+      [&] { offline::build_database(test::product_path(), test::cell_path(), out, zero); },
+      {"--jobs"});
 }
 
 TEST(Build, PartSeedsDependOnNameAndSeedOnly) {
@@ -179,7 +186,9 @@ TEST(Build, APartTooLargeForAnyGraspIsNamed) {
   text.replace(text.find("mesh_unit: mm"), 13, "mesh_unit: m");
   const std::string product = test::write_file(dir, "product.yaml", text);
   test::expect_input_error(
-      [&] { offline::build_database(product, test::cell_path(), dir + "/x.hila", quick_settings()); },
+      [&] {
+        offline::build_database(product, test::cell_path(), dir + "/x.hila", quick_settings());
+      },
       {product, "base", "no collision-free antipodal grasp"});
   EXPECT_FALSE(fs::exists(dir + "/x.hila"));
 }

@@ -1,5 +1,3 @@
-#include "hila/offline/comfort.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/SVD>
@@ -8,6 +6,7 @@
 #include "hila/core/generic_ik.hpp"
 #include "hila/core/human_model.hpp"
 #include "hila/core/robot_model.hpp"
+#include "hila/offline/comfort.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -80,7 +79,8 @@ TEST(Comfort, BestComfortIsAtLeastThatOfTheGeneratingPostureAndReachesThePose) {
 
 TEST(Comfort, UnreachablePoseHasZeroComfort) {
   const auto arm = human_arm(1.722);
-  const auto best = offline::best_comfort(arm, core::make_pose({2.0, 0, 0}), Eigen::VectorXd::Zero(7));
+  const auto best =
+      offline::best_comfort(arm, core::make_pose({2.0, 0, 0}), Eigen::VectorXd::Zero(7));
   EXPECT_FALSE(best.reachable);
   EXPECT_EQ(best.quality, 0.0);
 }

@@ -1,5 +1,3 @@
-#include "hila/offline/comfort_map.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,12 +5,15 @@
 
 #include "hila/core/generic_ik.hpp"
 #include "hila/offline/comfort.hpp"
+#include "hila/offline/comfort_map.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
 
 namespace {
-const core::KinematicChain& right_arm() { return test::reference_cell()->human_arms()[1].chain; }
+const core::KinematicChain& right_arm() {
+  return test::reference_cell()->human_arms()[1].chain;
+}
 
 offline::ComfortMapSettings small_settings() {
   offline::ComfortMapSettings s;
@@ -85,7 +86,9 @@ TEST(ComfortMap, EveryBinHoldsTheBestQOfTheSamplesThatLandedInIt) {
         best = o;
       }
     }
-    const std::size_t cell = (static_cast<std::size_t>(node.x()) * map.dims().y() + node.y()) * map.dims().z() + node.z();
+    const std::size_t cell =
+        (static_cast<std::size_t>(node.x()) * map.dims().y() + node.y()) * map.dims().z() +
+        node.z();
     auto& slot = expected[cell * n_orient + best];
     slot = std::max<std::uint8_t>(slot, static_cast<std::uint8_t>(std::lround(quality * 255.0)));
   }
@@ -93,7 +96,8 @@ TEST(ComfortMap, EveryBinHoldsTheBestQOfTheSamplesThatLandedInIt) {
   for (std::size_t i = 0; i < expected.size(); ++i) differing += expected[i] != map.values()[i];
   // SVD vs eigenvalue rounding can move a value across a 1/255 step on rare ties.
   EXPECT_LE(differing, expected.size() / 10000);
-  EXPECT_GT(std::count_if(map.values().begin(), map.values().end(), [](auto v) { return v > 0; }), 1000);
+  EXPECT_GT(std::count_if(map.values().begin(), map.values().end(), [](auto v) { return v > 0; }),
+            1000);
 }
 
 TEST(ComfortMap, LookupAtANodeIsItsBinAndOutsideTheGridIsZero) {

@@ -1,8 +1,7 @@
-#include "hila/offline/grasp_common.hpp"
-
 #include <gtest/gtest.h>
 
 #include "hila/core/mesh.hpp"
+#include "hila/offline/grasp_common.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -49,11 +48,12 @@ TEST(GraspCommon, AxisLeverIsTheDistanceToTheLine) {
 TEST(GraspCommon, DistinctPosesMergesNeighboursAndTheSymmetricFlip) {
   std::vector<core::Pose> poses;
   poses.push_back(core::make_pose({0, 0, 0}));
-  poses.push_back(core::make_pose({0.005, 0, 0}, {0, 0, 0.1}));     // near: merged
-  poses.push_back(core::make_pose({0, 0, 0}, {0, 0, core::kPi}));   // flipped about z: merged
-  poses.push_back(core::make_pose({0.05, 0, 0}));                   // far: kept
+  poses.push_back(core::make_pose({0.005, 0, 0}, {0, 0, 0.1}));        // near: merged
+  poses.push_back(core::make_pose({0, 0, 0}, {0, 0, core::kPi}));      // flipped about z: merged
+  poses.push_back(core::make_pose({0.05, 0, 0}));                      // far: kept
   poses.push_back(core::make_pose({0, 0, 0}, {core::kPi / 2, 0, 0}));  // turned: kept
-  EXPECT_EQ(offline::distinct_poses(poses, 0.01, core::deg_to_rad(20)), (std::vector<int>{0, 3, 4}));
+  EXPECT_EQ(offline::distinct_poses(poses, 0.01, core::deg_to_rad(20)),
+            (std::vector<int>{0, 3, 4}));
 }
 
 TEST(GraspCommon, HandPartCheckerSeesFingersOpenAndClosed) {

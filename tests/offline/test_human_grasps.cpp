@@ -1,9 +1,8 @@
-#include "hila/offline/human_grasps.hpp"
-
 #include <gtest/gtest.h>
 
 #include "hila/core/mesh.hpp"
 #include "hila/core/soft_finger.hpp"
+#include "hila/offline/human_grasps.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -18,7 +17,8 @@ std::vector<db::HumanGraspRecord> plan(const std::string& file, double mass) {
 
 TEST(HumanGrasps, BoardsGetEdgePinchesInsideTheHandsAperture) {
   const auto& hand = test::reference_cell()->spec().human_hand;
-  for (const auto& [file, mass] : {std::pair{"shelf.stl", 0.8}, std::pair{"back_panel.stl", 0.22}}) {
+  for (const auto& [file, mass] :
+       {std::pair{"shelf.stl", 0.8}, std::pair{"back_panel.stl", 0.22}}) {
     const auto grasps = plan(file, mass);
     ASSERT_FALSE(grasps.empty()) << file;
     for (const auto& g : grasps) {

@@ -1,5 +1,3 @@
-#include "hila/offline/robot_grasps.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +5,7 @@
 #include "hila/core/collision.hpp"
 #include "hila/core/mesh.hpp"
 #include "hila/core/soft_finger.hpp"
+#include "hila/offline/robot_grasps.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -27,7 +26,8 @@ Board plan(const std::string& file, double mass, std::uint64_t seed = 1) {
   b.analysis = offline::analyze_part(file, b.mesh, mass);
   offline::RobotGraspSettings settings;
   settings.seed = seed;
-  b.grasps = offline::plan_robot_grasps(b.mesh, b.analysis, mass, *test::reference_cell(), settings);
+  b.grasps =
+      offline::plan_robot_grasps(b.mesh, b.analysis, mass, *test::reference_cell(), settings);
   return b;
 }
 
@@ -134,10 +134,12 @@ TEST(RobotGrasps, ThetaCOfEveryGraspEqualsTheClosedForm) {
   for (const Board* board : {&shelf(), &lateral(), &back_panel()}) {
     for (const auto& g : board->grasps) {
       const Eigen::Vector3d axis = (g.contact_2 - g.contact_1).normalized();
-      const Eigen::Vector3d r = board->analysis.mass_properties.com - 0.5 * (g.contact_1 + g.contact_2);
+      const Eigen::Vector3d r =
+          board->analysis.mass_properties.com - 0.5 * (g.contact_1 + g.contact_2);
       EXPECT_NEAR(g.lever, (r - r.dot(axis) * axis).norm(), 1e-12);
       const double ratio = capacity / (board->mass * cell->spec().gravity * g.lever);
-      const double expected = ratio >= 1.0 ? 90.0 : std::floor(core::rad_to_deg(std::asin(ratio)) + 1e-12);
+      const double expected =
+          ratio >= 1.0 ? 90.0 : std::floor(core::rad_to_deg(std::asin(ratio)) + 1e-12);
       EXPECT_EQ(g.theta_c_deg, expected) << "lever " << g.lever;
       EXPECT_NEAR(g.friction_torque_capacity, capacity, 1e-12);
     }
@@ -180,8 +182,8 @@ TEST(RobotGrasps, NearDuplicatesAreMerged) {
   for (std::size_t i = 0; i < g.size(); ++i) {
     for (std::size_t k = i + 1; k < g.size(); ++k) {
       const bool close = (g[i].tcp.translation() - g[k].tcp.translation()).norm() <= 0.01;
-      const bool aligned = core::rotation_distance(g[i].tcp.linear(), g[k].tcp.linear()) <=
-                           core::deg_to_rad(20.0);
+      const bool aligned =
+          core::rotation_distance(g[i].tcp.linear(), g[k].tcp.linear()) <= core::deg_to_rad(20.0);
       EXPECT_FALSE(close && aligned) << i << " and " << k;
     }
   }
@@ -191,7 +193,7 @@ TEST(RobotGrasps, GripperGeometrySeparatesTheFingers) {
   const auto hand = offline::gripper_geometry(*test::reference_cell(), "left");
   EXPECT_EQ(hand.finger_pos.size(), 2u);  // finger body and pad
   EXPECT_EQ(hand.finger_neg.size(), 2u);
-  EXPECT_GE(hand.fixed.size(), 2u);       // sensor and palm
+  EXPECT_GE(hand.fixed.size(), 2u);  // sensor and palm
   for (const auto& s : hand.finger_pos) EXPECT_GT(s.origin.translation().y(), 0.0);
   for (const auto& s : hand.finger_neg) EXPECT_LT(s.origin.translation().y(), 0.0);
 }
@@ -201,5 +203,6 @@ TEST(RobotGrasps, APartWiderThanTheJawEverywhereHasNoGrasp) {
   const auto analysis = offline::analyze_part("cube", cube, 1.0);
   offline::RobotGraspSettings settings;
   settings.samples = 300;
-  EXPECT_TRUE(offline::plan_robot_grasps(cube, analysis, 1.0, *test::reference_cell(), settings).empty());
+  EXPECT_TRUE(
+      offline::plan_robot_grasps(cube, analysis, 1.0, *test::reference_cell(), settings).empty());
 }

@@ -1,8 +1,7 @@
-#include "hila/offline/suction_grasps.hpp"
-
 #include <gtest/gtest.h>
 
 #include "hila/core/mesh.hpp"
+#include "hila/offline/suction_grasps.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;

@@ -1,11 +1,11 @@
 // End-to-end tests of the `hila` command: real process, real files, exit codes and JSON.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <sys/wait.h>
 
 #include "util/test_util.hpp"
 
@@ -31,7 +31,9 @@ CommandRun run(const std::string& args) {
   return r;
 }
 
-std::string json_part(const std::string& out) { return out.substr(out.find('{')); }
+std::string json_part(const std::string& out) {
+  return out.substr(out.find('{'));
+}
 
 }  // namespace
 
@@ -59,7 +61,8 @@ TEST(Cli, CellCheckJsonReportsArmsHumanAndHome) {
   EXPECT_EQ(j["human_arms"][0]["dof"], 7);
   EXPECT_EQ(j["home_collision_free"], true);
   // The reach is the stretched arm: upper arm + forearm + 0.4 hand of a 1.722 m male.
-  EXPECT_NEAR(j["human_arms"][0]["reach"].get<double>(), (0.186 + 0.146 + 0.4 * 0.108) * 1.722, 2e-3);
+  EXPECT_NEAR(j["human_arms"][0]["reach"].get<double>(), (0.186 + 0.146 + 0.4 * 0.108) * 1.722,
+              2e-3);
 }
 
 TEST(Cli, CellCheckWithHomeInCollisionExitsOneAndNamesThePair) {
@@ -117,8 +120,8 @@ TEST(Cli, MeshBoxAndProductCheck) {
   EXPECT_FALSE(test::read_file(dir + "/b.stl").empty());
   EXPECT_NE(run("mesh box --size 100 -5 10 -o " + dir + "/c.stl").status, 0);
 
-  const CommandRun r = run("product check " + test::product_path() + " --cell " + test::cell_path() +
-                    " --json");
+  const CommandRun r =
+      run("product check " + test::product_path() + " --cell " + test::cell_path() + " --json");
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(json_part(r.out));
   EXPECT_EQ(j["parts"].size(), 7u);

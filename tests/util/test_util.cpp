@@ -11,8 +11,12 @@ namespace hila::test {
 std::string data_path(const std::string& relative) {
   return std::string(HILA_DATA_DIR) + "/" + relative;
 }
-std::string cell_path() { return data_path("cell/cell.yaml"); }
-std::string product_path() { return data_path("cabinet/product.yaml"); }
+std::string cell_path() {
+  return data_path("cell/cell.yaml");
+}
+std::string product_path() {
+  return data_path("cabinet/product.yaml");
+}
 
 std::shared_ptr<const core::Cell> reference_cell() {
   static const std::shared_ptr<const core::Cell> cell = core::Cell::load(cell_path());

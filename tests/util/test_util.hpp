@@ -14,8 +14,8 @@
 namespace hila::test {
 
 std::string data_path(const std::string& relative);  // under meshes/
-std::string cell_path();                               // meshes/cell/cell.yaml
-std::string product_path();                            // meshes/cabinet/product.yaml
+std::string cell_path();                             // meshes/cell/cell.yaml
+std::string product_path();                          // meshes/cabinet/product.yaml
 
 // The reference cell, loaded once per test binary.
 std::shared_ptr<const core::Cell> reference_cell();

@@ -1,7 +1,8 @@
+#include <unistd.h>
+
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
-#include <unistd.h>
 
 #include "commands.hpp"
 #include "hila/offline/build.hpp"
@@ -53,8 +54,11 @@ void add_build_command(CLI::App& app, Action& action) {
   build->add_option("product", opt->product_file, "product YAML file")->required();
   build->add_option("-o,--output", opt->output, "database file to write (atomically)")->required();
   build->add_option("--cell", opt->cell_file, "cell YAML file")->capture_default_str();
-  build->add_option("--seed", opt->seed, "random seed (same seed, same content)")->capture_default_str();
-  build->add_option("--jobs", opt->jobs, "worker threads over parts")->capture_default_str()->check(CLI::PositiveNumber);
+  build->add_option("--seed", opt->seed, "random seed (same seed, same content)")
+      ->capture_default_str();
+  build->add_option("--jobs", opt->jobs, "worker threads over parts")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   build->callback([opt, &action] { action = [opt] { return run_build(*opt); }; });
 }
 

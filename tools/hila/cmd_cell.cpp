@@ -80,15 +80,17 @@ int run_cell_check(const CellCheckOptions& opt) {
         {"analytic_ik", arm.ur_ik.has_value()},
         {"joint_limits_deg", limits},
         {"home_deg", vec_json(arm.spec.home, 180.0 / core::kPi, 3)},
-        {"home_tcp", {{"xyz", vec_json(tcp.translation())},
-                      {"rpy_deg", vec_json(core::matrix_to_rpy(tcp.linear()), 180.0 / core::kPi, 3)}}},
+        {"home_tcp",
+         {{"xyz", vec_json(tcp.translation())},
+          {"rpy_deg", vec_json(core::matrix_to_rpy(tcp.linear()), 180.0 / core::kPi, 3)}}},
     });
   }
   report["human_arms"] = nlohmann::json::array();
   for (const core::HumanArm& arm : cell->human_arms()) {
-    report["human_arms"].push_back({{"name", arm.spec.name},
-                                    {"dof", arm.chain.dof()},
-                                    {"reach", std::round(human_arm_reach(*cell, arm) * 1e4) / 1e4}});
+    report["human_arms"].push_back(
+        {{"name", arm.spec.name},
+         {"dof", arm.chain.dof()},
+         {"reach", std::round(human_arm_reach(*cell, arm) * 1e4) / 1e4}});
   }
   report["home_collision_free"] = !colliding;
   report["home_colliding_pair"] =

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -5,8 +6,6 @@
 #include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
-
-#include <cmath>
 
 namespace hila::tools {
 
@@ -18,7 +17,9 @@ struct InspectOptions {
   bool json = false;
 };
 
-double round_to(double v, double unit) { return std::round(v / unit) * unit; }
+double round_to(double v, double unit) {
+  return std::round(v / unit) * unit;
+}
 
 nlohmann::json summary_json(const db::Database& database) {
   nlohmann::json out;
@@ -59,18 +60,27 @@ nlohmann::json grasps_json(const db::Database& database, const std::string& part
   const auto& part = database.part(part_name);
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& g : database.robot_grasps(part.id)) {
-    rows.push_back({{"id", g.id}, {"kind", "robot"}, {"width", round_to(g.jaw_width, 1e-6)},
-                    {"quality", round_to(g.quality, 1e-4)}, {"theta_c_deg", g.theta_c_deg},
+    rows.push_back({{"id", g.id},
+                    {"kind", "robot"},
+                    {"width", round_to(g.jaw_width, 1e-6)},
+                    {"quality", round_to(g.quality, 1e-4)},
+                    {"theta_c_deg", g.theta_c_deg},
                     {"lever", round_to(g.lever, 1e-6)}});
   }
   for (const auto& g : database.suction_grasps(part.id)) {
-    rows.push_back({{"id", g.id}, {"kind", "suction"}, {"width", nullptr},
-                    {"quality", round_to(g.moment_margin, 1e-4)}, {"theta_c_deg", nullptr},
+    rows.push_back({{"id", g.id},
+                    {"kind", "suction"},
+                    {"width", nullptr},
+                    {"quality", round_to(g.moment_margin, 1e-4)},
+                    {"theta_c_deg", nullptr},
                     {"rotation_deg", g.rotation_deg}});
   }
   for (const auto& g : database.human_grasps(part.id)) {
-    rows.push_back({{"id", g.id}, {"kind", "human"}, {"width", round_to(g.aperture, 1e-6)},
-                    {"quality", round_to(g.quality, 1e-4)}, {"theta_c_deg", nullptr},
+    rows.push_back({{"id", g.id},
+                    {"kind", "human"},
+                    {"width", round_to(g.aperture, 1e-6)},
+                    {"quality", round_to(g.quality, 1e-4)},
+                    {"theta_c_deg", nullptr},
                     {"one_hand_stable", g.one_hand_stable}});
   }
   return {{"part", part_name}, {"grasps", rows}};
@@ -99,8 +109,8 @@ int run_inspect(const InspectOptions& opt) {
     std::cout << "grasps of " << opt.part << " (" << j["grasps"].size() << ")\n";
     std::cout << "      id  kind      width m  quality  theta_c deg\n";
     for (const auto& g : j["grasps"]) {
-      std::cout << std::setw(8) << g["id"].get<std::int64_t>() << "  " << std::left
-                << std::setw(8) << g["kind"].get<std::string>() << std::right;
+      std::cout << std::setw(8) << g["id"].get<std::int64_t>() << "  " << std::left << std::setw(8)
+                << g["kind"].get<std::string>() << std::right;
       if (g["width"].is_null()) {
         std::cout << std::setw(9) << "-";
       } else {
@@ -117,7 +127,8 @@ int run_inspect(const InspectOptions& opt) {
     return 0;
   }
   if (opt.what != "summary") {
-    throw core::InputError("command line", "what", "summary, grasps or digest", "'" + opt.what + "'");
+    throw core::InputError("command line", "what", "summary, grasps or digest",
+                           "'" + opt.what + "'");
   }
   const auto j = summary_json(database);
   if (opt.json) {
@@ -147,7 +158,8 @@ void add_inspect_command(CLI::App& app, Action& action) {
   auto opt = std::make_shared<InspectOptions>();
   auto* inspect = app.add_subcommand("inspect", "Show what a product database holds");
   inspect->add_option("database", opt->database, "database file")->required();
-  inspect->add_option("what", opt->what, "summary (default), grasps or digest")->capture_default_str();
+  inspect->add_option("what", opt->what, "summary (default), grasps or digest")
+      ->capture_default_str();
   inspect->add_option("--part", opt->part, "part name (for grasps)");
   inspect->add_flag("--json", opt->json, "print JSON");
   inspect->callback([opt, &action] { action = [opt] { return run_inspect(*opt); }; });

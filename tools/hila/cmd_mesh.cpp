@@ -35,7 +35,8 @@ void add_mesh_command(CLI::App& app, Action& action) {
   auto* mesh = app.add_subcommand("mesh", "Write simple part meshes");
   mesh->require_subcommand(1);
   auto opt = std::make_shared<MeshBoxOptions>();
-  auto* box = mesh->add_subcommand("box", "A box centred at the origin (x length, y width, z thickness)");
+  auto* box =
+      mesh->add_subcommand("box", "A box centred at the origin (x length, y width, z thickness)");
   box->add_option("--size", opt->size, "x y z side lengths")->expected(3)->required();
   box->add_option("--unit", opt->unit, "unit of the sizes and the file (m, cm, mm, in)")
       ->capture_default_str();

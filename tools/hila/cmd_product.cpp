@@ -103,7 +103,11 @@ void add_product_command(CLI::App& app, Action& action) {
   check->callback([opt, &action] { action = [opt] { return run_product_check(*opt); }; });
 }
 
-std::string default_cell_path() { return HILA_DATA_DIR "/cell/cell.yaml"; }
-std::string default_product_path() { return HILA_DATA_DIR "/cabinet/product.yaml"; }
+std::string default_cell_path() {
+  return HILA_DATA_DIR "/cell/cell.yaml";
+}
+std::string default_product_path() {
+  return HILA_DATA_DIR "/cabinet/product.yaml";
+}
 
 }  // namespace hila::tools

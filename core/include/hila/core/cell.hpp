@@ -16,13 +16,13 @@
 namespace hila::core {
 
 struct PadSpec {
-  double friction = 0.5;          // Coulomb coefficient pad/part
-  double elastic_modulus = 1e6;   // Pa (Winkler foundation K)
-  double thickness = 0.003;       // m, elastic layer depth h
-  double radius_1 = 0.05;         // m, principal relative radii R', R''
+  double friction = 0.5;         // Coulomb coefficient pad/part
+  double elastic_modulus = 1e6;  // Pa (Winkler foundation K)
+  double thickness = 0.003;      // m, elastic layer depth h
+  double radius_1 = 0.05;        // m, principal relative radii R', R''
   double radius_2 = 0.05;
-  double width = 0.022;           // m, contact patch extent across the finger
-  double length = 0.037;          // m, along the approach
+  double width = 0.022;   // m, contact patch extent across the finger
+  double length = 0.037;  // m, along the approach
 };
 
 struct GripperSpec {
@@ -47,8 +47,8 @@ struct SuctionSpec {
   std::string cup_link;     // suction face, z out of the cup
   double handle_width = 0.03;
   double cup_radius = 0.02;
-  double max_force = 40.0;   // N, pull-off force with safety factor
-  double max_moment = 0.8;   // N·m
+  double max_force = 40.0;  // N, pull-off force with safety factor
+  double max_moment = 0.8;  // N·m
 };
 
 struct ArmSpec {

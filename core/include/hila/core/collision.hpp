@@ -74,8 +74,7 @@ struct CollisionPair {
 // Any collision between enabled bodies, except static-static and allowed pairs. Broad-phase
 // (FCL dynamic AABB trees) over the static and the moving bodies. Stops at the first contact and
 // reports its pair.
-bool in_collision(const CollisionModel& model, CollisionData& data,
-                  CollisionPair* first = nullptr);
+bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPair* first = nullptr);
 // Collisions involving at least one of `bodies` (against every other enabled body, static or
 // moving, and among themselves). This is the planner's query when one arm (with what it holds)
 // moves and the rest of the scene is unchanged; it needs no broad-phase tree update for the

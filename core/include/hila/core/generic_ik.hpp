@@ -10,12 +10,12 @@
 namespace hila::core {
 
 struct GenericIkSettings {
-  int max_iterations = 150;        // per attempt
-  int max_attempts = 20;           // the seed first, then random restarts inside the limits
+  int max_iterations = 150;              // per attempt
+  int max_attempts = 20;                 // the seed first, then random restarts inside the limits
   double position_tolerance = 1e-10;     // m
   double orientation_tolerance = 1e-10;  // rad
-  double damping = 1e-6;           // added to the LM lambda (keeps steps bounded near singularities)
-  bool position_only = false;      // ignore orientation (reaching tasks)
+  double damping = 1e-6;       // added to the LM lambda (keeps steps bounded near singularities)
+  bool position_only = false;  // ignore orientation (reaching tasks)
 };
 
 struct GenericIkResult {

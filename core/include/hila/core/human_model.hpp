@@ -15,14 +15,14 @@ struct HumanBodySpec {
 // Segment lengths from stature by standard anthropometric ratios (Drillis & Contini; DESIGN §4).
 struct HumanDimensions {
   double stature = 0.0;
-  double hip_height = 0.0;       // 0.530 H
-  double shoulder_height = 0.0;  // 0.818 H
+  double hip_height = 0.0;           // 0.530 H
+  double shoulder_height = 0.0;      // 0.818 H
   double shoulder_half_width = 0.0;  // biacromial / 2: 0.245 H male, 0.230 H female
-  double upper_arm = 0.0;        // 0.186 H
-  double forearm = 0.0;          // 0.146 H
-  double hand = 0.0;             // 0.108 H
-  double chest_depth = 0.0;      // 0.130 H
-  double head_radius = 0.0;      // 0.060 H
+  double upper_arm = 0.0;            // 0.186 H
+  double forearm = 0.0;              // 0.146 H
+  double hand = 0.0;                 // 0.108 H
+  double chest_depth = 0.0;          // 0.130 H
+  double head_radius = 0.0;          // 0.060 H
 };
 
 // Throws InputError (field "stature") outside the adult range 1.30–2.20 m.

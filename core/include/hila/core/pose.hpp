@@ -24,7 +24,11 @@ void check_pose(const Pose& pose, const std::string& file, const std::string& fi
 double rotation_distance(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double deg_to_rad(double deg) { return deg * kPi / 180.0; }
-constexpr double rad_to_deg(double rad) { return rad * 180.0 / kPi; }
+constexpr double deg_to_rad(double deg) {
+  return deg * kPi / 180.0;
+}
+constexpr double rad_to_deg(double rad) {
+  return rad * 180.0 / kPi;
+}
 
 }  // namespace hila::core

@@ -10,21 +10,21 @@ namespace hila::core {
 
 struct PartSpec {
   std::string name;
-  std::string mesh_file;   // resolved path
-  double unit_scale = 1.0; // metres per mesh unit
-  double mass = 0.0;       // kg
+  std::string mesh_file;            // resolved path
+  double unit_scale = 1.0;          // metres per mesh unit
+  double mass = 0.0;                // kg
   Pose target = Pose::Identity();   // in the assembly frame
   Pose initial = Pose::Identity();  // nominal pose on the table, world frame
-  int order = 0;           // 1-based assembly order
-  TriangleMesh mesh;       // loaded, in metres, part frame
+  int order = 0;                    // 1-based assembly order
+  TriangleMesh mesh;                // loaded, in metres, part frame
 };
 
 struct ProductSpec {
   std::string file;
   std::string name;
-  Pose assembly_frame = Pose::Identity();  // world
+  Pose assembly_frame = Pose::Identity();     // world
   Pose suction_tool_pose = Pose::Identity();  // world, the tool's handle frame
-  std::vector<PartSpec> parts;  // sorted by assembly order
+  std::vector<PartSpec> parts;                // sorted by assembly order
 
   const PartSpec& part(const std::string& name) const;  // throws InputError
   Pose target_in_world(const PartSpec& part) const { return assembly_frame * part.target; }

@@ -16,7 +16,7 @@ struct GeometrySpec {
   Type type = Type::Box;
   Eigen::Vector3d box_size = Eigen::Vector3d::Zero();
   double radius = 0.0;
-  double length = 0.0;  // cylinder, along its local z, centred
+  double length = 0.0;    // cylinder, along its local z, centred
   std::string mesh_path;  // resolved, absolute or relative to the working directory
   Eigen::Vector3d mesh_scale = Eigen::Vector3d::Ones();
   Pose origin = Pose::Identity();  // in the link frame
@@ -39,8 +39,8 @@ struct Joint {
   double lower = 0.0;
   double upper = 0.0;
   double velocity_limit = 0.0;
-  int variable = -1;       // index into the configuration vector, -1 when fixed or mimic
-  int mimic_joint = -1;    // joint whose value this one copies
+  int variable = -1;     // index into the configuration vector, -1 when fixed or mimic
+  int mimic_joint = -1;  // joint whose value this one copies
   double mimic_multiplier = 1.0;
   double mimic_offset = 0.0;
 };

@@ -8,11 +8,11 @@ namespace hila::core {
 //   f_t^2 + tau_n^2 / e_n^2 <= mu^2 P^2,
 // f_t the tangential force and tau_n the torque about the contact normal it must transmit.
 struct SoftFingerPad {
-  double friction = 0.8;          // mu
-  double elastic_modulus = 1e6;   // K, Pa
-  double thickness = 0.003;       // h, m (elastic layer depth)
-  double radius_1 = 0.05;         // R', m
-  double radius_2 = 0.05;         // R'', m
+  double friction = 0.8;         // mu
+  double elastic_modulus = 1e6;  // K, Pa
+  double thickness = 0.003;      // h, m (elastic layer depth)
+  double radius_1 = 0.05;        // R', m
+  double radius_2 = 0.05;        // R'', m
 };
 
 // Eccentricity e_n of the Winkler elastic foundation (Johnson, Contact Mechanics §5.9):

@@ -45,7 +45,7 @@ class UrIk {
 
  private:
   UrDhParameters dh_;
-  Pose tool_;       // TCP in the DH flange frame
+  Pose tool_;  // TCP in the DH flange frame
   Pose tool_inv_;
   Vector6d lower_;
   Vector6d upper_;

@@ -1,12 +1,13 @@
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Core>
 #include <initializer_list>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-#include <yaml-cpp/yaml.h>
 
 #include "hila/core/pose.hpp"
 

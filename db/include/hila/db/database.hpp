@@ -41,7 +41,7 @@ class DatabaseWriter {
   // Record ids are assigned by the database (1, 2, ... in call order); the records' own id and
   // part_id fields are ignored. An empty meta.created_at is filled with the current UTC time.
   // After any failed call the writer refuses to commit (the temporary file is discarded).
-  void write_meta(const Meta& meta);  // schema_version is set by the writer
+  void write_meta(const Meta& meta);              // schema_version is set by the writer
   std::int64_t add_part(const PartRecord& part);  // returns the part id
   void add_placements(std::int64_t part_id, const std::vector<PlacementRecord>& placements);
   void add_robot_grasps(std::int64_t part_id, const std::vector<RobotGraspRecord>& grasps);

@@ -13,8 +13,8 @@ namespace hila::db {
 // Stored as columns (x, y, z, qw, qx, qy, qz) so they read well in the sqlite3 shell.
 
 struct MassProperties {
-  double volume = 0.0;                     // m^3
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();  // part frame
+  double volume = 0.0;                                // m^3
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();      // part frame
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  // about the CoM, part frame, kg m^2
 };
 
@@ -22,22 +22,23 @@ struct PartRecord {
   std::int64_t id = 0;  // assigned by the database
   std::string name;
   int assembly_order = 0;
-  std::string mesh_file;         // as given in the product file
-  std::string mesh_hash;         // SHA-256 of the mesh as loaded (vertices and triangles, metres)
+  std::string mesh_file;  // as given in the product file
+  std::string mesh_hash;  // SHA-256 of the mesh as loaded (vertices and triangles, metres)
   double mass = 0.0;
   MassProperties mass_properties;
   Eigen::Vector3d extent = Eigen::Vector3d::Zero();  // bounding box size, part frame
   int triangle_count = 0;
-  core::Pose target = core::Pose::Identity();        // world (assembly frame applied)
-  core::Pose initial = core::Pose::Identity();       // world
+  core::Pose target = core::Pose::Identity();   // world (assembly frame applied)
+  core::Pose initial = core::Pose::Identity();  // world
 };
 
 // A stable placement of the part resting on a horizontal plane (kept for later use).
 struct PlacementRecord {
   std::int64_t id = 0;
   std::int64_t part_id = 0;
-  core::Pose part_in_plane = core::Pose::Identity();  // part frame in a plane frame (z up, plane z=0)
-  double stability = 0.0;  // distance of the CoM projection to the support polygon's edge, m
+  core::Pose part_in_plane =
+      core::Pose::Identity();  // part frame in a plane frame (z up, plane z=0)
+  double stability = 0.0;      // distance of the CoM projection to the support polygon's edge, m
 };
 
 struct RobotGraspRecord {
@@ -49,10 +50,10 @@ struct RobotGraspRecord {
   Eigen::Vector3d normal_1 = Eigen::Vector3d::Zero();  // outward surface normal
   Eigen::Vector3d contact_2 = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal_2 = Eigen::Vector3d::Zero();
-  double quality = 0.0;                     // in [0, 1], higher is better
-  double friction_torque_capacity = 0.0;    // N m, both fingers
-  double lever = 0.0;                       // distance of the CoM from the grasp axis, m
-  double theta_c_deg = 90.0;                // relaxation limit (90 = no constraint)
+  double quality = 0.0;                   // in [0, 1], higher is better
+  double friction_torque_capacity = 0.0;  // N m, both fingers
+  double lever = 0.0;                     // distance of the CoM from the grasp axis, m
+  double theta_c_deg = 90.0;              // relaxation limit (90 = no constraint)
 };
 
 struct SuctionGraspRecord {
@@ -84,7 +85,7 @@ struct Meta {
   std::string product_hash;   // SHA-256 hex of the product file and its meshes
   std::string settings_hash;  // SHA-256 hex of the build settings
   std::uint64_t seed = 0;
-  std::string created_at;     // ISO 8601 UTC; excluded from the content digest
+  std::string created_at;  // ISO 8601 UTC; excluded from the content digest
   std::string cell_file;
   std::string product_file;
 };

@@ -32,6 +32,7 @@ struct ComfortResult {
 // `seed_joints` and from seeded random restarts inside the joint limits, keeping the solution with
 // the highest Q. The redundancy is searched by the restarts, not analytically.
 ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& hand_in_base,
-                           const Eigen::VectorXd& seed_joints, const ComfortSettings& settings = {});
+                           const Eigen::VectorXd& seed_joints,
+                           const ComfortSettings& settings = {});
 
 }  // namespace hila::offline

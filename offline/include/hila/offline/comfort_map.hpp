@@ -15,12 +15,13 @@ namespace hila::offline {
 std::vector<Eigen::Quaterniond> spread_orientations(int count);
 
 // Index of the rotation of `set` closest to `rotation` (largest |<q, q_i>|).
-int nearest_orientation(const std::vector<Eigen::Quaterniond>& set, const Eigen::Quaterniond& rotation);
+int nearest_orientation(const std::vector<Eigen::Quaterniond>& set,
+                        const Eigen::Quaterniond& rotation);
 
 struct ComfortMapSettings {
-  double spacing = 0.03;    // m between grid nodes (issue: at most 3 cm)
-  int orientations = 128;   // hand orientations per node (issue: at least 100)
-  long samples = 3'000'000; // forward-kinematics samples of the arm's joint space
+  double spacing = 0.03;     // m between grid nodes (issue: at most 3 cm)
+  int orientations = 128;    // hand orientations per node (issue: at least 100)
+  long samples = 3'000'000;  // forward-kinematics samples of the arm's joint space
   std::uint64_t seed = 1;
 };
 

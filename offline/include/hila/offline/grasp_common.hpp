@@ -16,17 +16,17 @@ namespace hila::offline {
 struct ContactPair {
   SurfacePoint first;
   SurfacePoint second;
-  double width = 0.0;               // |p2 - p1|
-  double alignment = 0.0;           // cos of the angle between -n2 and the p2 -> p1 direction
+  double width = 0.0;      // |p2 - p1|
+  double alignment = 0.0;  // cos of the angle between -n2 and the p2 -> p1 direction
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();  // unit, p1 -> p2
 };
 
 struct AntipodalSettings {
-  int samples = 1500;          // surface points tried as first contacts
-  double friction = 0.5;       // mu of the contact: the friction cone half-angle is atan(mu)
-  double min_width = 0.0;      // m
-  double max_width = 0.08;     // m (jaw maximum minus the opening margin)
+  int samples = 1500;       // surface points tried as first contacts
+  double friction = 0.5;    // mu of the contact: the friction cone half-angle is atan(mu)
+  double min_width = 0.0;   // m
+  double max_width = 0.08;  // m (jaw maximum minus the opening margin)
   std::uint64_t seed = 1;
 };
 
@@ -44,7 +44,7 @@ std::vector<core::Pose> grasp_frames_about_axis(const ContactPair& pair, int cou
 // A hand (gripper or human) as three collision bodies in its grasp frame: the fixed part (palm,
 // sensor), and two fingers that move to +-opening/2 along y.
 struct HandGeometry {
-  std::vector<core::GeometrySpec> fixed;     // origins in the grasp frame
+  std::vector<core::GeometrySpec> fixed;       // origins in the grasp frame
   std::vector<core::GeometrySpec> finger_pos;  // at opening 0, moving along +y
   std::vector<core::GeometrySpec> finger_neg;  // at opening 0, moving along -y
 };
@@ -97,6 +97,7 @@ double axis_lever(const Eigen::Vector3d& com, const Eigen::Vector3d& point_on_ax
 // Near-duplicate removal: keeps, in the given order, each pose farther than `distance` (m) or
 // `angle` (rad) from every kept pose; a rotation by pi about z (a symmetric hand) counts as the
 // same pose. Returns the kept indices.
-std::vector<int> distinct_poses(const std::vector<core::Pose>& poses, double distance, double angle);
+std::vector<int> distinct_poses(const std::vector<core::Pose>& poses, double distance,
+                                double angle);
 
 }  // namespace hila::offline

@@ -15,7 +15,7 @@ struct PlanarFacet {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // area-weighted
   double offset = 0.0;                                 // plane: normal . x = offset
   double area = 0.0;
-  std::vector<int> triangles;                          // indices into the mesh
+  std::vector<int> triangles;  // indices into the mesh
   // The facet's boundary polygon(s) are implied by its triangles; inside() tests use them.
 };
 
@@ -49,7 +49,8 @@ struct PartAnalysis {
 // stability is that distance to the facet edge; part_in_plane puts the facet on z = 0 (outward
 // normal along -z, part above) with the CoM above the plane origin; sorted by decreasing
 // stability (ties: facet order).
-PartAnalysis analyze_part(const std::string& part_name, const core::TriangleMesh& mesh, double mass);
+PartAnalysis analyze_part(const std::string& part_name, const core::TriangleMesh& mesh,
+                          double mass);
 
 // Is `point` (on the facet's plane, part frame) inside the facet with at least `margin` to its
 // boundary? (For placing a suction cup of radius `margin`.) The point is projected onto the

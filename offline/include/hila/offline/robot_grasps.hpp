@@ -11,11 +11,11 @@
 namespace hila::offline {
 
 struct RobotGraspSettings {
-  int samples = 1500;              // surface samples tried as first contacts
-  int approach_rotations = 12;     // approach directions about each grasp axis (30 degrees)
-  double opening_margin = 0.005;   // m, the jaw opens to width + margin before closing
-  double merge_distance = 0.01;    // m, near-duplicate TCP positions
-  double merge_angle_deg = 20.0;   // and orientations
+  int samples = 1500;             // surface samples tried as first contacts
+  int approach_rotations = 12;    // approach directions about each grasp axis (30 degrees)
+  double opening_margin = 0.005;  // m, the jaw opens to width + margin before closing
+  double merge_distance = 0.01;   // m, near-duplicate TCP positions
+  double merge_angle_deg = 20.0;  // and orientations
   std::uint64_t seed = 1;
 };
 

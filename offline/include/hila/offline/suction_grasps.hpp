@@ -9,8 +9,8 @@
 namespace hila::offline {
 
 struct SuctionSettings {
-  int rotations = 12;             // tool rotations about the face normal (30 degrees)
-  double min_area_fraction = 0.2; // a "large" flat face has at least this share of the largest
+  int rotations = 12;              // tool rotations about the face normal (30 degrees)
+  double min_area_fraction = 0.2;  // a "large" flat face has at least this share of the largest
 };
 
 // Suction grasps (paper §VI-A): the cup at the centre of mass projected onto each large flat
