@@ -196,7 +196,7 @@ void check_schema_version(const std::string& path, int stored, int expected, boo
   if (stored < expected) {
     throw DatabaseError(
         path, "meta.schema_version", wanted, written + " (an older hila)",
-        rebuild + (can_migrate ? ", or migrate it in place (hila::db::migrate_in_place)" : ""));
+        rebuild + (can_migrate ? " (or migrate it in place with hila::db::migrate_in_place)" : ""));
   }
   throw DatabaseError(path, "meta.schema_version", wanted, written + " (a newer hila)",
                       "upgrade hila, or " + rebuild);

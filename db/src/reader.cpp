@@ -1,10 +1,13 @@
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <optional>
 
+#include "comfort_codec.hpp"
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
 #include "open_checks.hpp"
@@ -96,6 +99,81 @@ Meta parse_meta(const std::string& path, const std::map<std::string, std::string
     throw DatabaseError(path, "meta.seed", "an unsigned 64-bit integer", "'" + seed + "'", fix);
   }
   return meta;
+}
+
+// The comfort_maps table. Every size is checked against the others before anything is trusted: a
+// damaged row is a DatabaseError, never a map whose lookups read out of bounds.
+std::vector<ComfortMapRecord> load_comfort_maps(detail::Connection& connection,
+                                                const std::string& path, const std::string& fix) {
+  detail::Statement select(connection,
+                           "SELECT id, arm, " + vector_columns("origin") +
+                               ", spacing, dim_x, dim_y, dim_z, orientation_count, orientations, "
+                               "value_bytes, values_deflate, samples, seed, coverage "
+                               "FROM comfort_maps ORDER BY id",
+                           {"comfort_maps", "a readable hila table", fix});
+  std::vector<ComfortMapRecord> maps;
+  while (select.step()) {
+    ComfortMapRecord map;
+    const std::int64_t id = select.next_int64();
+    map.arm = select.next_text();
+    const std::string row = "(arm '" + map.arm + "', id " + std::to_string(id) + ")";
+    const auto corrupt = [&](const std::string& column, const std::string& expected,
+                             const std::string& got) {
+      return DatabaseError(path, "comfort_maps." + column + " " + row, expected, got, fix);
+    };
+    map.origin = read_vector(select);
+    map.spacing = select.next_double();
+    if (!map.origin.allFinite()) throw corrupt("origin", "finite values", "something else");
+    if (!(map.spacing > 0.0) || !std::isfinite(map.spacing)) {
+      throw corrupt("spacing", "a finite value > 0", std::to_string(map.spacing));
+    }
+    std::int64_t dims[3];
+    for (std::int64_t& d : dims) d = select.next_int64();
+    for (int i = 0; i < 3; ++i) {
+      if (dims[i] <= 0 || dims[i] > std::numeric_limits<int>::max()) {
+        throw corrupt("dim_x/y/z", "node counts > 0",
+                      std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+                          std::to_string(dims[2]));
+      }
+      map.dims[i] = static_cast<int>(dims[i]);
+    }
+    const std::int64_t orientation_count = select.next_int64();
+    const std::string orientation_bytes = select.next_blob();
+    if (!detail::decode_orientations(orientation_bytes, orientation_count, map.orientations)) {
+      throw corrupt("orientations",
+                    "orientation_count = " + std::to_string(orientation_count) +
+                        " orientations (32 bytes each)",
+                    std::to_string(orientation_bytes.size()) + " bytes");
+    }
+    for (std::size_t o = 0; o < map.orientations.size(); ++o) {
+      const double norm = map.orientations[o].coeffs().norm();
+      if (!(std::abs(norm - 1.0) <= detail::kUnitQuaternionTolerance)) {
+        throw corrupt("orientations", "unit quaternions",
+                      "orientation " + std::to_string(o) + " of norm " + std::to_string(norm));
+      }
+    }
+    const std::int64_t value_bytes = select.next_int64();
+    const std::int64_t count =
+        detail::comfort_value_count(dims[0], dims[1], dims[2], orientation_count);
+    if (count < 0 || value_bytes != count) {
+      throw corrupt("value_bytes",
+                    "dim_x * dim_y * dim_z * orientation_count = " + std::to_string(count),
+                    std::to_string(value_bytes));
+    }
+    const std::string compressed = select.next_blob();
+    const std::string problem = detail::inflate_values(compressed, value_bytes, map.values);
+    if (!problem.empty()) {
+      throw corrupt("values_deflate",
+                    "zlib-compressed values that inflate to value_bytes = " +
+                        std::to_string(value_bytes) + " bytes",
+                    problem);
+    }
+    map.samples = select.next_int64();
+    map.seed = static_cast<std::uint64_t>(select.next_int64());
+    map.coverage = select.next_double();
+    maps.push_back(std::move(map));
+  }
+  return maps;
 }
 
 template <typename Record>
@@ -201,6 +279,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.quality = s.next_double();
         r.one_hand_stable = s.next_int64() != 0;
       });
+  db.comfort_maps_ = load_comfort_maps(*connection, path, fix);
   return db;
 }
 
@@ -214,6 +293,18 @@ const PartRecord& Database::part(const std::string& name) const {
       path_, "parts",
       "a part named '" + name + "' (parts: " + (known.empty() ? std::string("none") : known) + ")",
       "no such part");
+}
+
+const ComfortMapRecord& Database::comfort_map(const std::string& arm) const {
+  for (const auto& map : comfort_maps_) {
+    if (map.arm == arm) return map;
+  }
+  std::string known;
+  for (const auto& map : comfort_maps_) known += (known.empty() ? "" : ", ") + map.arm;
+  throw core::InputError(path_, "comfort_maps",
+                         "a comfort map for arm '" + arm +
+                             "' (arms: " + (known.empty() ? std::string("none") : known) + ")",
+                         "no such arm");
 }
 
 std::vector<PlacementRecord> Database::placements(std::int64_t part_id) const {

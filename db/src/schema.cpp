@@ -7,12 +7,42 @@ namespace hila::db {
 
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 1;
+  return 2;
 }
 
 namespace detail {
 
-// Written out in full (not generated) so this file is the readable reference of the schema.
+namespace {
+
+// The comfort_maps table as schema version 2 defines it. Both the current schema and the 1 -> 2
+// migration step create it from this text. If a later version changes the table, write the new
+// definition into schema_sql() and leave this one to the 1 -> 2 step (a step must keep producing
+// the version it upgrades to).
+//
+// values_deflate is zlib (compress2, level 6) of value_bytes bytes, one per bin, Q * 255, bin
+// ((x * dim_y + y) * dim_z + z) * orientation_count + o; orientations holds orientation_count
+// quaternions as little-endian doubles w, x, y, z; seed is the uint64 seed's bit pattern.
+constexpr const char* kCreateComfortMapsV2 = R"sql(
+CREATE TABLE comfort_maps (
+  id INTEGER PRIMARY KEY,
+  arm TEXT UNIQUE NOT NULL,
+  origin_x REAL NOT NULL, origin_y REAL NOT NULL, origin_z REAL NOT NULL,
+  spacing REAL NOT NULL,
+  dim_x INTEGER NOT NULL, dim_y INTEGER NOT NULL, dim_z INTEGER NOT NULL,
+  orientation_count INTEGER NOT NULL,
+  orientations BLOB NOT NULL,
+  value_bytes INTEGER NOT NULL,
+  values_deflate BLOB NOT NULL,
+  samples INTEGER NOT NULL,
+  seed INTEGER NOT NULL,
+  coverage REAL NOT NULL
+);
+)sql";
+
+}  // namespace
+
+// Written out in full (not generated) so this file is the readable reference of the schema (the
+// comfort_maps table is kCreateComfortMapsV2 above).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
@@ -92,14 +122,18 @@ CREATE TABLE human_grasps (
   one_hand_stable INTEGER NOT NULL CHECK (one_hand_stable IN (0, 1))
 );
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
-)sql";
+)sql" + std::string(kCreateComfortMapsV2);
   return sql;
 }
 
-// Upgrades from older schema versions, oldest first. Schema version 1 is the first release, so
-// there is nothing to upgrade from yet. A step's SQL runs inside the migration's transaction.
+// Upgrades from older schema versions, oldest first. Schema version 1 is the first release. A
+// step's SQL runs inside the migration's transaction; the framework updates schema_version.
 const std::vector<MigrationStep>& migration_steps() {
-  static const std::vector<MigrationStep> steps = {};
+  static const std::vector<MigrationStep> steps = {
+      // 1 -> 2: human comfort maps (a new table; the old tables are unchanged, and a migrated file
+      // has no maps until it is rebuilt).
+      {1, kCreateComfortMapsV2},
+  };
   return steps;
 }
 

@@ -8,9 +8,19 @@ namespace hila::db::detail {
 // CREATE statements of the current schema (tables and indexes; meta rows are the writer's job).
 const std::string& schema_sql();
 
-// Every table in a fixed order: the content digest hashes them in this order.
-inline constexpr std::array<const char*, 6> kTables = {
-    "meta", "parts", "placements", "robot_grasps", "suction_grasps", "human_grasps"};
+// Every table in a fixed order: the content digest hashes them in this order (those the file's
+// schema version has).
+struct TableInfo {
+  const char* name;
+  int since_version;  // the schema version that added the table
+};
+inline constexpr std::array<TableInfo, 7> kTables = {{{"meta", 1},
+                                                      {"parts", 1},
+                                                      {"placements", 1},
+                                                      {"robot_grasps", 1},
+                                                      {"suction_grasps", 1},
+                                                      {"human_grasps", 1},
+                                                      {"comfort_maps", 2}}};
 
 // The meta keys every database carries.
 inline constexpr std::array<const char*, 10> kMetaKeys = {

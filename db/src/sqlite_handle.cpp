@@ -82,6 +82,14 @@ void Statement::bind_next(const std::string& value) {
   }
 }
 
+void Statement::bind_blob(const std::string& bytes) {
+  // data() is never null, so an empty string binds an empty blob (a null pointer would be NULL).
+  if (sqlite3_bind_blob64(stmt_, bind_index_++, bytes.data(), bytes.size(), SQLITE_TRANSIENT) !=
+      SQLITE_OK) {
+    fail();
+  }
+}
+
 bool Statement::step() {
   read_column_ = 0;
   const int rc = sqlite3_step(stmt_);

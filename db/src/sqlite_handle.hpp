@@ -53,6 +53,7 @@ class Statement {
   void bind_next(double value);
   void bind_next(std::int64_t value);
   void bind_next(const std::string& value);
+  void bind_blob(const std::string& bytes);  // a BLOB (bind_next binds a string as TEXT)
 
   // Steps once: true if a row is available. Throws DatabaseError on failure.
   bool step();
@@ -72,6 +73,7 @@ class Statement {
   double next_double() { return column_double(read_column_++); }
   std::int64_t next_int64() { return column_int64(read_column_++); }
   std::string next_text() { return column_text(read_column_++); }
+  std::string next_blob() { return column_blob(read_column_++); }
 
   // Changes the error context, e.g. to name the part being written.
   void set_context(ErrorContext context) { context_ = std::move(context); }

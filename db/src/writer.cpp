@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "atomic_file.hpp"
+#include "comfort_codec.hpp"
 #include "hila/db/database.hpp"
 #include "pose_codec.hpp"
 #include "schema.hpp"
@@ -47,7 +48,7 @@ struct DatabaseWriter::Impl {
   std::unique_ptr<detail::Connection> connection;
   // Prepared once, reused for every row; destroyed before the connection closes.
   std::optional<detail::Statement> insert_meta, insert_part, insert_placement, insert_robot,
-      insert_suction, insert_human;
+      insert_suction, insert_human, insert_comfort;
   bool meta_written = false;
   bool committed = false;
   std::string failure;  // the first error: a writer that failed never commits
@@ -86,6 +87,7 @@ struct DatabaseWriter::Impl {
     insert_robot.reset();
     insert_suction.reset();
     insert_human.reset();
+    insert_comfort.reset();
   }
 };
 
@@ -142,6 +144,13 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
                                        vector_columns("contact_1") + ", " +
                                        vector_columns("contact_2") + ", quality, one_hand_stable"),
         m.context("human_grasps"));
+    m.insert_comfort.emplace(
+        *m.connection,
+        insert_sql("comfort_maps", "arm, " + vector_columns("origin") +
+                                       ", spacing, dim_x, dim_y, dim_z, orientation_count, "
+                                       "orientations, value_bytes, values_deflate, samples, seed, "
+                                       "coverage"),
+        m.context("comfort_maps"));
   } catch (...) {
     m.finalize_statements();
     m.connection.reset();
@@ -283,6 +292,27 @@ void DatabaseWriter::add_human_grasps(std::int64_t part_id,
       s.bind_next(static_cast<std::int64_t>(g.one_hand_stable ? 1 : 0));
       s.run();
     }
+  });
+}
+
+void DatabaseWriter::add_comfort_map(const ComfortMapRecord& map) {
+  Impl& m = *impl_;
+  m.guarded("add_comfort_map", [&] {
+    detail::validate_comfort_map(map);
+    detail::Statement& s = *m.insert_comfort;
+    s.set_context(m.context("comfort_maps (arm '" + map.arm + "')"));
+    s.bind_next(map.arm);
+    bind_vector(s, map.origin);
+    s.bind_next(map.spacing);
+    for (int i = 0; i < 3; ++i) s.bind_next(static_cast<std::int64_t>(map.dims[i]));
+    s.bind_next(static_cast<std::int64_t>(map.orientations.size()));
+    s.bind_blob(detail::encode_orientations(map.orientations));
+    s.bind_next(static_cast<std::int64_t>(map.values.size()));
+    s.bind_blob(detail::deflate_values(map.values));
+    s.bind_next(map.samples);
+    s.bind_next(static_cast<std::int64_t>(map.seed));  // the bit pattern: SQLite has no uint64
+    s.bind_next(map.coverage);
+    s.run();
   });
 }
 

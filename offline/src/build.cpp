@@ -155,7 +155,8 @@ std::string settings_hash(const BuildSettings& s) {
        << s.robot.opening_margin << ' ' << s.robot.merge_distance << ' ' << s.robot.merge_angle_deg
        << "\nsuction " << s.suction.rotations << ' ' << s.suction.min_area_fraction << "\nhuman "
        << s.human.samples << ' ' << s.human.approach_rotations << ' ' << s.human.opening_margin
-       << ' ' << s.human.merge_distance << ' ' << s.human.merge_angle_deg << '\n';
+       << ' ' << s.human.merge_distance << ' ' << s.human.merge_angle_deg << "\ncomfort "
+       << s.comfort.spacing << ' ' << s.comfort.orientations << ' ' << s.comfort.samples << '\n';
   return db::sha256_hex(text.str());
 }
 
@@ -172,30 +173,54 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   // Open the writer first: an unwritable destination fails before minutes of work.
   db::DatabaseWriter writer(output_path);
 
+  // One task per part and one per human arm's comfort map, shared by the workers; results go to
+  // fixed slots, so the content does not depend on which thread ran what.
   const std::size_t n = product.parts.size();
+  const std::size_t arms = cell->human_arms().size();
+  const std::size_t tasks = n + arms;
   std::vector<PartResult> results(n);
-  std::vector<std::exception_ptr> errors(n);
+  std::vector<ComfortMap> maps(arms);
+  std::vector<ComfortMapSummary> map_summaries(arms);
+  std::vector<std::exception_ptr> errors(tasks);
   std::atomic<std::size_t> next{0};
   std::mutex progress_mutex;
   int done = 0;
   auto worker = [&] {
-    for (std::size_t i = next++; i < n; i = next++) {
+    // Comfort maps are the longest tasks: start them first.
+    for (std::size_t t = next++; t < tasks; t = next++) {
+      const bool is_map = t < arms;
+      std::string label;
       try {
-        results[i] = build_part(product, i, *cell, settings);
+        if (is_map) {
+          const auto start_map = std::chrono::steady_clock::now();
+          const core::HumanArm& arm = cell->human_arms()[t];
+          label = "comfort map, " + arm.spec.name + " arm";
+          ComfortMapSettings comfort = settings.comfort;
+          comfort.seed = part_seed(settings.seed, "comfort:" + arm.spec.name, 3);
+          maps[t] = ComfortMap::build(arm.chain, comfort);
+          auto& s = map_summaries[t];
+          s.arm = arm.spec.name;
+          for (const auto v : maps[t].values()) s.filled_bins += v > 0 ? 1 : 0;
+          s.coverage = maps[t].coverage();
+          s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_map).count();
+        } else {
+          label = product.parts[t - arms].name;
+          results[t - arms] = build_part(product, t - arms, *cell, settings);
+        }
       } catch (...) {
-        errors[i] = std::current_exception();
+        errors[is_map ? n + t : t - arms] = std::current_exception();
       }
       std::lock_guard<std::mutex> lock(progress_mutex);
       ++done;
-      if (progress) progress(product.parts[i].name, done, static_cast<int>(n));
+      if (progress) progress(label, done, static_cast<int>(tasks));
     }
   };
-  const int threads = std::min<int>(settings.jobs, static_cast<int>(n));
+  const int threads = std::min<int>(settings.jobs, static_cast<int>(tasks));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
-  // The first failing part in assembly order, whatever thread hit it first.
+  // The first failing part in assembly order (then the maps), whatever thread hit it first.
   for (const auto& e : errors) {
     if (e) std::rethrow_exception(e);
   }
@@ -221,6 +246,12 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     writer.add_human_grasps(id, r.human);
     summary.parts.push_back(r.summary);
   }
+  for (std::size_t a = 0; a < arms; ++a) {
+    ComfortMapSettings comfort = settings.comfort;
+    comfort.seed = part_seed(settings.seed, "comfort:" + cell->human_arms()[a].spec.name, 3);
+    writer.add_comfort_map(maps[a].to_record(cell->human_arms()[a].spec.name, comfort));
+  }
+  summary.comfort_maps = map_summaries;
   writer.commit();
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;

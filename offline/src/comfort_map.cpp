@@ -102,6 +102,32 @@ double ComfortMap::lookup(const core::Pose& hand) const {
   return value;
 }
 
+ComfortMap ComfortMap::from_record(const db::ComfortMapRecord& record) {
+  ComfortMap map;
+  map.origin_ = record.origin;
+  map.spacing_ = record.spacing;
+  map.dims_ = record.dims;
+  map.orientations_ = record.orientations;
+  map.values_ = record.values;
+  map.coverage_ = record.coverage;
+  return map;
+}
+
+db::ComfortMapRecord ComfortMap::to_record(const std::string& arm,
+                                           const ComfortMapSettings& settings) const {
+  db::ComfortMapRecord record;
+  record.arm = arm;
+  record.origin = origin_;
+  record.spacing = spacing_;
+  record.dims = dims_;
+  record.orientations = orientations_;
+  record.values = values_;
+  record.samples = settings.samples;
+  record.seed = settings.seed;
+  record.coverage = coverage_;
+  return record;
+}
+
 ComfortMap ComfortMap::build(const core::KinematicChain& arm, const ComfortMapSettings& settings) {
   ComfortMap map;
   map.spacing_ = settings.spacing;

@@ -26,6 +26,7 @@ struct SamplePart {
 struct Sample {
   Meta meta;
   std::vector<SamplePart> parts;
+  std::vector<ComfortMapRecord> comfort_maps;
 };
 
 inline Eigen::Vector3d random_vector(std::mt19937_64& rng, double scale) {
@@ -33,8 +34,35 @@ inline Eigen::Vector3d random_vector(std::mt19937_64& rng, double scale) {
   return {u(rng), u(rng), u(rng)};
 }
 
+inline Eigen::Quaterniond random_orientation(std::mt19937_64& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  return Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized();
+}
+
+// A comfort map with random values, `zero_share` of them 0 (as the bins the arm never reaches),
+// the others anywhere in 1..255.
+inline ComfortMapRecord make_comfort_map(const std::string& arm, std::uint64_t seed,
+                                         const Eigen::Vector3i& dims, int orientation_count,
+                                         double zero_share = 0.9) {
+  std::mt19937_64 rng(seed);
+  ComfortMapRecord map;
+  map.arm = arm;
+  map.origin = random_vector(rng, 1.0);
+  map.spacing = 0.03;
+  map.dims = dims;
+  for (int o = 0; o < orientation_count; ++o) map.orientations.push_back(random_orientation(rng));
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::uniform_int_distribution<int> value(1, 255);
+  map.values.resize(static_cast<std::size_t>(dims.prod()) * map.orientations.size());
+  for (auto& v : map.values) v = u(rng) < zero_share ? 0 : static_cast<std::uint8_t>(value(rng));
+  map.samples = 2000000;
+  map.seed = seed | (std::uint64_t{1} << 63);  // beyond SQLite's signed integers
+  map.coverage = 0.25 + 1e-17;
+  return map;
+}
+
 // Two parts with different record counts (part 2 has no suction grasps), values that are
-// negative, tiny, huge, subnormal and infinite, and a non-ASCII part name.
+// negative, tiny, huge, subnormal and infinite, a non-ASCII part name, and two comfort maps.
 inline Sample make_sample(std::uint64_t seed = 7) {
   std::mt19937_64 rng(seed);
   Sample s;
@@ -109,10 +137,14 @@ inline Sample make_sample(std::uint64_t seed = 7) {
     }
     s.parts.push_back(p);
   }
+  // Two small comfort maps of different shapes (the values' size is what the writer checks).
+  s.comfort_maps.push_back(make_comfort_map("right", seed + 1, {4, 3, 2}, 10));
+  s.comfort_maps.push_back(make_comfort_map("left", seed + 2, {2, 5, 3}, 7, 0.5));
   return s;
 }
 
-// Writes `sample` to `path` through DatabaseWriter and returns the part ids in order.
+// Writes `sample` to `path` through DatabaseWriter (parts, then comfort maps) and returns the part
+// ids in order.
 inline std::vector<std::int64_t> write_sample(const std::string& path, const Sample& sample) {
   DatabaseWriter writer(path);
   writer.write_meta(sample.meta);
@@ -125,6 +157,7 @@ inline std::vector<std::int64_t> write_sample(const std::string& path, const Sam
     writer.add_human_grasps(id, p.human_grasps);
     ids.push_back(id);
   }
+  for (const auto& map : sample.comfort_maps) writer.add_comfort_map(map);
   writer.commit();
   return ids;
 }

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -64,11 +65,40 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
     s.parts[0].suction_grasps.clear();
   });
   add("part order", [](Sample& s) { std::swap(s.parts[0], s.parts[1]); });
+  add("comfort map order", [](Sample& s) { std::swap(s.comfort_maps[0], s.comfort_maps[1]); });
+  add("a comfort map less", [](Sample& s) { s.comfort_maps.pop_back(); });
+  add("comfort map seed", [](Sample& s) { s.comfort_maps[0].seed += 1; });
+  add("comfort orientation", [](Sample& s) {
+    auto& q = s.comfort_maps[1].orientations[6];
+    q.w() = std::nextafter(q.w(), 2.0);
+  });
+  add("comfort map arm name", [](Sample& s) { s.comfort_maps[1].arm = "Left"; });
   for (const auto& [name, sample] : variants) {
     const std::string path = dir + "/variant.db";
     write_sample(path, sample);
     EXPECT_NE(content_digest(path), reference) << name;
   }
+}
+
+TEST(Digest, OneComfortValueByteChangesIt) {
+  const std::string dir = temp_dir("db_digest_comfort_value");
+  Sample a = make_sample();
+  Sample b = make_sample();
+  // A bin in the middle, and one that was 0 (the common case: a bin the arm never reached).
+  std::uint8_t& v = b.comfort_maps[0].values[117];
+  v = static_cast<std::uint8_t>(v + 1);
+  write_sample(dir + "/a.db", a);
+  write_sample(dir + "/b.db", b);
+  EXPECT_NE(content_digest(dir + "/a.db"), content_digest(dir + "/b.db"));
+  Sample c = make_sample();
+  auto& values = c.comfort_maps[1].values;
+  const auto zero = std::find(values.begin(), values.end(), 0);
+  ASSERT_NE(zero, values.end());
+  *zero = 1;
+  write_sample(dir + "/c.db", c);
+  EXPECT_NE(content_digest(dir + "/a.db"), content_digest(dir + "/c.db"));
+  write_sample(dir + "/d.db", make_sample());
+  EXPECT_EQ(content_digest(dir + "/a.db"), content_digest(dir + "/d.db"));
 }
 
 TEST(Digest, IndependentOfTheFileName) {

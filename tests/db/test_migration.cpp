@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "hila/db/database.hpp"
@@ -15,11 +16,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A "version 0" database: what schema 1 would look like if robot_grasps had no theta_c_deg yet.
+// A "version 0" database: what schema 1 would look like if robot_grasps had no theta_c_deg yet
+// (and, as in schema 1, there were no comfort maps).
 std::string write_v0(const std::string& dir) {
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
   execute_script(path,
+                 "DROP TABLE comfort_maps;"
                  "ALTER TABLE robot_grasps DROP COLUMN theta_c_deg;"
                  "UPDATE meta SET value = '0' WHERE key = 'schema_version';");
   return path;
@@ -29,6 +32,13 @@ std::string write_v0(const std::string& dir) {
 const std::vector<MigrationStep> kSteps = {
     {0, "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"}};
 
+// kSteps followed by the real steps (1 -> 2, ...): a version 0 file to the current version.
+std::vector<MigrationStep> steps_from_v0() {
+  std::vector<MigrationStep> steps = kSteps;
+  steps.insert(steps.end(), migration_steps().begin(), migration_steps().end());
+  return steps;
+}
+
 std::vector<std::string> files_in(const std::string& dir) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
@@ -36,17 +46,231 @@ std::vector<std::string> files_in(const std::string& dir) {
   return names;
 }
 
+// Schema version 1 exactly as hila 0.1 (schema 1) wrote it, frozen here: the migration from 1 must
+// keep working on such files whatever the current schema looks like.
+const char* const kSchemaV1 = R"sql(
+CREATE TABLE meta (
+  key TEXT PRIMARY KEY,
+  value TEXT NOT NULL
+);
+
+CREATE TABLE parts (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL UNIQUE,
+  assembly_order INTEGER NOT NULL,
+  mesh_file TEXT NOT NULL,
+  mesh_hash TEXT NOT NULL,
+  mass REAL NOT NULL,
+  volume REAL NOT NULL,
+  com_x REAL NOT NULL, com_y REAL NOT NULL, com_z REAL NOT NULL,
+  ixx REAL NOT NULL, iyy REAL NOT NULL, izz REAL NOT NULL,
+  ixy REAL NOT NULL, ixz REAL NOT NULL, iyz REAL NOT NULL,
+  extent_x REAL NOT NULL, extent_y REAL NOT NULL, extent_z REAL NOT NULL,
+  triangle_count INTEGER NOT NULL,
+  target_x REAL NOT NULL, target_y REAL NOT NULL, target_z REAL NOT NULL,
+  target_qw REAL NOT NULL, target_qx REAL NOT NULL, target_qy REAL NOT NULL,
+  target_qz REAL NOT NULL,
+  initial_x REAL NOT NULL, initial_y REAL NOT NULL, initial_z REAL NOT NULL,
+  initial_qw REAL NOT NULL, initial_qx REAL NOT NULL, initial_qy REAL NOT NULL,
+  initial_qz REAL NOT NULL
+);
+
+CREATE TABLE placements (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  part_in_plane_x REAL NOT NULL, part_in_plane_y REAL NOT NULL, part_in_plane_z REAL NOT NULL,
+  part_in_plane_qw REAL NOT NULL, part_in_plane_qx REAL NOT NULL,
+  part_in_plane_qy REAL NOT NULL, part_in_plane_qz REAL NOT NULL,
+  stability REAL NOT NULL
+);
+CREATE INDEX placements_part_id ON placements(part_id);
+
+CREATE TABLE robot_grasps (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  tcp_x REAL NOT NULL, tcp_y REAL NOT NULL, tcp_z REAL NOT NULL,
+  tcp_qw REAL NOT NULL, tcp_qx REAL NOT NULL, tcp_qy REAL NOT NULL, tcp_qz REAL NOT NULL,
+  jaw_width REAL NOT NULL,
+  contact_1_x REAL NOT NULL, contact_1_y REAL NOT NULL, contact_1_z REAL NOT NULL,
+  normal_1_x REAL NOT NULL, normal_1_y REAL NOT NULL, normal_1_z REAL NOT NULL,
+  contact_2_x REAL NOT NULL, contact_2_y REAL NOT NULL, contact_2_z REAL NOT NULL,
+  normal_2_x REAL NOT NULL, normal_2_y REAL NOT NULL, normal_2_z REAL NOT NULL,
+  quality REAL NOT NULL,
+  friction_torque_capacity REAL NOT NULL,
+  lever REAL NOT NULL,
+  theta_c_deg REAL NOT NULL
+);
+CREATE INDEX robot_grasps_part_id ON robot_grasps(part_id);
+
+CREATE TABLE suction_grasps (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  cup_x REAL NOT NULL, cup_y REAL NOT NULL, cup_z REAL NOT NULL,
+  cup_qw REAL NOT NULL, cup_qx REAL NOT NULL, cup_qy REAL NOT NULL, cup_qz REAL NOT NULL,
+  rotation_deg REAL NOT NULL,
+  force_margin REAL NOT NULL,
+  moment_margin REAL NOT NULL
+);
+CREATE INDEX suction_grasps_part_id ON suction_grasps(part_id);
+
+CREATE TABLE human_grasps (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  hand_x REAL NOT NULL, hand_y REAL NOT NULL, hand_z REAL NOT NULL,
+  hand_qw REAL NOT NULL, hand_qx REAL NOT NULL, hand_qy REAL NOT NULL, hand_qz REAL NOT NULL,
+  aperture REAL NOT NULL,
+  contact_1_x REAL NOT NULL, contact_1_y REAL NOT NULL, contact_1_z REAL NOT NULL,
+  contact_2_x REAL NOT NULL, contact_2_y REAL NOT NULL, contact_2_z REAL NOT NULL,
+  quality REAL NOT NULL,
+  one_hand_stable INTEGER NOT NULL CHECK (one_hand_stable IN (0, 1))
+);
+CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
+)sql";
+
+// A version 1 file made by hand (no DatabaseWriter involved): meta, one part with a placement and
+// one grasp of each kind. Values are exact in binary so the writer would store the same bits.
+std::string write_v1(const std::string& dir) {
+  const std::string path = dir + "/v1.db";
+  execute_script(path, std::string(kSchemaV1) + R"sql(
+INSERT INTO meta (key, value) VALUES
+  ('schema_version', '1'), ('hila_version', '0.1.0'), ('product_name', 'cabinet'),
+  ('cell_hash', 'cccc'), ('product_hash', 'aaaa'), ('settings_hash', '5555'),
+  ('seed', '18446744073709551615'), ('created_at', '2024-06-11T10:00:00Z'),
+  ('cell_file', 'cell.yaml'), ('product_file', 'product.yaml');
+INSERT INTO parts VALUES (1, 'bracket', 3, 'bracket.stl', 'eeee', 0.5, 0.25,
+  0.125, 0.0, -0.5,  1.0, 2.0, 3.0, 0.5, 0.25, 0.125,  0.5, 0.25, 0.125,  12,
+  1.0, 2.0, 3.0, 1.0, 0.0, 0.0, 0.0,  0.5, -0.5, 0.0, 1.0, 0.0, 0.0, 0.0);
+INSERT INTO placements VALUES (1, 1, 0.0, 0.0, 0.0625, 1.0, 0.0, 0.0, 0.0, 0.03125);
+INSERT INTO robot_grasps VALUES (1, 1, 0.0, 0.0, 0.25, 1.0, 0.0, 0.0, 0.0, 0.5,
+  0.25, 0.0, 0.0, 1.0, 0.0, 0.0, -0.25, 0.0, 0.0, -1.0, 0.0, 0.0, 0.75, 2.0, 0.125, 45.0);
+INSERT INTO suction_grasps VALUES (1, 1, 0.0, 0.125, 0.0, 1.0, 0.0, 0.0, 0.0, -90.0, 4.5, 0.5);
+INSERT INTO human_grasps VALUES (1, 1, 0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0, 0.0625,
+  0.03125, 0.0, 0.0, -0.03125, 0.0, 0.0, 0.5, 1);
+)sql");
+  return path;
+}
+
+// The same content written by this hila's DatabaseWriter (schema 2, no comfort maps).
+void write_v1_content_as_v2(const std::string& path) {
+  Meta meta;
+  meta.hila_version = "0.1.0";
+  meta.product_name = "cabinet";
+  meta.cell_hash = "cccc";
+  meta.product_hash = "aaaa";
+  meta.settings_hash = "5555";
+  meta.seed = 18446744073709551615ull;
+  meta.created_at = "2031-01-01T00:00:00Z";  // ignored by the digest
+  meta.cell_file = "cell.yaml";
+  meta.product_file = "product.yaml";
+  PartRecord part;
+  part.name = "bracket";
+  part.assembly_order = 3;
+  part.mesh_file = "bracket.stl";
+  part.mesh_hash = "eeee";
+  part.mass = 0.5;
+  part.mass_properties.volume = 0.25;
+  part.mass_properties.com = {0.125, 0.0, -0.5};
+  part.mass_properties.inertia << 1.0, 0.5, 0.25, 0.5, 2.0, 0.125, 0.25, 0.125, 3.0;
+  part.extent = {0.5, 0.25, 0.125};
+  part.triangle_count = 12;
+  part.target.translation() = Eigen::Vector3d(1.0, 2.0, 3.0);
+  part.initial.translation() = Eigen::Vector3d(0.5, -0.5, 0.0);
+  PlacementRecord placement;
+  placement.part_in_plane.translation() = Eigen::Vector3d(0.0, 0.0, 0.0625);
+  placement.stability = 0.03125;
+  RobotGraspRecord robot;
+  robot.tcp.translation() = Eigen::Vector3d(0.0, 0.0, 0.25);
+  robot.jaw_width = 0.5;
+  robot.contact_1 = {0.25, 0.0, 0.0};
+  robot.normal_1 = {1.0, 0.0, 0.0};
+  robot.contact_2 = {-0.25, 0.0, 0.0};
+  robot.normal_2 = {-1.0, 0.0, 0.0};
+  robot.quality = 0.75;
+  robot.friction_torque_capacity = 2.0;
+  robot.lever = 0.125;
+  robot.theta_c_deg = 45.0;
+  SuctionGraspRecord suction;
+  suction.cup.translation() = Eigen::Vector3d(0.0, 0.125, 0.0);
+  suction.rotation_deg = -90.0;
+  suction.force_margin = 4.5;
+  suction.moment_margin = 0.5;
+  HumanGraspRecord human;
+  human.hand.translation() = Eigen::Vector3d(0.0, 0.0, 0.5);
+  human.aperture = 0.0625;
+  human.contact_1 = {0.03125, 0.0, 0.0};
+  human.contact_2 = {-0.03125, 0.0, 0.0};
+  human.quality = 0.5;
+  human.one_hand_stable = true;
+
+  DatabaseWriter writer(path);
+  writer.write_meta(meta);
+  const auto id = writer.add_part(part);
+  writer.add_placements(id, {placement});
+  writer.add_robot_grasps(id, {robot});
+  writer.add_suction_grasps(id, {suction});
+  writer.add_human_grasps(id, {human});
+  writer.commit();
+}
+
 }  // namespace
 
-TEST(Migration, SyntheticStepUpgradesAVersion0Database) {
+TEST(Migration, Version1FileIsUpgradedToVersion2) {
+  const std::string dir = temp_dir("db_migration_v1");
+  const std::string path = write_v1(dir);
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta.schema_version", "written by schema version 1 (an older hila)",
+                      "rebuild with: hila build product.yaml -o " + path,
+                      "(or migrate it in place with hila::db::migrate_in_place)"});
+  const std::string digest_v1 = content_digest(path);  // an old file still has a digest
+
+  migrate_in_place(path);
+
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 2);
+  EXPECT_EQ(db.meta().product_name, "cabinet");
+  EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
+  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+  ASSERT_EQ(db.parts().size(), 1u);
+  const PartRecord& part = db.part("bracket");
+  EXPECT_EQ(part.id, 1);
+  EXPECT_EQ(part.assembly_order, 3);
+  EXPECT_EQ(part.mass_properties.inertia(1, 2), 0.125);
+  EXPECT_EQ(part.target.translation(), Eigen::Vector3d(1.0, 2.0, 3.0));
+  EXPECT_EQ(db.placements(1).size(), 1u);
+  ASSERT_EQ(db.robot_grasps(1).size(), 1u);
+  EXPECT_EQ(db.robot_grasps(1)[0].theta_c_deg, 45.0);
+  EXPECT_EQ(db.robot_grasps(1)[0].normal_2, Eigen::Vector3d(-1.0, 0.0, 0.0));
+  ASSERT_EQ(db.suction_grasps(1).size(), 1u);
+  EXPECT_EQ(db.suction_grasps(1)[0].force_margin, 4.5);
+  ASSERT_EQ(db.human_grasps(1).size(), 1u);
+  EXPECT_TRUE(db.human_grasps(1)[0].one_hand_stable);
+  EXPECT_TRUE(db.comfort_maps().empty()) << "a migrated file has no maps until it is rebuilt";
+  expect_input_error([&] { db.comfort_map("right"); },
+                     {path + ": comfort_maps", "a comfort map for arm 'right' (arms: none)"});
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"v1.db"}) << "no temporary copy left";
+
+  // The migrated file holds exactly what this hila writes for the same records: same tables,
+  // columns, types and values.
+  const std::string fresh = dir + "/fresh.db";
+  write_v1_content_as_v2(fresh);
+  EXPECT_EQ(content_digest(path), content_digest(fresh));
+  EXPECT_NE(content_digest(path), digest_v1);
+
+  // Migrating again is a no-op.
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after);
+}
+
+TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   const std::string dir = temp_dir("db_migration_v0");
   const std::string path = write_v0(dir);
   expect_input_error([&] { Database::open(path); }, {"written by schema version 0"});
 
-  migrate_with_steps(path, kSteps, 1);
+  migrate_with_steps(path, steps_from_v0(), current_schema_version());
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 1);
+  EXPECT_EQ(db.meta().schema_version, 2);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -56,25 +280,29 @@ TEST(Migration, SyntheticStepUpgradesAVersion0Database) {
     EXPECT_EQ(grasps[i].theta_c_deg, 90.0) << "the step's default";
     EXPECT_EQ(grasps[i].quality, sample.parts[0].robot_grasps[i].quality) << "data kept";
   }
+  EXPECT_TRUE(db.comfort_maps().empty());
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"}) << "no temporary copy left";
 }
 
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 1 -> 2 needs the table step 0 -> 1 creates; listed first to prove ordering.
-  const std::vector<MigrationStep> steps = {
-      {1, "INSERT INTO notes (text) VALUES ('from step 1');"},
-      {0,
-       "CREATE TABLE notes (text TEXT NOT NULL);"
-       "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"}};
-  EXPECT_TRUE(can_migrate(steps, 0, 2));
-  migrate_with_steps(path, steps, 2);
-  // The file is now version 2: this hila (1) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 2"});
-  // Migrating to 2 again is a no-op (already there).
+  // Step 2 -> 3 needs the table step 0 -> 1 creates and the one step 1 -> 2 creates; listed
+  // first to prove ordering.
+  std::vector<MigrationStep> steps = {{2,
+                                       "INSERT INTO notes (text) VALUES ('from step 2');"
+                                       "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"}};
+  steps.push_back(migration_steps().at(0));
+  steps.push_back({0,
+                   "CREATE TABLE notes (text TEXT NOT NULL);"
+                   "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
+  EXPECT_TRUE(can_migrate(steps, 0, 3));
+  migrate_with_steps(path, steps, 3);
+  // The file is now version 3: this hila (2) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 3"});
+  // Migrating to 3 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 2);
+  migrate_with_steps(path, steps, 3);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -98,12 +326,26 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
   const std::string before = read_file(path);
   EXPECT_FALSE(can_migrate({}, 0, 1));
   EXPECT_FALSE(can_migrate(kSteps, 0, 2));
-  // The real step list of schema 1 is empty: there is nothing to migrate from 0.
+  // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },
       {path + ": meta.schema_version", "schema version 0, for which there is no migration",
        "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
   expect_input_error([&] { migrate_with_steps(path, kSteps, 2); }, {"no migration"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
+}
+
+TEST(Migration, Version1FileThatAlreadyHasTheTableFailsCleanly) {
+  // A damaged "version 1" file (version 2 content, version number set back): the step's CREATE
+  // TABLE fails and the file is left as it was.
+  const std::string dir = temp_dir("db_migration_v1_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '1' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 1 -> 2", "table comfort_maps already exists"});
   EXPECT_EQ(read_file(path), before);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }

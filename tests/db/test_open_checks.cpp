@@ -119,14 +119,14 @@ TEST(OpenChecks, CorruptPageInTheMiddle) {
                         "rebuild with: hila build"});
 }
 
-TEST(OpenChecks, OlderSchemaVersion) {
+TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   const std::string path = write_small(temp_dir("db_open_older"));
   detail::execute_script(path, "UPDATE meta SET value = '0' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "this hila reads (schema version 1)",
+                     {path + ": meta.schema_version", "this hila reads (schema version 2)",
                       "written by schema version 0 (an older hila)",
                       "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
-  // Schema 1 has no migration steps, so the message must not offer one.
+  // There is no step from version 0, so the message must not offer one.
   try {
     Database::open(path);
   } catch (const DatabaseError& e) {
@@ -134,17 +134,32 @@ TEST(OpenChecks, OlderSchemaVersion) {
   }
 }
 
+TEST(OpenChecks, Version1OffersMigration) {
+  const std::string path = write_small(temp_dir("db_open_v1"));
+  detail::execute_script(path,
+                         "DROP TABLE comfort_maps;"
+                         "UPDATE meta SET value = '1' WHERE key = 'schema_version'");
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 2), "
+       "got one written by schema version 1 (an older hila); rebuild with: hila build "
+       "meshes/cabinet/product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+}
+
 TEST(OpenChecks, NewerSchemaVersion) {
   const std::string path = write_small(temp_dir("db_open_newer"));
-  detail::execute_script(path, "UPDATE meta SET value = '2' WHERE key = 'schema_version'");
+  detail::execute_script(path, "UPDATE meta SET value = '3' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "written by schema version 2 (a newer hila)",
+                     {path + ": meta.schema_version", "written by schema version 3 (a newer hila)",
                       "upgrade hila, or rebuild with: hila build"});
 }
 
 TEST(OpenChecks, OlderVersionWithAMigrationPathSaysSo) {
   expect_input_error([] { detail::check_schema_version("p.db", 0, 1, true, "rebuild with: X"); },
-                     {"p.db: meta.schema_version", "rebuild with: X, or migrate it in place"});
+                     {"p.db: meta.schema_version",
+                      "rebuild with: X (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_NO_THROW(detail::check_schema_version("p.db", 3, 3, false, ""));
 }
 
@@ -182,6 +197,105 @@ TEST(OpenChecks, DamagedQuaternion) {
   detail::execute_script(path, "UPDATE robot_grasps SET tcp_qw = 0.5 WHERE id = 2");
   expect_input_error([&] { Database::open(path); },
                      {path + ": robot_grasps.tcp (id 2)", "a unit quaternion"});
+}
+
+TEST(OpenChecks, CorruptComfortValues) {
+  const std::string dir = temp_dir("db_open_comfort_deflate");
+  const std::string path = write_small(dir);
+  const std::string pristine = read_file(path);
+  const auto reset = [&] { write_bytes(path, pristine); };
+  const std::string field = path + ": comfort_maps.values_deflate (arm 'right', id 1)";
+
+  // Four bytes in the middle of the zlib stream overwritten (zlib's checksum sees any change).
+  detail::execute_script(
+      path,
+      "UPDATE comfort_maps SET values_deflate = CAST(substr(values_deflate, 1, 8) || "
+      "x'a5a5a5a5' || substr(values_deflate, 13) AS BLOB) WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); },
+                     {field,
+                      "expected zlib-compressed values that inflate to value_bytes = 240 "
+                      "bytes, got data that is not a valid zlib stream",
+                      "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
+  expect_input_error([&] { content_digest(path); }, {path, "comfort_maps.values_deflate"});
+  reset();
+  // Cut short.
+  detail::execute_script(
+      path,
+      "UPDATE comfort_maps SET values_deflate = "
+      "substr(values_deflate, 1, length(values_deflate) - 6) WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); }, {field, "a cut-off zlib stream"});
+  reset();
+  // Not zlib at all.
+  detail::execute_script(
+      path, "UPDATE comfort_maps SET values_deflate = x'0102030405' WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); },
+                     {field, "not a valid zlib stream (incorrect header check)"});
+  reset();
+  // A valid stream followed by garbage.
+  detail::execute_script(
+      path,
+      "UPDATE comfort_maps SET values_deflate = CAST(values_deflate || x'00' AS BLOB) "
+      "WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); }, {field, "followed by extra bytes"});
+  reset();
+  // The streams of the two maps (240 and 210 bytes) swapped.
+  detail::execute_script(path,
+                         "UPDATE comfort_maps SET values_deflate = (SELECT values_deflate FROM "
+                         "comfort_maps WHERE arm = 'left') WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); }, {field, "got a zlib stream of 210 bytes"});
+  reset();
+  detail::execute_script(path,
+                         "UPDATE comfort_maps SET values_deflate = (SELECT values_deflate FROM "
+                         "comfort_maps WHERE arm = 'right') WHERE arm = 'left'");
+  expect_input_error([&] { Database::open(path); },
+                     {"comfort_maps.values_deflate (arm 'left', id 2)",
+                      "got a zlib stream of more than 210 bytes"});
+  reset();
+  EXPECT_NO_THROW(Database::open(path));
+}
+
+TEST(OpenChecks, InconsistentComfortMapSizes) {
+  const std::string dir = temp_dir("db_open_comfort_sizes");
+  const std::string path = write_small(dir);
+  const std::string pristine = read_file(path);
+  const auto reset = [&] { write_bytes(path, pristine); };
+  const std::string row = "(arm 'right', id 1)";
+
+  // value_bytes must be dims * orientation_count: a changed dimension is seen before inflating.
+  detail::execute_script(path, "UPDATE comfort_maps SET dim_x = 5 WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": comfort_maps.value_bytes " + row,
+                      "expected dim_x * dim_y * dim_z * orientation_count = 300, got 240"});
+  reset();
+  detail::execute_script(path, "UPDATE comfort_maps SET dim_z = 0 WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); },
+                     {"comfort_maps.dim_x/y/z " + row, "node counts > 0", "4 x 3 x 0"});
+  reset();
+  // A huge value_bytes must not become a huge allocation.
+  detail::execute_script(path,
+                         "UPDATE comfort_maps SET dim_x = 100000, dim_y = 100000, "
+                         "value_bytes = 100000 * 100000 * 2 * 10 WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); },
+                     {"comfort_maps.values_deflate " + row, "too short to inflate"});
+  reset();
+  detail::execute_script(path,
+                         "UPDATE comfort_maps SET orientation_count = 11 WHERE arm = 'right'");
+  expect_input_error(
+      [&] { Database::open(path); },
+      {"comfort_maps.orientations " + row,
+       "expected orientation_count = 11 orientations (32 bytes each), got 320 bytes"});
+  reset();
+  // The first orientation's w set to 0: no longer a unit quaternion.
+  detail::execute_script(path,
+                         "UPDATE comfort_maps SET orientations = CAST(zeroblob(8) || "
+                         "substr(orientations, 9) AS BLOB) WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); },
+                     {"comfort_maps.orientations " + row, "unit quaternions", "orientation 0"});
+  reset();
+  detail::execute_script(path, "UPDATE comfort_maps SET spacing = -0.03 WHERE arm = 'right'");
+  expect_input_error([&] { Database::open(path); }, {"comfort_maps.spacing " + row, "> 0"});
+  reset();
+  EXPECT_NO_THROW(Database::open(path));
 }
 
 TEST(OpenChecks, OpeningChangesNothingOnDisk) {

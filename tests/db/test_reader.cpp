@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -149,6 +150,40 @@ TEST_F(ReaderRoundTrip, HumanGrasps) {
             db.human_grasps(ids_[0])[1].one_hand_stable);
 }
 
+TEST_F(ReaderRoundTrip, ComfortMapsInWriteOrder) {
+  const Database db = Database::open(path_);
+  ASSERT_EQ(db.comfort_maps().size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const ComfortMapRecord& got = db.comfort_maps()[k];
+    const ComfortMapRecord& want = sample_.comfort_maps[k];
+    SCOPED_TRACE(want.arm);
+    EXPECT_EQ(got.arm, want.arm);
+    EXPECT_EQ(got.origin, want.origin);
+    EXPECT_EQ(got.spacing, want.spacing);
+    EXPECT_EQ(got.dims, want.dims);
+    ASSERT_EQ(got.orientations.size(), want.orientations.size());
+    for (std::size_t o = 0; o < want.orientations.size(); ++o) {
+      EXPECT_EQ(got.orientations[o].coeffs(), want.orientations[o].coeffs()) << o;
+    }
+    EXPECT_EQ(got.values, want.values);
+    EXPECT_EQ(got.samples, want.samples);
+    EXPECT_EQ(got.seed, want.seed) << "a uint64 above 2^63 survives";
+    EXPECT_EQ(got.coverage, want.coverage);
+  }
+  EXPECT_EQ(db.comfort_maps()[0].arm, "right");
+  EXPECT_EQ(db.comfort_maps()[1].arm, "left");
+}
+
+TEST_F(ReaderRoundTrip, ComfortMapByArm) {
+  const Database db = Database::open(path_);
+  EXPECT_EQ(&db.comfort_map("left"), &db.comfort_maps()[1]);
+  EXPECT_EQ(db.comfort_map("right").dims, Eigen::Vector3i(4, 3, 2));
+  expect_input_error(
+      [&] { db.comfort_map("torso"); },
+      {path_ + ": comfort_maps", "expected a comfort map for arm 'torso' (arms: right, left)",
+       "got no such arm"});
+}
+
 TEST_F(ReaderRoundTrip, PerPartFilteringKeepsIdOrderAcrossInterleavedWrites) {
   // Records of two parts written alternately: ids interleave, each part's list stays ordered.
   const std::string path = temp_dir("db_reader_interleaved") + "/p.db";
@@ -222,6 +257,45 @@ TEST_F(ReaderRoundTrip, DatabaseIsAValueThatOutlivesTheFile) {
   EXPECT_EQ(copy.robot_grasps(ids_[0]).size(), sample_.parts[0].robot_grasps.size());
 }
 
+TEST(Reader, LargeComfortMapRoundTrip) {
+  // About the shape of a real map: 1000 orientations, 92 % zeros, ~4.5 MB of values.
+  const std::string dir = temp_dir("db_reader_comfort_large");
+  const std::string path = dir + "/p.db";
+  const ComfortMapRecord map = make_comfort_map("right", 11, {20, 16, 14}, 1000, 0.92);
+  ASSERT_EQ(map.values.size(), 4480000u);
+  {
+    DatabaseWriter writer(path);
+    writer.write_meta(make_sample().meta);
+    writer.add_comfort_map(map);
+    writer.commit();
+  }
+  const auto file_size = std::filesystem::file_size(path);
+  EXPECT_LT(file_size, map.values.size() / 2) << "the values are stored compressed";
+  RecordProperty("file_bytes", std::to_string(file_size));
+
+  const Database db = Database::open(path);
+  ASSERT_EQ(db.comfort_maps().size(), 1u);
+  const ComfortMapRecord& got = db.comfort_map("right");
+  EXPECT_EQ(got.dims, map.dims);
+  ASSERT_EQ(got.values.size(), map.values.size());
+  EXPECT_TRUE(got.values == map.values) << "every value byte";
+  ASSERT_EQ(got.orientations.size(), 1000u);
+  double worst = 0.0;
+  for (std::size_t o = 0; o < map.orientations.size(); ++o) {
+    worst = std::max(
+        worst, (got.orientations[o].coeffs() - map.orientations[o].coeffs()).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-15);
+  // The index convention: ((x * dims.y + y) * dims.z + z) * n_orient + o.
+  const auto at = [&](const ComfortMapRecord& m, int x, int y, int z, int o) {
+    return m.values[((static_cast<std::size_t>(x) * m.dims.y() + y) * m.dims.z() + z) *
+                        m.orientations.size() +
+                    o];
+  };
+  EXPECT_EQ(at(got, 19, 15, 13, 999), map.values.back());
+  EXPECT_EQ(at(got, 7, 3, 11, 500), at(map, 7, 3, 11, 500));
+}
+
 TEST(Reader, EmptyDatabaseOpens) {
   const std::string path = temp_dir("db_reader_empty") + "/p.db";
   {
@@ -231,6 +305,7 @@ TEST(Reader, EmptyDatabaseOpens) {
   }
   const Database db = Database::open(path);
   EXPECT_TRUE(db.parts().empty());
+  EXPECT_TRUE(db.comfort_maps().empty());
   EXPECT_EQ(db.meta().seed, 0u);
   expect_input_error([&] { db.part("x"); }, {"parts: none"});
 }

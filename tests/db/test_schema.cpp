@@ -22,9 +22,15 @@ std::string schema_only_database(const std::string& name) {
 
 }  // namespace
 
-TEST(Schema, VersionIsOneAndHasNoMigrationsYet) {
-  EXPECT_EQ(current_schema_version(), 1);
-  EXPECT_TRUE(migration_steps().empty());
+TEST(Schema, VersionIsTwoWithTheStepFromOne) {
+  EXPECT_EQ(current_schema_version(), 2);
+  ASSERT_EQ(migration_steps().size(), 1u);
+  EXPECT_EQ(migration_steps()[0].from_version, 1);
+  EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
+  EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
+  // The step creates the table exactly as a fresh database has it.
+  EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
+  EXPECT_NE(schema_sql().find(migration_steps()[0].sql), std::string::npos);
 }
 
 TEST(Schema, ColumnListHelpers) {
@@ -33,12 +39,30 @@ TEST(Schema, ColumnListHelpers) {
 }
 
 TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
-  ASSERT_EQ(kTables.size(), 6u);
-  EXPECT_STREQ(kTables[0], "meta");
-  EXPECT_STREQ(kTables[1], "parts");
-  for (const char* table : kTables) {
-    EXPECT_NE(schema_sql().find(std::string("CREATE TABLE ") + table + " ("), std::string::npos)
-        << table;
+  ASSERT_EQ(kTables.size(), 7u);
+  EXPECT_STREQ(kTables[0].name, "meta");
+  EXPECT_STREQ(kTables[1].name, "parts");
+  EXPECT_STREQ(kTables[6].name, "comfort_maps");
+  EXPECT_EQ(kTables[6].since_version, 2);
+  for (const auto& table : kTables) {
+    EXPECT_NE(schema_sql().find(std::string("CREATE TABLE ") + table.name + " ("),
+              std::string::npos)
+        << table.name;
+    EXPECT_GE(table.since_version, 1);
+    EXPECT_LE(table.since_version, current_schema_version());
+  }
+}
+
+TEST(Schema, ComfortMapColumnsAreDeclaredNotNull) {
+  const std::string& sql = schema_sql();
+  for (const std::string column :
+       {"arm TEXT UNIQUE NOT NULL", "origin_x REAL NOT NULL", "origin_y REAL NOT NULL",
+        "origin_z REAL NOT NULL", "spacing REAL NOT NULL", "dim_x INTEGER NOT NULL",
+        "dim_y INTEGER NOT NULL", "dim_z INTEGER NOT NULL", "orientation_count INTEGER NOT NULL",
+        "orientations BLOB NOT NULL", "value_bytes INTEGER NOT NULL",
+        "values_deflate BLOB NOT NULL", "samples INTEGER NOT NULL", "seed INTEGER NOT NULL",
+        "coverage REAL NOT NULL"}) {
+    EXPECT_NE(sql.find(column), std::string::npos) << column;
   }
 }
 
@@ -96,6 +120,14 @@ TEST(Schema, ConstraintsRejectBadRows) {
                        "0.5, 2)");
       },
       {"CHECK constraint failed"});
+  // Arm names are unique.
+  const std::string insert_map =
+      "INSERT INTO comfort_maps (arm, origin_x, origin_y, origin_z, spacing, dim_x, dim_y, dim_z, "
+      "orientation_count, orientations, value_bytes, values_deflate, samples, seed, coverage) "
+      "VALUES ('left', 0, 0, 0, 0.03, 1, 1, 1, 0, x'', 0, x'00', 0, 0, 0)";
+  execute_script(path, insert_map);
+  expect_input_error([&] { execute_script(path, insert_map); },
+                     {"UNIQUE constraint failed: comfort_maps.arm"});
   // Part names are unique.
   expect_input_error(
       [&] {

@@ -53,6 +53,25 @@ TEST(SqliteHandle, BindAndReadBackEveryType) {
   EXPECT_FALSE(select.step());
 }
 
+TEST(SqliteHandle, BlobsAreBlobsEvenWhenEmpty) {
+  Connection c(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, "mem");
+  c.exec("CREATE TABLE t (b BLOB NOT NULL)", kContext);
+  Statement insert(c, "INSERT INTO t VALUES (?)", kContext);
+  const std::string bytes("\x00\xff\x01\x00", 4);
+  insert.bind_blob(bytes);
+  insert.run();
+  insert.bind_blob(std::string());  // an empty blob, not NULL
+  insert.run();
+  Statement select(c, "SELECT b, typeof(b) FROM t ORDER BY rowid", kContext);
+  ASSERT_TRUE(select.step());
+  EXPECT_EQ(select.next_blob(), bytes);
+  EXPECT_EQ(select.next_text(), "blob");
+  ASSERT_TRUE(select.step());
+  EXPECT_EQ(select.next_blob(), "");
+  EXPECT_EQ(select.next_text(), "blob");
+  EXPECT_FALSE(select.step());
+}
+
 TEST(SqliteHandle, BadSqlNamesFileFieldAndFix) {
   Connection c(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, "shown.db");
   expect_input_error([&] { Statement s(c, "SELEKT 1", kContext); },

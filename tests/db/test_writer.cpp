@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <stdexcept>
 
 #include "hila/db/database.hpp"
@@ -157,6 +159,87 @@ TEST(Writer, NanValueIsRefusedWithAHint) {
   g.force_margin = std::nan("");
   expect_input_error([&] { writer.add_suction_grasps(id, {g}); },
                      {target, "suction_grasps", "suction_grasps.force_margin", "NaN"});
+}
+
+TEST(Writer, ComfortMapWithWrongSizesOrValuesIsInvalidArgument) {
+  const std::string dir = temp_dir("db_writer_comfort_invalid");
+  const ComfortMapRecord good = make_comfort_map("right", 3, {3, 2, 2}, 5);
+  // Each case on a fresh writer: a failed call makes the writer refuse to commit.
+  const auto refused = [&](const std::string& name,
+                           const std::function<void(ComfortMapRecord&)>& change,
+                           const std::string& fragment) {
+    SCOPED_TRACE(name);
+    ComfortMapRecord map = good;
+    change(map);
+    DatabaseWriter writer(dir + "/p.db");
+    writer.write_meta(make_sample().meta);
+    try {
+      writer.add_comfort_map(map);
+      ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(writer.commit(), std::logic_error);
+  };
+  refused(
+      "empty arm", [](ComfortMapRecord& m) { m.arm.clear(); }, "empty arm name");
+  refused(
+      "zero spacing", [](ComfortMapRecord& m) { m.spacing = 0.0; }, "spacing");
+  refused(
+      "NaN spacing", [](ComfortMapRecord& m) { m.spacing = std::nan(""); }, "spacing");
+  refused(
+      "infinite origin",
+      [](ComfortMapRecord& m) { m.origin.x() = std::numeric_limits<double>::infinity(); },
+      "origin");
+  refused(
+      "zero dimension", [](ComfortMapRecord& m) { m.dims.z() = 0; }, "3 x 2 x 0");
+  refused(
+      "negative dimension", [](ComfortMapRecord& m) { m.dims.x() = -3; }, "dims");
+  refused(
+      "a value too many", [](ComfortMapRecord& m) { m.values.push_back(0); },
+      "values must hold dims.prod() * orientations.size() = 3 * 2 * 2 * 5 = 60 bytes, got 61");
+  refused(
+      "a value too few", [](ComfortMapRecord& m) { m.values.pop_back(); }, "got 59");
+  refused(
+      "an orientation too many",
+      [](ComfortMapRecord& m) { m.orientations.push_back(Eigen::Quaterniond::Identity()); },
+      "= 72 bytes, got 60");
+  refused(
+      "dims swapped for a wrong total",
+      [](ComfortMapRecord& m) {
+        m.dims = {3, 2, 3};
+      },
+      "= 90 bytes");
+  refused(
+      "non-unit orientation", [](ComfortMapRecord& m) { m.orientations[3].coeffs() *= 1.0 + 1e-8; },
+      "orientation 3 is not a unit quaternion");
+  refused(
+      "NaN orientation", [](ComfortMapRecord& m) { m.orientations[0].w() = std::nan(""); },
+      "orientation 0");
+  // Within the tolerance is fine.
+  ComfortMapRecord close = good;
+  close.orientations[0].coeffs() *= 1.0 + 1e-12;
+  DatabaseWriter writer(dir + "/p.db");
+  writer.write_meta(make_sample().meta);
+  EXPECT_NO_THROW(writer.add_comfort_map(close));
+  writer.commit();
+  EXPECT_EQ(Database::open(dir + "/p.db").comfort_maps().size(), 1u);
+}
+
+TEST(Writer, DuplicateArmFailsAndTheWriterThenRefusesToCommit) {
+  const std::string dir = temp_dir("db_writer_comfort_duplicate");
+  const std::string target = dir + "/p.db";
+  DatabaseWriter writer(target);
+  writer.write_meta(make_sample().meta);
+  writer.add_comfort_map(make_comfort_map("left", 1, {2, 2, 2}, 3));
+  writer.add_comfort_map(make_comfort_map("right", 2, {2, 2, 2}, 3));
+  expect_input_error(
+      [&] {
+        writer.add_comfort_map(make_comfort_map("left", 3, {3, 3, 3}, 4));
+      },
+      {target, "comfort_maps (arm 'left')", "UNIQUE constraint failed: comfort_maps.arm"});
+  EXPECT_THROW(writer.commit(), std::logic_error);
+  EXPECT_FALSE(fs::exists(target));
 }
 
 TEST(Writer, MisuseIsALogicError) {

@@ -23,6 +23,9 @@ offline::BuildSettings quick_settings(std::uint64_t seed = 7, int jobs = 1) {
   s.jobs = jobs;
   s.robot.samples = 500;
   s.human.samples = 300;
+  s.comfort.spacing = 0.06;
+  s.comfort.orientations = 100;
+  s.comfort.samples = 20000;
   return s;
 }
 
@@ -75,6 +78,14 @@ TEST(Build, CabinetDatabaseHoldsEveryBoardWithGraspsOfEachKind) {
     EXPECT_NEAR(part.mass_properties.volume, part.extent.prod(), 1e-12) << part.name;
   }
   EXPECT_EQ(database.meta().cell_hash, offline::cell_hash(core::load_cell_spec(test::cell_path())));
+  // One comfort map per human arm, equal to one built directly with the same settings and seed.
+  ASSERT_EQ(database.comfort_maps().size(), 2u);
+  const auto cell = test::reference_cell();
+  offline::ComfortMapSettings comfort = quick_settings().comfort;
+  comfort.seed = offline::part_seed(7, "comfort:right", 3);
+  const auto direct = offline::ComfortMap::build(cell->human_arms()[1].chain, comfort);
+  EXPECT_EQ(database.comfort_map("right").values, direct.values());
+  EXPECT_EQ(database.comfort_map("right").dims, direct.dims());
   EXPECT_EQ(files_in(dir), (std::vector<std::string>{"cabinet.hila"}));  // no temporary left
 }
 

@@ -133,7 +133,7 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
   const std::string dir = test::temp_dir("cli_build");
   const std::string out = dir + "/cabinet.hila";
   const CommandRun build = run("build " + test::product_path() + " --cell " + test::cell_path() +
-                               " -o " + out + " --seed 3 --jobs 2");
+                               " -o " + out + " --seed 3 --jobs 2 --comfort-samples 20000");
   ASSERT_EQ(build.status, 0) << build.out;
   // Not a terminal: no progress lines, just the summary.
   EXPECT_EQ(build.out.find("\r"), std::string::npos);
@@ -159,11 +159,19 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
   for (const auto& row : g["grasps"]) robot += row["kind"] == "robot";
   EXPECT_EQ(robot, j["parts"][5]["robot_grasps"].get<int>());
 
+  const CommandRun comfort = run("inspect " + out + " comfort --arm right --json");
+  ASSERT_EQ(comfort.status, 0) << comfort.out;
+  const auto c = nlohmann::json::parse(json_part(comfort.out));
+  EXPECT_EQ(c["orientations"], 128);
+  EXPECT_GT(c["filled_bins"].get<long>(), 1000);
+  EXPECT_LE(c["q_max"].get<double>(), 1.0);
+  EXPECT_EQ(run("inspect " + out + " comfort --arm tail").status, 2);
+
   const CommandRun digest1 = run("inspect " + out + " digest");
   ASSERT_EQ(digest1.status, 0);
   EXPECT_EQ(digest1.out.size(), 65u);  // 64 hex digits and a newline
   ASSERT_EQ(run("build " + test::product_path() + " --cell " + test::cell_path() + " -o " + dir +
-                "/again.hila --seed 3 --jobs 1")
+                "/again.hila --seed 3 --jobs 1 --comfort-samples 20000")
                 .status,
             0);
   EXPECT_EQ(run("inspect " + dir + "/again.hila digest").out, digest1.out);
@@ -183,7 +191,7 @@ TEST(Cli, BuildAndInspectBadInputs) {
   EXPECT_EQ(no_dir.status, 2);
   EXPECT_NE(no_dir.out.find("no/dir"), std::string::npos) << no_dir.out;
   EXPECT_NE(run("build " + test::product_path() + " -o " + dir + "/x.hila --jobs 0").status, 0);
-  ASSERT_EQ(run("build " + test::product_path() + " -o " + dir + "/ok.hila").status, 0);
+  ASSERT_EQ(run("build " + test::product_path() + " -o " + dir + "/ok.hila --comfort-samples 20000").status, 0);
   const CommandRun part = run("inspect " + dir + "/ok.hila grasps --part drawer");
   EXPECT_EQ(part.status, 2);
   EXPECT_NE(part.out.find("drawer"), std::string::npos) << part.out;

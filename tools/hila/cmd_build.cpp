@@ -16,12 +16,14 @@ struct BuildOptions {
   std::string cell_file;
   std::uint64_t seed = 1;
   int jobs = 1;
+  long comfort_samples = offline::ComfortMapSettings{}.samples;
 };
 
 int run_build(const BuildOptions& opt) {
   offline::BuildSettings settings;
   settings.seed = opt.seed;
   settings.jobs = opt.jobs;
+  settings.comfort.samples = opt.comfort_samples;
   // Progress only for a person watching a terminal; logs and pipes stay clean.
   const bool terminal = isatty(fileno(stderr)) != 0;
   offline::BuildProgress progress;
@@ -43,6 +45,11 @@ int run_build(const BuildOptions& opt) {
               << std::setw(4) << p.one_hand_grasps << ")   " << std::setprecision(0)
               << p.theta_c_min_deg << "-" << p.theta_c_max_deg << "\n";
   }
+  for (const auto& m : summary.comfort_maps) {
+    std::cout << "  comfort map, " << m.arm << " arm: " << m.filled_bins << " bins filled, coverage "
+              << std::setprecision(1) << 100.0 * m.coverage << " % (" << std::setprecision(2)
+              << m.seconds << " s)\n";
+  }
   return 0;
 }
 }  // namespace
@@ -56,6 +63,10 @@ void add_build_command(CLI::App& app, Action& action) {
   build->add_option("--cell", opt->cell_file, "cell YAML file")->capture_default_str();
   build->add_option("--seed", opt->seed, "random seed (same seed, same content)")
       ->capture_default_str();
+  build->add_option("--comfort-samples", opt->comfort_samples,
+                    "arm postures sampled per human comfort map")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   build->add_option("--jobs", opt->jobs, "worker threads over parts")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -14,6 +14,7 @@ struct InspectOptions {
   std::string database;
   std::string what = "summary";
   std::string part;
+  std::string arm;
   bool json = false;
 };
 
@@ -86,6 +87,33 @@ nlohmann::json grasps_json(const db::Database& database, const std::string& part
   return {{"part", part_name}, {"grasps", rows}};
 }
 
+nlohmann::json comfort_json(const db::Database& database, const std::string& arm) {
+  const db::ComfortMapRecord& map = database.comfort_map(arm);
+  // Distribution of the stored Q over the bins that hold one.
+  std::vector<long> histogram(10, 0);
+  long filled = 0;
+  double sum = 0.0, best = 0.0;
+  for (const auto v : map.values) {
+    if (v == 0) continue;
+    const double q = v / 255.0;
+    ++filled;
+    sum += q;
+    best = std::max(best, q);
+    ++histogram[std::min<std::size_t>(9, static_cast<std::size_t>(q * 10.0))];
+  }
+  return {{"arm", map.arm},
+          {"dims", {map.dims.x(), map.dims.y(), map.dims.z()}},
+          {"spacing", map.spacing},
+          {"orientations", map.orientations.size()},
+          {"bins", map.values.size()},
+          {"filled_bins", filled},
+          {"coverage", map.coverage},
+          {"samples", map.samples},
+          {"q_max", best},
+          {"q_mean", filled ? sum / static_cast<double>(filled) : 0.0},
+          {"q_histogram_tenths", histogram}};
+}
+
 int run_inspect(const InspectOptions& opt) {
   if (opt.what == "digest") {
     const std::string digest = db::content_digest(opt.database);
@@ -126,8 +154,26 @@ int run_inspect(const InspectOptions& opt) {
     }
     return 0;
   }
+  if (opt.what == "comfort") {
+    if (opt.arm.empty()) throw core::InputError("command line", "--arm", "a human arm name", "nothing");
+    const auto j = comfort_json(database, opt.arm);
+    if (opt.json) {
+      std::cout << j.dump(2) << "\n";
+      return 0;
+    }
+    std::cout << "comfort map of the " << opt.arm << " arm: " << j["dims"].dump() << " nodes "
+              << j["spacing"].get<double>() << " m apart x " << j["orientations"].get<std::size_t>()
+              << " orientations = " << j["bins"].get<std::size_t>() << " bins\n"
+              << "  filled " << j["filled_bins"].get<long>() << ", coverage of the reach sphere "
+              << std::fixed << std::setprecision(1) << 100.0 * j["coverage"].get<double>()
+              << " %, from " << j["samples"].get<long>() << " sampled postures\n"
+              << "  Q max " << std::setprecision(3) << j["q_max"].get<double>() << ", mean "
+              << j["q_mean"].get<double>() << "\n  Q histogram (tenths): "
+              << j["q_histogram_tenths"].dump() << "\n";
+    return 0;
+  }
   if (opt.what != "summary") {
-    throw core::InputError("command line", "what", "summary, grasps or digest",
+    throw core::InputError("command line", "what", "summary, grasps, comfort or digest",
                            "'" + opt.what + "'");
   }
   const auto j = summary_json(database);
@@ -158,9 +204,10 @@ void add_inspect_command(CLI::App& app, Action& action) {
   auto opt = std::make_shared<InspectOptions>();
   auto* inspect = app.add_subcommand("inspect", "Show what a product database holds");
   inspect->add_option("database", opt->database, "database file")->required();
-  inspect->add_option("what", opt->what, "summary (default), grasps or digest")
+  inspect->add_option("what", opt->what, "summary (default), grasps, comfort or digest")
       ->capture_default_str();
   inspect->add_option("--part", opt->part, "part name (for grasps)");
+  inspect->add_option("--arm", opt->arm, "human arm name (for comfort)");
   inspect->add_flag("--json", opt->json, "print JSON");
   inspect->callback([opt, &action] { action = [opt] { return run_inspect(*opt); }; });
 }

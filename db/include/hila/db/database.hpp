@@ -47,6 +47,11 @@ class DatabaseWriter {
   void add_robot_grasps(std::int64_t part_id, const std::vector<RobotGraspRecord>& grasps);
   void add_suction_grasps(std::int64_t part_id, const std::vector<SuctionGraspRecord>& grasps);
   void add_human_grasps(std::int64_t part_id, const std::vector<HumanGraspRecord>& grasps);
+  // One map per human arm; the values are stored zlib-compressed. Throws std::invalid_argument
+  // for an empty arm name, spacing <= 0, a dimension <= 0, values.size() != dims.prod() *
+  // orientations.size() or an orientation that is not a unit quaternion (to 1e-9), and
+  // DatabaseError for an arm that already has a map.
+  void add_comfort_map(const ComfortMapRecord& map);
   void commit();
 
   const std::string& temporary_path() const;
@@ -63,7 +68,8 @@ struct OpenOptions {
   std::optional<std::string> expected_product_hash;
 };
 
-// A read-only, fully loaded product database (it is small). Const after open: safe to share.
+// A read-only, fully loaded product database (small, except the comfort maps: about 13 MB per arm
+// in memory). Const after open: safe to share.
 class Database {
  public:
   // Throws DatabaseError for a missing, truncated, corrupt or foreign file (not SQLite, or SQLite
@@ -78,6 +84,9 @@ class Database {
   std::vector<RobotGraspRecord> robot_grasps(std::int64_t part_id) const;
   std::vector<SuctionGraspRecord> suction_grasps(std::int64_t part_id) const;
   std::vector<HumanGraspRecord> human_grasps(std::int64_t part_id) const;
+  // In the order they were written (id order).
+  const std::vector<ComfortMapRecord>& comfort_maps() const { return comfort_maps_; }
+  const ComfortMapRecord& comfort_map(const std::string& arm) const;  // throws core::InputError
 
  private:
   std::string path_;
@@ -87,6 +96,7 @@ class Database {
   std::vector<RobotGraspRecord> robot_grasps_;
   std::vector<SuctionGraspRecord> suction_grasps_;
   std::vector<HumanGraspRecord> human_grasps_;
+  std::vector<ComfortMapRecord> comfort_maps_;
 };
 
 // Upgrades a database written by an older schema version to current_schema_version(): copies it
@@ -95,8 +105,9 @@ class Database {
 // Throws DatabaseError for a newer, foreign or corrupt file, or when no migration path exists.
 void migrate_in_place(const std::string& path);
 
-// A hash of the database content (every table, rows in id order, doubles by their exact bits),
-// ignoring meta.created_at: two builds from the same inputs and seed have the same digest.
+// A hash of the database content (every table, rows in id order, doubles by their exact bits,
+// comfort map values uncompressed), ignoring meta.created_at: two builds from the same inputs and
+// seed have the same digest.
 std::string content_digest(const std::string& path);
 
 }  // namespace hila::db

@@ -12,7 +12,7 @@ struct MigrationStep {
   std::string sql;
 };
 
-// The steps this build of hila knows, in order (empty for schema version 1).
+// The steps this build of hila knows, in order (1 -> 2 adds comfort_maps).
 const std::vector<MigrationStep>& migration_steps();
 
 // True if `steps` hold one step for every version from `from_version` up to `to_version` - 1.

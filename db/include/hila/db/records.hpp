@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -74,6 +75,22 @@ struct HumanGraspRecord {
   Eigen::Vector3d contact_2 = Eigen::Vector3d::Zero();
   double quality = 0.0;
   bool one_hand_stable = false;  // false: the part needs two hands (soft-finger check)
+};
+
+// Best human comfort Q (paper Eq. 4) over a grid of hand positions x a set of hand orientations,
+// for one human arm, in the arm's base frame. Bins the arm never reached hold 0.
+struct ComfortMapRecord {
+  std::string arm;                                   // human arm name, unique per database
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // grid node (0,0,0), arm base frame, m
+  double spacing = 0.0;                              // m between nodes
+  Eigen::Vector3i dims = Eigen::Vector3i::Zero();    // nodes per axis
+  std::vector<Eigen::Quaterniond> orientations;      // hand orientations (w, x, y, z)
+  // dims.prod() * orientations.size() bytes, Q * 255 (0: never reached); node (x, y, z) and
+  // orientation o at index ((x * dims.y + y) * dims.z + z) * n_orient + o.
+  std::vector<std::uint8_t> values;
+  std::int64_t samples = 0;  // forward-kinematics samples used
+  std::uint64_t seed = 0;
+  double coverage = 0.0;  // share of in-reach bins holding a value
 };
 
 // Self-description of a database (the `meta` table, one key per field).

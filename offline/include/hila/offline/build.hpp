@@ -7,6 +7,7 @@
 
 #include "hila/core/cell.hpp"
 #include "hila/core/product.hpp"
+#include "hila/offline/comfort_map.hpp"
 #include "hila/offline/human_grasps.hpp"
 #include "hila/offline/robot_grasps.hpp"
 #include "hila/offline/suction_grasps.hpp"
@@ -19,6 +20,7 @@ struct BuildSettings {
   RobotGraspSettings robot;
   SuctionSettings suction;
   HumanGraspSettings human;
+  ComfortMapSettings comfort;  // one map per human arm of the cell
 };
 
 struct PartBuildSummary {
@@ -35,9 +37,17 @@ struct PartBuildSummary {
   double seconds = 0.0;
 };
 
+struct ComfortMapSummary {
+  std::string arm;
+  long filled_bins = 0;
+  double coverage = 0.0;
+  double seconds = 0.0;
+};
+
 struct BuildSummary {
   std::string output;
   std::vector<PartBuildSummary> parts;  // in assembly order
+  std::vector<ComfortMapSummary> comfort_maps;  // in the cell's human-arm order
   double seconds = 0.0;
 };
 

@@ -7,6 +7,7 @@
 
 #include "hila/core/kinematic_chain.hpp"
 #include "hila/core/pose.hpp"
+#include "hila/db/records.hpp"
 
 namespace hila::offline {
 
@@ -33,6 +34,10 @@ struct ComfortMapSettings {
 class ComfortMap {
  public:
   static ComfortMap build(const core::KinematicChain& arm, const ComfortMapSettings& settings);
+  // To and from the database record (the arm's name and the build's sample count and seed are
+  // the record's).
+  static ComfortMap from_record(const db::ComfortMapRecord& record);
+  db::ComfortMapRecord to_record(const std::string& arm, const ComfortMapSettings& settings) const;
 
   double lookup(const core::Pose& hand_in_base) const;
   // The stored value of one bin (no interpolation).
