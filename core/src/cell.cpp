@@ -158,7 +158,7 @@ CellSpec load_cell_spec(const std::string& path) {
 
   const YamlNode suction = root.at("suction");
   suction.expect_only({"tool_urdf", "handle_link", "cup_link", "handle_width", "cup_radius",
-                       "max_force", "max_moment"});
+                       "max_force", "max_moment", "handle_in_tcp"});
   cell.suction.tool_urdf = suction.resolve_path(suction.at("tool_urdf").as_string());
   cell.suction.handle_link = suction.at("handle_link").as_string();
   cell.suction.cup_link = suction.at("cup_link").as_string();
@@ -166,6 +166,7 @@ CellSpec load_cell_spec(const std::string& path) {
   cell.suction.cup_radius = suction.at("cup_radius").as_positive();
   cell.suction.max_force = suction.at("max_force").as_positive();
   cell.suction.max_moment = suction.at("max_moment").as_positive();
+  cell.suction.handle_in_tcp = suction.at("handle_in_tcp").as_pose();
 
   if (const auto obstacles = root.find("obstacles")) {
     for (std::size_t i = 0; i < obstacles->size(); ++i) {

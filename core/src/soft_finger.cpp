@@ -1,6 +1,7 @@
 #include "hila/core/soft_finger.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -52,6 +53,25 @@ double relaxation_limit_deg(double mass, double gravity, double lever, double ca
   // Every step safe: the grasp holds at any inclination.
   if (max_gravity_torque(mass, gravity, lever, kPi / 2) <= capacity) return 90.0;
   return last_safe;
+}
+
+double axis_inclination_deg(const Eigen::Vector3d& axis, const Eigen::Vector3d& gravity_direction) {
+  const double c = std::min(1.0, std::abs(axis.dot(gravity_direction)));
+  return rad_to_deg(std::acos(c));
+}
+
+double slip_angle_deg(const Eigen::Vector3d& axis, const Eigen::Vector3d& lever,
+                      const Eigen::Vector3d& gravity_direction) {
+  const double s = std::min(1.0, std::abs(gravity_direction.dot(axis.cross(lever))));
+  return rad_to_deg(std::asin(s));
+}
+
+Eigen::Vector3d lever_direction(const Eigen::Vector3d& axis, const Eigen::Vector3d& contact_centre,
+                                const Eigen::Vector3d& com) {
+  const Eigen::Vector3d r = com - contact_centre;
+  const Eigen::Vector3d perp = r - r.dot(axis) * axis;
+  const double n = perp.norm();
+  return n > 1e-12 ? Eigen::Vector3d(perp / n) : Eigen::Vector3d::Zero();
 }
 
 }  // namespace hila::core

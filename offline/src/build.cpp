@@ -5,12 +5,14 @@
 #include <ctime>
 #include <exception>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <sstream>
 #include <thread>
 
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
+#include "hila/offline/human_comfort.hpp"
 #include "hila/offline/part_analysis.hpp"
 
 #ifndef HILA_VERSION
@@ -62,6 +64,8 @@ std::string utc_now() {
 }
 
 struct PartResult {
+  HandoverResult handover;
+  std::vector<db::ErgonomicsRecord> ergonomics;
   db::PartRecord record;
   std::vector<db::PlacementRecord> placements;
   std::vector<db::RobotGraspRecord> robot;
@@ -123,7 +127,67 @@ PartResult build_part(const core::ProductSpec& product, std::size_t index, const
   return r;
 }
 
+// Runs task(0..count-1) on `jobs` threads; rethrows the failure of the lowest task index.
+void run_tasks(int jobs, std::size_t count, const std::function<void(std::size_t)>& task) {
+  std::vector<std::exception_ptr> errors(count);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t t = next++; t < count; t = next++) {
+      try {
+        task(t);
+      } catch (...) {
+        errors[t] = std::current_exception();
+      }
+    }
+  };
+  const int threads = std::min<int>(jobs, static_cast<int>(count));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (const auto& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+}
+
+// Turns the result's 0-based indices into database ids and writes it.
+void write_handover(db::DatabaseWriter& writer, std::int64_t part_id, const HandoverResult& h,
+                    const std::vector<std::int64_t>& robot_ids,
+                    const std::vector<std::int64_t>& suction_ids,
+                    const std::vector<std::int64_t>& human_ids) {
+  auto id_of = [](const std::vector<std::int64_t>& ids, std::int64_t index) -> std::int64_t {
+    return index < 0 ? 0 : ids[static_cast<std::size_t>(index)];
+  };
+  db::HandoverStageRecord stage = h.stage;
+  stage.part_id = part_id;
+  writer.add_handover_stage(stage);
+  std::vector<db::RobotHandoverRecord> rr = h.robot_handovers;
+  for (auto& r : rr) r.suction_grasp_id = id_of(suction_ids, r.suction_grasp_id);
+  const auto rr_ids = writer.add_robot_handovers(part_id, rr);
+  std::vector<db::HandoverCandidateRecord> candidates = h.candidates;
+  for (auto& c : candidates) {
+    c.human_grasp_id = id_of(human_ids, c.human_grasp_id);
+    c.second_grasp_id = id_of(human_ids, c.second_grasp_id);
+  }
+  const auto candidate_ids = writer.add_handover_candidates(part_id, candidates);
+  std::vector<db::SharedGraspRecord> shared = h.shared;
+  for (auto& s : shared) {
+    s.candidate_id = id_of(candidate_ids, s.candidate_id);
+    s.robot_grasp_id = id_of(robot_ids, s.robot_grasp_id);
+    s.robot_handover_id = id_of(rr_ids, s.robot_handover_id);
+  }
+  writer.add_shared_grasps(shared);
+}
+
 }  // namespace
+
+std::vector<std::string> BuildSummary::failed_parts() const {
+  std::vector<std::string> out;
+  for (const auto& p : parts) {
+    if (!p.handover_failure.empty()) out.push_back(p.name);
+  }
+  return out;
+}
 
 std::uint64_t part_seed(std::uint64_t seed, const std::string& part_name, std::uint64_t stream) {
   // FNV-1a over the name, mixed with the seed and stream by SplitMix64.
@@ -157,6 +221,17 @@ std::string settings_hash(const BuildSettings& s) {
        << s.human.samples << ' ' << s.human.approach_rotations << ' ' << s.human.opening_margin
        << ' ' << s.human.merge_distance << ' ' << s.human.merge_angle_deg << "\ncomfort "
        << s.comfort.spacing << ' ' << s.comfort.orientations << ' ' << s.comfort.samples << '\n';
+  const auto& h = s.handover;
+  text << "handover " << h.candidates << ' ' << h.max_draws << ' ' << h.max_rotation_deg << ' '
+       << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.two_hand_separation << ' '
+       << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
+       << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' '
+       << h.human_ik_goals;
+  for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
+  const auto& e = s.ergonomics;
+  text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
+       << ' ' << e.bent_forward_deg << ' ' << e.candidates_per_step << ' ' << e.ik_attempts
+       << "\nbodies " << format_human_bodies(s.human_bodies) << '\n';
   return db::sha256_hex(text.str());
 }
 
@@ -173,57 +248,91 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   // Open the writer first: an unwritable destination fails before minutes of work.
   db::DatabaseWriter writer(output_path);
 
-  // One task per part and one per human arm's comfort map, shared by the workers; results go to
-  // fixed slots, so the content does not depend on which thread ran what.
+  // Phase 1: one task per human arm's comfort map and one per part's grasps. Phase 2 (needs the
+  // maps and every part's grasps): one task per board's handover goals and ergonomics. Results
+  // go to fixed slots, so the content does not depend on which thread ran what.
   const std::size_t n = product.parts.size();
   const std::size_t arms = cell->human_arms().size();
-  const std::size_t tasks = n + arms;
+  const int total = static_cast<int>(arms + 2 * n);
   std::vector<PartResult> results(n);
   std::vector<ComfortMap> maps(arms);
   std::vector<ComfortMapSummary> map_summaries(arms);
-  std::vector<std::exception_ptr> errors(tasks);
-  std::atomic<std::size_t> next{0};
   std::mutex progress_mutex;
   int done = 0;
-  auto worker = [&] {
-    // Comfort maps are the longest tasks: start them first.
-    for (std::size_t t = next++; t < tasks; t = next++) {
-      const bool is_map = t < arms;
-      std::string label;
-      try {
-        if (is_map) {
-          const auto start_map = std::chrono::steady_clock::now();
-          const core::HumanArm& arm = cell->human_arms()[t];
-          label = "comfort map, " + arm.spec.name + " arm";
-          ComfortMapSettings comfort = settings.comfort;
-          comfort.seed = part_seed(settings.seed, "comfort:" + arm.spec.name, 3);
-          maps[t] = ComfortMap::build(arm.chain, comfort);
-          auto& s = map_summaries[t];
-          s.arm = arm.spec.name;
-          for (const auto v : maps[t].values()) s.filled_bins += v > 0 ? 1 : 0;
-          s.coverage = maps[t].coverage();
-          s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_map).count();
-        } else {
-          label = product.parts[t - arms].name;
-          results[t - arms] = build_part(product, t - arms, *cell, settings);
-        }
-      } catch (...) {
-        errors[is_map ? n + t : t - arms] = std::current_exception();
-      }
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      ++done;
-      if (progress) progress(label, done, static_cast<int>(tasks));
-    }
+  auto report = [&](const std::string& label) {
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    ++done;
+    if (progress) progress(label, done, total);
   };
-  const int threads = std::min<int>(settings.jobs, static_cast<int>(tasks));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  // The first failing part in assembly order (then the maps), whatever thread hit it first.
-  for (const auto& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
+  auto comfort_seed = [&](std::size_t a) {
+    ComfortMapSettings comfort = settings.comfort;
+    comfort.seed = part_seed(settings.seed, "comfort:" + cell->human_arms()[a].spec.name, 3);
+    return comfort;
+  };
+  run_tasks(settings.jobs, arms + n, [&](std::size_t t) {
+    // Comfort maps are the longest tasks: they go first.
+    if (t < arms) {
+      const auto start_map = std::chrono::steady_clock::now();
+      const core::HumanArm& arm = cell->human_arms()[t];
+      maps[t] = ComfortMap::build(arm.chain, comfort_seed(t));
+      auto& s = map_summaries[t];
+      s.arm = arm.spec.name;
+      for (const auto v : maps[t].values()) s.filled_bins += v > 0 ? 1 : 0;
+      s.coverage = maps[t].coverage();
+      s.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_map).count();
+      report("comfort map, " + arm.spec.name + " arm");
+    } else {
+      results[t - arms] = build_part(product, t - arms, *cell, settings);
+      report(product.parts[t - arms].name);
+    }
+  });
+
+  const HumanComfort comfort(*cell, maps, settings.human_bodies);
+  run_tasks(settings.jobs, n, [&](std::size_t i) {
+    PartResult& r = results[i];
+    BoardGrasps grasps{r.robot, r.suction, r.human, r.record.mass_properties.com};
+    HandoverSettings handover = settings.handover;
+    handover.seed = part_seed(settings.seed, product.parts[i].name, 4);
+    r.handover = plan_handover_goals(*cell, product, i, grasps, comfort, handover);
+    ErgonomicsInputs in;
+    in.target = r.record.target;
+    in.initial = r.record.initial;
+    if (!r.placements.empty()) in.table_placement = r.placements.front().part_in_plane;
+    in.human_grasps = &r.human;
+    for (const auto& c : r.handover.candidates) {
+      if (c.rank == 0) {
+        in.has_goal = true;
+        in.goal = c.board;
+        for (int a = 0; a < comfort.arm_count(); ++a) {
+          if (comfort.arm_name(a) == c.human_arm) in.goal_arm = a;
+        }
+        in.goal_grasp = static_cast<int>(c.human_grasp_id);
+      }
+    }
+    ErgonomicsSettings ergonomics = settings.ergonomics;
+    ergonomics.seed = part_seed(settings.seed, product.parts[i].name, 5);
+    r.ergonomics = evaluate_ergonomics(*cell, comfort, in, ergonomics);
+
+    auto& s = r.summary;
+    const auto& st = r.handover.stage;
+    s.handover_draws = st.draws;
+    s.handover_candidates = st.candidates;
+    s.comfortable = st.comfortable;
+    s.comfortable_default_body = st.comfortable_default_body;
+    s.goals = st.goals;
+    s.robot_handovers = st.robot_handovers;
+    s.two_hands = st.two_hands;
+    s.handover_failure = st.failure;
+    s.handover_seconds = r.handover.seconds;
+    if (in.has_goal) {
+      s.goal_distance = handover_distance(in.goal, in.target, settings.handover.rotation_weight);
+      for (const auto& c : r.handover.candidates) {
+        if (c.rank == 0) s.goal_quality = c.quality;
+      }
+    }
+    report(product.parts[i].name + " handover");
+  });
 
   db::Meta meta;
   meta.hila_version = HILA_VERSION;
@@ -235,21 +344,22 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   meta.created_at = utc_now();
   meta.cell_file = cell_path.substr(cell_path.find_last_of('/') + 1);
   meta.product_file = product_path.substr(product_path.find_last_of('/') + 1);
+  meta.human_bodies = format_human_bodies(settings.human_bodies);
   writer.write_meta(meta);
   BuildSummary summary;
   summary.output = output_path;
   for (auto& r : results) {
     const std::int64_t id = writer.add_part(r.record);
     writer.add_placements(id, r.placements);
-    writer.add_robot_grasps(id, r.robot);
-    writer.add_suction_grasps(id, r.suction);
-    writer.add_human_grasps(id, r.human);
+    const auto robot_ids = writer.add_robot_grasps(id, r.robot);
+    const auto suction_ids = writer.add_suction_grasps(id, r.suction);
+    const auto human_ids = writer.add_human_grasps(id, r.human);
+    write_handover(writer, id, r.handover, robot_ids, suction_ids, human_ids);
+    writer.add_ergonomics(id, r.ergonomics);
     summary.parts.push_back(r.summary);
   }
   for (std::size_t a = 0; a < arms; ++a) {
-    ComfortMapSettings comfort = settings.comfort;
-    comfort.seed = part_seed(settings.seed, "comfort:" + cell->human_arms()[a].spec.name, 3);
-    writer.add_comfort_map(maps[a].to_record(cell->human_arms()[a].spec.name, comfort));
+    writer.add_comfort_map(maps[a].to_record(cell->human_arms()[a].spec.name, comfort_seed(a)));
   }
   summary.comfort_maps = map_summaries;
   writer.commit();

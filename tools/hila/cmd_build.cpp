@@ -17,6 +17,9 @@ struct BuildOptions {
   std::uint64_t seed = 1;
   int jobs = 1;
   long comfort_samples = offline::ComfortMapSettings{}.samples;
+  int handover_candidates = offline::HandoverSettings{}.candidates;
+  double comfort_threshold = offline::HandoverSettings{}.comfort_threshold;
+  std::string bodies;
 };
 
 int run_build(const BuildOptions& opt) {
@@ -24,6 +27,9 @@ int run_build(const BuildOptions& opt) {
   settings.seed = opt.seed;
   settings.jobs = opt.jobs;
   settings.comfort.samples = opt.comfort_samples;
+  settings.handover.candidates = opt.handover_candidates;
+  settings.handover.comfort_threshold = opt.comfort_threshold;
+  if (!opt.bodies.empty()) settings.human_bodies = offline::parse_human_bodies(opt.bodies, "--bodies");
   // Progress only for a person watching a terminal; logs and pipes stay clean.
   const bool terminal = isatty(fileno(stderr)) != 0;
   offline::BuildProgress progress;
@@ -50,6 +56,42 @@ int run_build(const BuildOptions& opt) {
               << std::setprecision(1) << 100.0 * m.coverage << " % (" << std::setprecision(2)
               << m.seconds << " s)\n";
   }
+  std::cout << "  handover goals (Eq. 1 candidates, S comfortable" << (settings.human_bodies.empty() ? "" : " for every body")
+            << ", 𝕊 with a shared grasp):\n";
+  std::cout << "  #  part           candidates    |S|    |𝕊|  rr poses  goal Q  distance m   time s\n";
+  for (const auto& p : summary.parts) {
+    std::cout << "  " << p.order << "  " << std::left << std::setw(14) << p.name << std::right
+              << std::setw(11) << p.handover_candidates << std::setw(7) << p.comfortable
+              << std::setw(7) << p.goals << std::setw(10) << p.robot_handovers;
+    if (p.goals > 0) {
+      std::cout << std::setw(8) << std::setprecision(3) << p.goal_quality << std::setw(12)
+                << p.goal_distance;
+    } else {
+      std::cout << std::setw(8) << "-" << std::setw(12) << "-";
+    }
+    std::cout << std::setw(9) << std::setprecision(2) << p.handover_seconds
+              << (p.two_hands ? "  (two hands)" : "") << "\n";
+  }
+  if (!settings.human_bodies.empty()) {
+    std::cout << "  body set: " << offline::format_human_bodies(settings.human_bodies) << "\n";
+    for (const auto& p : summary.parts) {
+      std::cout << "    " << p.name << ": " << p.comfortable << " of " << p.comfortable_default_body
+                << " comfortable candidates survive for every body\n";
+    }
+  }
+  const auto failed = summary.failed_parts();
+  for (const auto& p : summary.parts) {
+    if (!p.handover_failure.empty()) {
+      std::cerr << "hila: " << p.name << ": no handover goal: " << p.handover_failure << "\n";
+    }
+  }
+  if (!failed.empty()) {
+    std::cerr << "hila: " << failed.size() << " of " << summary.parts.size()
+              << " boards have no handover goal; the database was written with the reasons "
+                 "(hila inspect "
+              << summary.output << " handover --part NAME)\n";
+    return 1;
+  }
   return 0;
 }
 }  // namespace
@@ -67,6 +109,16 @@ void add_build_command(CLI::App& app, Action& action) {
                     "arm postures sampled per human comfort map")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  build->add_option("--handover-candidates", opt->handover_candidates,
+                    "Eq. 1 candidate poses per board")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  build->add_option("--comfort-threshold", opt->comfort_threshold,
+                    "least human comfort Q of a handover goal (S)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  build->add_option("--bodies", opt->bodies,
+                    "human bodies every goal must suit, e.g. 1.50:female,1.722,1.88:male");
   build->add_option("--jobs", opt->jobs, "worker threads over parts")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -1,6 +1,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
@@ -16,6 +17,7 @@ struct InspectOptions {
   std::string part;
   std::string arm;
   bool json = false;
+  int limit = 10;
 };
 
 double round_to(double v, double unit) {
@@ -114,6 +116,71 @@ nlohmann::json comfort_json(const db::Database& database, const std::string& arm
           {"q_histogram_tenths", histogram}};
 }
 
+nlohmann::json pose_json(const core::Pose& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d t = pose.translation();
+  return {{"xyz", {round_to(t.x(), 1e-6), round_to(t.y(), 1e-6), round_to(t.z(), 1e-6)}},
+          {"quat_wxyz",
+           {round_to(q.w(), 1e-9), round_to(q.x(), 1e-9), round_to(q.y(), 1e-9),
+            round_to(q.z(), 1e-9)}}};
+}
+
+nlohmann::json handover_json(const db::Database& database, const std::string& part_name) {
+  const auto& part = database.part(part_name);
+  const db::HandoverStageRecord* stage = database.handover_stage(part.id);
+  if (stage == nullptr) {
+    throw core::InputError(database.path(), "handover_stages",
+                           "handover goals for '" + part_name + "'",
+                           "none (a database from before schema 3: rebuild it with hila build)");
+  }
+  std::map<std::int64_t, double> theta_c;
+  for (const auto& g : database.robot_grasps(part.id)) theta_c[g.id] = g.theta_c_deg;
+  nlohmann::json goals = nlohmann::json::array();
+  for (const auto& c : database.handover_goals(part.id)) {
+    nlohmann::json shared = nlohmann::json::array();
+    for (const auto& s : database.shared_grasps(c.id)) {
+      shared.push_back({{"robot_grasp", s.robot_grasp_id},
+                        {"theta_c_deg", theta_c[s.robot_grasp_id]},
+                        {"robot_handover", s.robot_handover_id},
+                        {"arm", s.arm},
+                        {"slip_rr_deg", round_to(s.inclination_rr_deg, 0.01)},
+                        {"slip_rh_deg", round_to(s.inclination_rh_deg, 0.01)}});
+    }
+    nlohmann::json g = {{"rank", c.rank},
+                        {"candidate", c.id},
+                        {"distance", round_to(c.distance, 1e-5)},
+                        {"quality", round_to(c.quality, 1e-4)},
+                        {"human_arm", c.human_arm},
+                        {"human_grasp", c.human_grasp_id},
+                        {"pose", pose_json(c.board)},
+                        {"human_posture_solved", c.human_joints.size() > 0},
+                        {"shared_grasps", shared}};
+    if (!c.second_arm.empty()) {
+      g["second_arm"] = c.second_arm;
+      g["second_grasp"] = c.second_grasp_id;
+    }
+    goals.push_back(g);
+  }
+  nlohmann::json rr = nlohmann::json::array();
+  for (const auto& r : database.robot_handovers(part.id)) {
+    rr.push_back({{"id", r.id}, {"arm", r.arm}, {"suction_grasp", r.suction_grasp_id},
+                  {"pose", pose_json(r.board)}});
+  }
+  return {{"part", part_name},
+          {"finished_parts", stage->finished_parts},
+          {"draws", stage->draws},
+          {"candidates", stage->candidates},
+          {"comfortable", stage->comfortable},
+          {"comfortable_default_body", stage->comfortable_default_body},
+          {"goals", stage->goals},
+          {"robot_handovers", stage->robot_handovers},
+          {"two_hands", stage->two_hands},
+          {"failure", stage->failure},
+          {"human_bodies", database.meta().human_bodies},
+          {"robot_handover_poses", rr},
+          {"ranked_goals", goals}};
+}
+
 int run_inspect(const InspectOptions& opt) {
   if (opt.what == "digest") {
     const std::string digest = db::content_digest(opt.database);
@@ -172,8 +239,54 @@ int run_inspect(const InspectOptions& opt) {
               << j["q_histogram_tenths"].dump() << "\n";
     return 0;
   }
+  if (opt.what == "handover") {
+    if (opt.part.empty()) {
+      throw core::InputError("command line", "--part", "the name of a part", "nothing");
+    }
+    const auto j = handover_json(database, opt.part);
+    if (opt.json) {
+      std::cout << j.dump(2) << "\n";
+      return 0;
+    }
+    std::cout << "handover goals of " << opt.part << " (finished before it: "
+              << (j["finished_parts"].empty() ? std::string("none")
+                                              : j["finished_parts"].dump())
+              << ")\n  " << j["candidates"].get<int>() << " Eq. 1 candidates ("
+              << j["draws"].get<int>() << " draws), |S| " << j["comfortable"].get<int>()
+              << ", |𝕊| " << j["goals"].get<int>() << ", " << j["robot_handovers"].get<int>()
+              << " robot-robot poses" << (j["two_hands"].get<bool>() ? ", two hands" : "")
+              << "\n";
+    if (!j["failure"].get<std::string>().empty()) {
+      std::cout << "  no goal: " << j["failure"].get<std::string>() << "\n";
+    }
+    std::cout << "  rank  distance m  Q      human hand (grasp)   shared grasps (theta_c deg)\n";
+    int shown = 0;
+    for (const auto& g : j["ranked_goals"]) {
+      if (shown++ == opt.limit) {
+        std::cout << "  ... " << j["ranked_goals"].size() - static_cast<std::size_t>(opt.limit)
+                  << " more (--limit, --json)\n";
+        break;
+      }
+      std::string hand = g["human_arm"].get<std::string>() + " (" +
+                         std::to_string(g["human_grasp"].get<std::int64_t>()) + ")";
+      if (g.contains("second_arm")) {
+        hand += " + " + g["second_arm"].get<std::string>() + " (" +
+                std::to_string(g["second_grasp"].get<std::int64_t>()) + ")";
+      }
+      std::string shared;
+      for (const auto& s : g["shared_grasps"]) {
+        shared += (shared.empty() ? "" : ", ") + std::to_string(s["robot_grasp"].get<std::int64_t>()) +
+                  " (" + std::to_string(static_cast<int>(s["theta_c_deg"].get<double>())) + ")";
+      }
+      std::cout << std::setw(6) << g["rank"].get<int>() << std::setw(12) << std::fixed
+                << std::setprecision(3) << g["distance"].get<double>() << "  " << std::setw(5)
+                << std::setprecision(3) << g["quality"].get<double>() << "  " << std::left
+                << std::setw(20) << hand << std::right << " " << shared << "\n";
+    }
+    return 0;
+  }
   if (opt.what != "summary") {
-    throw core::InputError("command line", "what", "summary, grasps, comfort or digest",
+    throw core::InputError("command line", "what", "summary, grasps, comfort, handover or digest",
                            "'" + opt.what + "'");
   }
   const auto j = summary_json(database);
@@ -204,9 +317,10 @@ void add_inspect_command(CLI::App& app, Action& action) {
   auto opt = std::make_shared<InspectOptions>();
   auto* inspect = app.add_subcommand("inspect", "Show what a product database holds");
   inspect->add_option("database", opt->database, "database file")->required();
-  inspect->add_option("what", opt->what, "summary (default), grasps, comfort or digest")
+  inspect->add_option("what", opt->what, "summary (default), grasps, comfort, handover or digest")
       ->capture_default_str();
-  inspect->add_option("--part", opt->part, "part name (for grasps)");
+  inspect->add_option("--part", opt->part, "part name (for grasps and handover)");
+  inspect->add_option("--limit", opt->limit, "goals listed (handover, text)")->capture_default_str();
   inspect->add_option("--arm", opt->arm, "human arm name (for comfort)");
   inspect->add_flag("--json", opt->json, "print JSON");
   inspect->callback([opt, &action] { action = [opt] { return run_inspect(*opt); }; });

@@ -49,6 +49,8 @@ struct SuctionSpec {
   double cup_radius = 0.02;
   double max_force = 40.0;  // N, pull-off force with safety factor
   double max_moment = 0.8;  // N·m
+  // The handle frame in the gripper's TCP frame while the gripper holds the tool.
+  Pose handle_in_tcp = Pose::Identity();
 };
 
 struct ArmSpec {

@@ -39,6 +39,24 @@ double gravity_torque_about_axis(const Eigen::Vector3d& axis, const Eigen::Vecto
 // axis line and gravity): m g r_perp sin(theta), r_perp the distance of the CoM from the axis.
 double max_gravity_torque(double mass, double gravity, double lever, double inclination);
 
+// Angle between the line of a grasp's opening axis and gravity, degrees in [0, 90] (both unit
+// vectors). DESIGN §3's inclination: the worst case over the rotation about gravity.
+double axis_inclination_deg(const Eigen::Vector3d& axis, const Eigen::Vector3d& gravity_direction);
+
+// The slip angle of a held part at one orientation, degrees in [0, 90]: the inclination at which
+// the worst-case torque m g r_perp sin(theta) equals the actual gravity torque about the grasp
+// axis, sin(theta_s) = |g . (axis x lever)| with `lever` the unit direction from the axis to the
+// centre of mass (perpendicular to the axis). The grasp holds statically while theta_s <= theta_c.
+// theta_s <= axis_inclination_deg: a board hanging straight below its grasp has theta_s = 0 at
+// any inclination of the axis.
+double slip_angle_deg(const Eigen::Vector3d& axis, const Eigen::Vector3d& lever,
+                      const Eigen::Vector3d& gravity_direction);
+
+// Unit direction from the grasp axis (through `contact_centre` along unit `axis`) to the centre
+// of mass, perpendicular to the axis; zero when the centre of mass lies on the axis.
+Eigen::Vector3d lever_direction(const Eigen::Vector3d& axis, const Eigen::Vector3d& contact_centre,
+                                const Eigen::Vector3d& com);
+
 struct RelaxationSettings {
   double step_deg = 1.0;  // the paper's even steps
 };

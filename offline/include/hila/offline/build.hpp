@@ -7,7 +7,10 @@
 
 #include "hila/core/cell.hpp"
 #include "hila/core/product.hpp"
+#include "hila/core/human_model.hpp"
 #include "hila/offline/comfort_map.hpp"
+#include "hila/offline/ergonomics.hpp"
+#include "hila/offline/handover.hpp"
 #include "hila/offline/human_grasps.hpp"
 #include "hila/offline/robot_grasps.hpp"
 #include "hila/offline/suction_grasps.hpp"
@@ -21,6 +24,11 @@ struct BuildSettings {
   SuctionSettings suction;
   HumanGraspSettings human;
   ComfortMapSettings comfort;  // one map per human arm of the cell
+  HandoverSettings handover;
+  ErgonomicsSettings ergonomics;
+  // Empty: handover goals must be comfortable for the cell's human. Otherwise for every body of
+  // the set (statures and sexes, served by the cell human's maps; see HumanComfort).
+  std::vector<core::HumanBodySpec> human_bodies;
 };
 
 struct PartBuildSummary {
@@ -35,6 +43,18 @@ struct PartBuildSummary {
   double theta_c_min_deg = 90.0;
   double theta_c_max_deg = 90.0;
   double seconds = 0.0;
+  // Handover goals (paper §IV, §VI-B).
+  int handover_draws = 0;
+  int handover_candidates = 0;
+  int comfortable = 0;               // |S|
+  int comfortable_default_body = 0;  // |S| for the cell's human alone
+  int goals = 0;                     // |𝕊|
+  int robot_handovers = 0;
+  bool two_hands = false;
+  double goal_quality = 0.0;   // the first goal's
+  double goal_distance = 0.0;  // Eq. 8
+  std::string handover_failure;  // empty when the board has goals
+  double handover_seconds = 0.0;
 };
 
 struct ComfortMapSummary {
@@ -49,6 +69,8 @@ struct BuildSummary {
   std::vector<PartBuildSummary> parts;  // in assembly order
   std::vector<ComfortMapSummary> comfort_maps;  // in the cell's human-arm order
   double seconds = 0.0;
+  // Boards without a handover goal (the database is still written, with the reason stored).
+  std::vector<std::string> failed_parts() const;
 };
 
 // Called as each part finishes (from a worker thread, serialised): name, parts done, total.
@@ -65,7 +87,10 @@ std::string settings_hash(const BuildSettings& settings);
 std::uint64_t part_seed(std::uint64_t seed, const std::string& part_name, std::uint64_t stream);
 
 // Builds the product database: part analysis, robot grasps with theta_c, suction and human
-// grasps, in parallel over parts, written atomically (the previous file survives any failure).
+// grasps and the human comfort maps (in parallel over parts and arms), then per board its
+// handover goals and the ergonomics comparison (in parallel over boards); written atomically
+// (the previous file survives any failure). A board without a handover goal does not stop the
+// build: its stage record says why and BuildSummary::failed_parts() lists it.
 // Throws core::InputError for bad input, naming the file, the part and the field.
 BuildSummary build_database(const std::string& product_path, const std::string& cell_path,
                             const std::string& output_path, const BuildSettings& settings,

@@ -1,0 +1,84 @@
+#include "hila/core/stage_scene.hpp"
+
+#include "hila/core/error.hpp"
+
+namespace hila::core {
+
+namespace {
+
+// The body of `link` or, when it has no geometry, of its nearest ancestor with geometry.
+int body_of_link_or_ancestor(const RobotModel& robot, const RobotBodies& bodies, int link) {
+  while (link >= 0) {
+    const int body = bodies.link_to_body[static_cast<std::size_t>(link)];
+    if (body >= 0) return body;
+    const int joint = robot.links()[static_cast<std::size_t>(link)].parent_joint;
+    link = joint < 0 ? -1 : robot.joints()[static_cast<std::size_t>(joint)].parent_link;
+  }
+  return -1;
+}
+
+}  // namespace
+
+Pose arm_base_in_world(const Cell& cell, const Arm& arm) {
+  std::vector<Pose> poses;
+  cell.robot().link_poses(cell.home_configuration(), poses);
+  return poses[static_cast<std::size_t>(cell.robot().link_index(arm.spec.base_link))];
+}
+
+StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
+                             const std::vector<PlacedPart>& finished,
+                             const std::string& suction_arm) {
+  StageScene scene;
+  scene.cell = build_cell_scene(cell);
+  CollisionModel& model = scene.cell.model;
+  for (const PlacedPart& p : finished) {
+    scene.finished.push_back(model.add_mesh_body("finished/" + p.name, *p.mesh, true, p.pose));
+  }
+  scene.board = model.add_mesh_body("board", board, false);
+
+  const RobotModel& tool = cell.suction_tool();
+  scene.tool = add_robot(model, tool, "tool/");
+  for (const int b : scene.tool.link_to_body) {
+    if (b >= 0) scene.tool_bodies.push_back(b);
+  }
+  const auto& arms = cell.arms();
+  for (std::size_t a = 0; a < arms.size(); ++a) {
+    if (arms[a].spec.name == suction_arm) scene.suction_arm = static_cast<int>(a);
+  }
+  if (scene.suction_arm < 0) {
+    throw InputError(cell.spec().file, "suction arm", "the name of an arm of the cell",
+                     "'" + suction_arm + "'");
+  }
+  const Arm& arm = arms[static_cast<std::size_t>(scene.suction_arm)];
+  const int handle = body_of_link_or_ancestor(
+      tool, scene.tool, tool.link_index(cell.spec().suction.handle_link));
+  const int cup = body_of_link_or_ancestor(tool, scene.tool,
+                                           tool.link_index(cell.spec().suction.cup_link));
+  // The handle sits in the hand: it may touch every body from the flange on.
+  const auto hand = subtree_bodies(cell.robot(), scene.cell.robot,
+                                   cell.robot().link_index(arm.spec.flange_link));
+  for (const int h : hand) {
+    if (handle >= 0) model.allow(handle, h);
+  }
+  if (cup >= 0) model.allow(cup, scene.board);
+
+  std::vector<Pose> poses;
+  tool.link_poses(tool.neutral_configuration(), poses);
+  const Pose handle_to_cup =
+      poses[static_cast<std::size_t>(tool.link_index(cell.spec().suction.handle_link))].inverse() *
+      poses[static_cast<std::size_t>(tool.link_index(cell.spec().suction.cup_link))];
+  scene.cup_in_tcp = cell.spec().suction.handle_in_tcp * handle_to_cup;
+  return scene;
+}
+
+void set_tool_held(const Cell& cell, const StageScene& scene, CollisionData& data,
+                   const Pose& tcp) {
+  const RobotModel& tool = cell.suction_tool();
+  std::vector<Pose> poses;
+  tool.link_poses(tool.neutral_configuration(), poses);
+  const Pose root_in_handle =
+      poses[static_cast<std::size_t>(tool.link_index(cell.spec().suction.handle_link))].inverse();
+  set_robot_pose(data, scene.tool, poses, tcp * cell.spec().suction.handle_in_tcp * root_in_handle);
+}
+
+}  // namespace hila::core

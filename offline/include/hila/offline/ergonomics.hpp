@@ -1,0 +1,70 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+#include "hila/db/records.hpp"
+#include "hila/offline/human_comfort.hpp"
+
+namespace hila::offline {
+
+struct ErgonomicsSettings {
+  // Where a robot without regard to ergonomics lays every board down: flat on the table in front
+  // of the human, beside the assembly, longest side across the human (world, m).
+  double table_spot_x = 0.68;
+  double table_spot_y = 0.55;
+  double flexion_step_deg = 5.0;   // torso flexion searched in these steps up to its limit
+  double bent_forward_deg = 20.0;  // EAWS (the paper's Table 2): bent forward from 20 degrees
+  int candidates_per_step = 3;     // best map-scored grasps confirmed by direct IK per step
+  int ik_attempts = 12;
+  std::uint64_t seed = 5;
+};
+
+// How the human takes a board at `board` (world): the least torso flexion (in steps) at which
+// one of `grasps` (indices into `human_grasps`) is reachable by an arm, then the most
+// comfortable of the best map-scored grasps there by direct IK. `stance` is where the human
+// stands. With `only_arm` >= 0 just that arm is used.
+struct Posture {
+  bool reachable = false;
+  double torso_flexion_deg = 0.0;
+  bool shoulder_elevated = false;  // elbow at or above the shoulder
+  double reach = 0.0;              // shoulder to the grasp point, m
+  double quality = 0.0;            // Q of the arm at the posture (paper Eq. 4)
+  int arm = -1;
+  int grasp = -1;
+  Eigen::VectorXd arm_joints;
+};
+
+Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
+                          const core::Pose& stance, const core::Pose& board,
+                          const std::vector<db::HumanGraspRecord>& human_grasps,
+                          const std::vector<int>& grasps, int only_arm,
+                          const ErgonomicsSettings& settings);
+
+struct ErgonomicsInputs {
+  core::Pose target = core::Pose::Identity();   // world
+  core::Pose initial = core::Pose::Identity();  // on the stack, world
+  core::Pose table_placement = core::Pose::Identity();  // part in plane (z up), most stable
+  const std::vector<db::HumanGraspRecord>* human_grasps = nullptr;
+  // The first handover goal, if any: board pose, arm index and grasp index.
+  bool has_goal = false;
+  core::Pose goal = core::Pose::Identity();
+  int goal_arm = -1;
+  int goal_grasp = -1;
+};
+
+// The three ways of getting one board to the human (records in the order hila, table, alone):
+// hila's first goal with its human grasp; the board laid flat at the table spot; the human alone
+// stepping sideways to face the stack and taking the board from it. Board-specific inputs only;
+// part_id is left unset.
+std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
+                                                      const HumanComfort& comfort,
+                                                      const ErgonomicsInputs& inputs,
+                                                      const ErgonomicsSettings& settings);
+
+// The world pose of a board laid on the table at the spot with `placement` (part in plane).
+core::Pose table_drop_pose(const core::Cell& cell, const core::Pose& placement,
+                           const ErgonomicsSettings& settings);
+
+}  // namespace hila::offline

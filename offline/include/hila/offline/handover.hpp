@@ -1,0 +1,74 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/product.hpp"
+#include "hila/db/records.hpp"
+#include "hila/offline/human_comfort.hpp"
+
+namespace hila::offline {
+
+struct HandoverSettings {
+  // Eq. 1: candidates around the target pose.
+  int candidates = 500;            // poses satisfying Eq. 1 kept per board
+  int max_draws = 100000;          // give up drawing after this many
+  double max_rotation_deg = 45.0;  // from the target orientation
+  double max_offset = 0.5;         // m from the target position
+  // S (Eq. 9): the best human grasp's Q must exceed this. The cell human's Q peaks near 0.15
+  // (a 7-DoF arm with the reach as length scale); 0.06 keeps the better ~40 % of the reachable
+  // hand poses.
+  double comfort_threshold = 0.06;
+  double two_hand_separation = 0.20;  // m between the two hands' grasp points (two-hand boards)
+  // Eq. 8: distance = position offset + rotation_weight * rotation angle (m per rad): 10 degrees
+  // count as 3.5 cm.
+  double rotation_weight = 0.2;
+  // Robot-robot handover: the suction arm holds the board at its CoM in the shared workspace.
+  std::string suction_arm = "right";
+  std::string receiving_arm = "left";
+  std::vector<Eigen::Vector3d> rr_positions = {
+      {0.35, -0.08, 1.30}, {0.35, 0.0, 1.30}, {0.35, 0.08, 1.30}, {0.45, -0.08, 1.30},
+      {0.45, 0.0, 1.30},   {0.45, 0.08, 1.30}, {0.35, 0.0, 1.42}, {0.45, 0.0, 1.42},
+      {0.40, 0.0, 1.20}};
+  int rr_orientations = 64;  // board orientations tried per position (spread over SO(3))
+  int rr_poses = 24;         // suction-feasible robot-robot poses examined for receiving grasps
+  int shared_stored = 8;     // shared grasps searched for and stored per goal
+  int human_ik_goals = 5;    // goals whose human posture is solved by direct IK and stored
+  std::uint64_t seed = 3;
+};
+
+// The result for one board, with references given as 0-based indices into the inputs (robot,
+// suction and human grasp vectors, robot_handovers, candidates) and -1 for none; the database
+// writer turns them into ids.
+struct HandoverResult {
+  db::HandoverStageRecord stage;
+  std::vector<db::RobotHandoverRecord> robot_handovers;
+  std::vector<db::HandoverCandidateRecord> candidates;  // in sample order
+  std::vector<db::SharedGraspRecord> shared;            // for the goals, by rank
+  double seconds = 0.0;
+};
+
+struct BoardGrasps {
+  std::vector<db::RobotGraspRecord> robot;
+  std::vector<db::SuctionGraspRecord> suction;
+  std::vector<db::HumanGraspRecord> human;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();  // part frame
+};
+
+// Handover goals of product.parts[index] at its assembly stage (the parts before it finished at
+// their targets): Eq. 1 candidates, S by the comfort maps, robot-robot handover poses, 𝕊 by
+// shared grasps (receiving-arm IK, slip angle within theta_c and collision-free at both poses),
+// ranked by Eq. 8. Never throws for an infeasible board: stage.failure says why.
+HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSpec& product,
+                                   std::size_t index, const BoardGrasps& grasps,
+                                   const HumanComfort& comfort, const HandoverSettings& settings);
+
+// Eq. 8 distance between two poses.
+double handover_distance(const core::Pose& a, const core::Pose& b, double rotation_weight);
+// Rotation angle between two orientations, degrees.
+double rotation_angle_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
+
+}  // namespace hila::offline

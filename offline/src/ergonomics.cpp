@@ -1,0 +1,179 @@
+#include "hila/offline/ergonomics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hila/core/robot_model.hpp"
+#include "hila/offline/comfort.hpp"
+#include "hila/offline/handover.hpp"
+
+namespace hila::offline {
+
+namespace {
+
+// The configuration variable that bends the torso forward: the joint above the arms' base link.
+int torso_variable(const core::Cell& cell) {
+  if (cell.human_arms().empty()) return -1;
+  const auto& human = cell.human();
+  const int link = human.link_index(cell.human_arms().front().spec.base_link);
+  const int joint = human.links()[static_cast<std::size_t>(link)].parent_joint;
+  return joint < 0 ? -1 : human.joints()[static_cast<std::size_t>(joint)].variable;
+}
+
+struct Scored {
+  double map_quality;
+  double shoulder_distance;
+  int arm;
+  int grasp;
+};
+
+}  // namespace
+
+core::Pose table_drop_pose(const core::Cell& cell, const core::Pose& placement,
+                           const ErgonomicsSettings& settings) {
+  double top = 0.0;
+  for (const auto& o : cell.spec().obstacles) {
+    top = std::max(top, o.pose.translation().z() + 0.5 * o.size.z());
+  }
+  // Longest side across the human: turn the part's x axis (its length) onto world y.
+  const Eigen::Vector3d x = placement.linear().col(0);
+  const double yaw = std::atan2(1.0, 0.0) - std::atan2(x.y(), x.x());
+  core::Pose pose = core::Pose::Identity();
+  pose.translation() = Eigen::Vector3d(settings.table_spot_x, settings.table_spot_y, top);
+  pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  core::Pose on_plane = placement;
+  on_plane.translation().head<2>().setZero();  // the part's origin over the spot
+  return pose * on_plane;
+}
+
+Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
+                          const core::Pose& stance, const core::Pose& board,
+                          const std::vector<db::HumanGraspRecord>& human_grasps,
+                          const std::vector<int>& grasps, int only_arm,
+                          const ErgonomicsSettings& settings) {
+  Posture posture;
+  const auto& human = cell.human();
+  const int torso = torso_variable(cell);
+  const double max_flexion =
+      torso < 0 ? 0.0 : core::rad_to_deg(human.upper_limits()[torso]);
+  Eigen::VectorXd q = cell.human_neutral();
+  std::vector<core::Pose> links;
+  ComfortSettings ik;
+  ik.ik_attempts = settings.ik_attempts;
+  ik.seed = settings.seed;
+  for (double flexion = 0.0; flexion <= max_flexion + 1e-9; flexion += settings.flexion_step_deg) {
+    if (torso >= 0) q[torso] = core::deg_to_rad(flexion);
+    human.link_poses(q, links);
+    std::vector<Scored> scored;
+    for (int a = 0; a < static_cast<int>(cell.human_arms().size()); ++a) {
+      if (only_arm >= 0 && a != only_arm) continue;
+      const auto& arm = cell.human_arms()[static_cast<std::size_t>(a)];
+      const core::Pose base =
+          stance * links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
+      const core::Pose base_inv = base.inverse();
+      for (const int g : grasps) {
+        const core::Pose hand = base_inv * board * human_grasps[static_cast<std::size_t>(g)].hand;
+        scored.push_back({comfort.map(a).lookup(hand),
+                          (hand.translation() - arm.chain.first_joint_position()).norm(), a, g});
+      }
+    }
+    // Best by the map first; map misses (unsampled bins) by nearness to the shoulder.
+    std::stable_sort(scored.begin(), scored.end(), [](const Scored& x, const Scored& y) {
+      if (x.map_quality != y.map_quality) return x.map_quality > y.map_quality;
+      return x.shoulder_distance < y.shoulder_distance;
+    });
+    const auto take = std::min<std::size_t>(scored.size(),
+                                            static_cast<std::size_t>(settings.candidates_per_step));
+    for (std::size_t i = 0; i < take; ++i) {
+      const Scored& s = scored[i];
+      const auto& arm = cell.human_arms()[static_cast<std::size_t>(s.arm)];
+      const core::Pose base =
+          stance * links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
+      const core::Pose hand =
+          base.inverse() * board * human_grasps[static_cast<std::size_t>(s.grasp)].hand;
+      const Eigen::VectorXd seed = Eigen::VectorXd::Zero(arm.chain.dof())
+                                       .cwiseMax(arm.chain.lower_limits())
+                                       .cwiseMin(arm.chain.upper_limits());
+      const ComfortResult r = best_comfort(arm.chain, hand, seed, ik);
+      if (r.reachable && (!posture.reachable || r.quality > posture.quality)) {
+        posture.reachable = true;
+        posture.quality = r.quality;
+        posture.arm = s.arm;
+        posture.grasp = s.grasp;
+        posture.arm_joints = r.joints;
+        posture.torso_flexion_deg = flexion;
+      }
+    }
+    if (posture.reachable) break;
+  }
+  if (!posture.reachable) return posture;
+  // Shoulder and elbow heights at the posture.
+  const auto& arm = cell.human_arms()[static_cast<std::size_t>(posture.arm)];
+  const auto& vars = arm.chain.model_variables();
+  for (std::size_t i = 0; i < vars.size(); ++i) {
+    q[vars[i]] = posture.arm_joints[static_cast<Eigen::Index>(i)];
+  }
+  human.link_poses(q, links);
+  auto joint_position = [&](const std::string& name) {
+    const auto& joint = human.joints()[static_cast<std::size_t>(human.joint_index(name))];
+    return (stance * links[static_cast<std::size_t>(joint.child_link)]).translation();
+  };
+  const auto& names = arm.chain.joint_names();
+  const Eigen::Vector3d shoulder = joint_position(names.front());
+  std::string elbow_name = names.size() > 3 ? names[3] : names.back();
+  for (const auto& n : names) {
+    if (n.find("elbow") != std::string::npos) elbow_name = n;
+  }
+  const Eigen::Vector3d elbow = joint_position(elbow_name);
+  posture.shoulder_elevated = elbow.z() >= shoulder.z();
+  const core::Pose hand_world =
+      board * human_grasps[static_cast<std::size_t>(posture.grasp)].hand;
+  posture.reach = (hand_world.translation() - shoulder).norm();
+  return posture;
+}
+
+std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
+                                                      const HumanComfort& comfort,
+                                                      const ErgonomicsInputs& in,
+                                                      const ErgonomicsSettings& settings) {
+  const auto& grasps = *in.human_grasps;
+  std::vector<int> one_hand, all;
+  for (std::size_t g = 0; g < grasps.size(); ++g) {
+    all.push_back(static_cast<int>(g));
+    if (grasps[g].one_hand_stable) one_hand.push_back(static_cast<int>(g));
+  }
+  // Two-hand boards: the posture of one hand (the better one) stands for both.
+  const std::vector<int>& usable = one_hand.empty() ? all : one_hand;
+  auto record = [&](const std::string& method, const core::Pose& board, const Posture& p) {
+    db::ErgonomicsRecord r;
+    r.method = method;
+    r.reachable = p.reachable;
+    r.torso_flexion_deg = p.torso_flexion_deg;
+    r.shoulder_elevated = p.shoulder_elevated;
+    r.reach = p.reach;
+    r.reorientation_deg = rotation_angle_deg(board.linear(), in.target.linear());
+    r.quality = p.quality;
+    r.arm = p.arm >= 0 ? comfort.arm_name(p.arm) : "";
+    return r;
+  };
+  std::vector<db::ErgonomicsRecord> out;
+  const core::Pose stance = cell.spec().human_stance;
+  if (in.has_goal) {
+    const Posture p = receiving_posture(cell, comfort, stance, in.goal, grasps, {in.goal_grasp},
+                                        in.goal_arm, settings);
+    out.push_back(record("hila", in.goal, p));
+  }
+  const core::Pose table = table_drop_pose(cell, in.table_placement, settings);
+  out.push_back(record("table", table,
+                       receiving_posture(cell, comfort, stance, table, grasps, usable, -1,
+                                         settings)));
+  // Alone, the human steps sideways to face the stack.
+  core::Pose at_stack = stance;
+  at_stack.translation().y() = in.initial.translation().y();
+  out.push_back(record("alone", in.initial,
+                       receiving_posture(cell, comfort, at_stack, in.initial, grasps, usable, -1,
+                                         settings)));
+  return out;
+}
+
+}  // namespace hila::offline

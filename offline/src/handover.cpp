@@ -1,0 +1,567 @@
+#include "hila/offline/handover.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+
+#include "hila/core/collision.hpp"
+#include "hila/core/error.hpp"
+#include "hila/core/soft_finger.hpp"
+#include "hila/core/stage_scene.hpp"
+#include "hila/offline/comfort.hpp"
+#include "hila/offline/comfort_map.hpp"
+#include "hila/offline/human_grasps.hpp"
+
+namespace hila::offline {
+
+namespace {
+
+const core::Pose kParked = core::Pose(Eigen::Translation3d(100.0, 100.0, 100.0));
+const Eigen::Vector3d kDown(0.0, 0.0, -1.0);
+
+double uniform01(std::mt19937_64& rng) {
+  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
+}
+
+// Fisher-Yates with the raw generator: the same order on every standard library.
+void shuffle(std::vector<int>& v, std::mt19937_64& rng) {
+  for (std::size_t i = v.size(); i > 1; --i) std::swap(v[i - 1], v[rng() % i]);
+}
+
+// A rotation drawn uniformly (Haar measure) from the ball of angle < max_angle about identity:
+// axis uniform on the sphere, angle with density proportional to 1 - cos(angle).
+Eigen::Matrix3d random_rotation_within(double max_angle, std::mt19937_64& rng) {
+  Eigen::Vector3d axis;
+  do {
+    axis = Eigen::Vector3d(2 * uniform01(rng) - 1, 2 * uniform01(rng) - 1, 2 * uniform01(rng) - 1);
+  } while (axis.squaredNorm() > 1.0 || axis.squaredNorm() < 1e-6);
+  axis.normalize();
+  const double u = uniform01(rng) * (max_angle - std::sin(max_angle));
+  double lo = 0.0, hi = max_angle;
+  for (int i = 0; i < 60; ++i) {  // inverse of F(t) = t - sin t
+    const double mid = 0.5 * (lo + hi);
+    (mid - std::sin(mid) < u ? lo : hi) = mid;
+  }
+  return Eigen::AngleAxisd(0.5 * (lo + hi), axis).toRotationMatrix();
+}
+
+Eigen::Vector3d random_in_ball(double radius, std::mt19937_64& rng) {
+  Eigen::Vector3d u;
+  do {
+    u = Eigen::Vector3d(2 * uniform01(rng) - 1, 2 * uniform01(rng) - 1, 2 * uniform01(rng) - 1);
+  } while (u.squaredNorm() >= 1.0);
+  return radius * u;
+}
+
+// A human hand as three bodies (palm, two fingers) in a collision model.
+struct HandBodies {
+  int fixed = -1, finger_pos = -1, finger_neg = -1;
+  std::vector<int> all() const { return {fixed, finger_pos, finger_neg}; }
+};
+
+HandBodies add_hand(core::CollisionModel& model, const HandGeometry& hand, const std::string& name,
+                    int board) {
+  HandBodies h;
+  h.fixed = model.add_body(name + "/palm", hand.fixed, false, kParked);
+  h.finger_pos = model.add_body(name + "/finger+", hand.finger_pos, false, kParked);
+  h.finger_neg = model.add_body(name + "/finger-", hand.finger_neg, false, kParked);
+  for (const int b : h.all()) {
+    model.allow(b, board);  // the hand holds the board
+    for (const int c : h.all()) {
+      if (b != c) model.allow(b, c);
+    }
+  }
+  return h;
+}
+
+void place_hand(core::CollisionData& data, const HandBodies& h, const core::Pose& grasp_world,
+                double opening) {
+  data.set_body_pose(h.fixed, grasp_world);
+  data.set_body_pose(h.finger_pos,
+                     grasp_world * Eigen::Translation3d(0.0, 0.5 * opening, 0.0));
+  data.set_body_pose(h.finger_neg,
+                     grasp_world * Eigen::Translation3d(0.0, -0.5 * opening, 0.0));
+}
+
+void park_hand(core::CollisionData& data, const HandBodies& h) {
+  for (const int b : h.all()) data.set_body_pose(b, kParked);
+}
+
+// The human's choice at one candidate pose.
+struct HumanChoice {
+  double quality = 0.0;          // over the body set (weaker hand for two hands)
+  double default_quality = 0.0;  // the cell's human alone
+  int arm = -1, grasp = -1;
+  double arm_quality = 0.0;
+  int second_arm = -1, second_grasp = -1;
+  double second_quality = 0.0;
+};
+
+struct ScoredGrasp {
+  double quality;
+  double default_quality;
+  int grasp;
+};
+
+// Grasps of `arm` at `board`, best first, with positive Q.
+std::vector<ScoredGrasp> score_grasps(const HumanComfort& comfort, int arm,
+                                      const core::Pose& board,
+                                      const std::vector<db::HumanGraspRecord>& grasps,
+                                      const std::vector<int>& eligible) {
+  std::vector<ScoredGrasp> out;
+  for (const int g : eligible) {
+    const core::Pose hand = board * grasps[static_cast<std::size_t>(g)].hand;
+    const double q = comfort.worst_quality(arm, hand);
+    const double q0 = comfort.body_count() ? comfort.quality(arm, hand) : q;
+    if (q > 0.0 || q0 > 0.0) out.push_back({q, q0, g});
+  }
+  std::stable_sort(out.begin(), out.end(), [](const ScoredGrasp& a, const ScoredGrasp& b) {
+    return a.quality > b.quality;
+  });
+  return out;
+}
+
+struct Receiving {
+  int grasp = -1;
+  Eigen::VectorXd joints;
+  double slip_deg = 0.0;
+};
+
+}  // namespace
+
+double rotation_angle_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return core::rad_to_deg(Eigen::AngleAxisd(a.transpose() * b).angle());
+}
+
+double handover_distance(const core::Pose& a, const core::Pose& b, double rotation_weight) {
+  return (a.translation() - b.translation()).norm() +
+         rotation_weight * Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+}
+
+HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSpec& product,
+                                   std::size_t index, const BoardGrasps& grasps,
+                                   const HumanComfort& comfort, const HandoverSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  const core::PartSpec& part = product.parts[index];
+  const core::Pose target = product.target_in_world(part);
+  HandoverResult result;
+  auto& stage = result.stage;
+  std::vector<core::PlacedPart> finished;
+  for (std::size_t i = 0; i < index; ++i) {
+    const auto& p = product.parts[i];
+    stage.finished_parts.push_back(p.name);
+    finished.push_back({p.name, &p.mesh, product.target_in_world(p)});
+  }
+
+  // --- Scenes -----------------------------------------------------------------------------
+  // Screening (Eq. 1 and the human's hands): finished parts, the table taken as solid down to
+  // the floor (a board under the table top is no handover), the human's body.
+  const HandGeometry hand_geometry = human_hand_geometry(cell.spec().human_hand);
+  core::CollisionModel screen;
+  const core::RobotBodies screen_human = core::add_robot(screen, cell.human(), "human/", true);
+  const double floor_z = cell.spec().human_stance.translation().z();
+  for (const auto& o : cell.spec().obstacles) {
+    const double top = o.pose.translation().z() + 0.5 * o.size.z();
+    core::GeometrySpec box;
+    box.box_size = Eigen::Vector3d(o.size.x(), o.size.y(), top - floor_z);
+    core::Pose pose = o.pose;
+    pose.translation().z() = 0.5 * (top + floor_z);
+    screen.add_body(o.name, {box}, true, pose);
+  }
+  for (const auto& f : finished) screen.add_mesh_body("finished/" + f.name, *f.mesh, true, f.pose);
+  const int screen_board = screen.add_mesh_body("board", part.mesh, false, kParked);
+  const HandBodies screen_hands[2] = {add_hand(screen, hand_geometry, "hand0", screen_board),
+                                      add_hand(screen, hand_geometry, "hand1", screen_board)};
+  for (const int h0 : screen_hands[0].all()) {
+    for (const int h1 : screen_hands[1].all()) screen.allow(h0, h1);  // two hands may touch
+  }
+  core::CollisionData screen_data(screen);
+  {
+    std::vector<core::Pose> poses;
+    cell.human().link_poses(cell.human_neutral(), poses);
+    core::set_robot_pose(screen_data, screen_human, poses, cell.spec().human_stance);
+  }
+
+  // Robot checks: the stage scene with the human's hands at the receiving grasp.
+  core::StageScene scene = core::build_stage_scene(cell, part.mesh, finished, settings.suction_arm);
+  const HandBodies robot_hands[2] = {
+      add_hand(scene.cell.model, hand_geometry, "hand0", scene.board),
+      add_hand(scene.cell.model, hand_geometry, "hand1", scene.board)};
+  core::CollisionData data(scene.cell.model);
+  const core::Arm& suction_arm = cell.arms()[static_cast<std::size_t>(scene.suction_arm)];
+  const core::Arm& receiving_arm = cell.arm(settings.receiving_arm);
+  int receiving_index = 0;
+  while (&cell.arms()[static_cast<std::size_t>(receiving_index)] != &receiving_arm) ++receiving_index;
+  const std::vector<int>& receiving_bodies =
+      scene.cell.arm_bodies[static_cast<std::size_t>(receiving_index)];
+  std::vector<int> suction_bodies =
+      scene.cell.arm_bodies[static_cast<std::size_t>(scene.suction_arm)];
+  suction_bodies.insert(suction_bodies.end(), scene.tool_bodies.begin(), scene.tool_bodies.end());
+  suction_bodies.push_back(scene.board);
+  const core::Pose suction_base_inv = core::arm_base_in_world(cell, suction_arm).inverse();
+  const core::Pose receiving_base_inv = core::arm_base_in_world(cell, receiving_arm).inverse();
+  const Eigen::VectorXd home_q = cell.home_configuration();
+  const core::Pose suction_home_tcp =
+      core::arm_base_in_world(cell, suction_arm) * suction_arm.chain.fk(suction_arm.spec.home);
+  Eigen::VectorXd robot_q = home_q;
+  const Eigen::VectorXd human_q = cell.human_neutral();
+  auto reset_state = [&] {
+    robot_q = home_q;
+    core::set_cell_state(cell, scene.cell, data, robot_q, human_q);
+    core::set_tool_held(cell, scene, data, suction_home_tcp);
+    data.set_body_pose(scene.board, kParked);
+    park_hand(data, robot_hands[0]);
+    park_hand(data, robot_hands[1]);
+  };
+  reset_state();
+
+  // --- Human grasps usable for this board -------------------------------------------------
+  std::vector<int> eligible;
+  for (std::size_t g = 0; g < grasps.human.size(); ++g) {
+    if (grasps.human[g].one_hand_stable) eligible.push_back(static_cast<int>(g));
+  }
+  stage.two_hands = eligible.empty();
+  if (stage.two_hands) {
+    for (std::size_t g = 0; g < grasps.human.size(); ++g) eligible.push_back(static_cast<int>(g));
+  }
+  auto human_hand_clear = [&](const core::Pose& board, int hand_slot, int grasp) {
+    const auto& g = grasps.human[static_cast<std::size_t>(grasp)];
+    place_hand(screen_data, screen_hands[hand_slot], board * g.hand, g.aperture + 0.01);
+    const bool clear = !core::in_collision(screen, screen_data, screen_hands[hand_slot].all());
+    return clear;
+  };
+
+  auto choose_human = [&](const core::Pose& board) {
+    HumanChoice best;
+    screen_data.set_body_pose(screen_board, board);
+    const int arms = comfort.arm_count();
+    if (!stage.two_hands) {
+      for (int a = 0; a < arms; ++a) {
+        int tried = 0;
+        for (const auto& s : score_grasps(comfort, a, board, grasps.human, eligible)) {
+          if (s.quality <= best.quality && s.default_quality <= best.default_quality) break;
+          if (++tried > 12) break;
+          if (!human_hand_clear(board, 0, s.grasp)) continue;
+          best.default_quality = std::max(best.default_quality, s.default_quality);
+          if (s.quality > best.quality) {
+            best.quality = s.quality;
+            best.arm = a;
+            best.grasp = s.grasp;
+            best.arm_quality = s.quality;
+          }
+        }
+      }
+      park_hand(screen_data, screen_hands[0]);
+      return best;
+    }
+    // Two hands: one grasp per arm, far enough apart, both clear.
+    if (arms < 2) return best;
+    std::vector<ScoredGrasp> lists[2];
+    for (int a = 0; a < 2; ++a) {
+      for (const auto& s : score_grasps(comfort, a, board, grasps.human, eligible)) {
+        if (lists[a].size() >= 10) break;
+        if (human_hand_clear(board, a, s.grasp)) lists[a].push_back(s);
+      }
+    }
+    for (const auto& s0 : lists[0]) {
+      for (const auto& s1 : lists[1]) {
+        const double q = std::min(s0.quality, s1.quality);
+        const double q0 = std::min(s0.default_quality, s1.default_quality);
+        if (q <= best.quality && q0 <= best.default_quality) continue;
+        const auto& g0 = grasps.human[static_cast<std::size_t>(s0.grasp)];
+        const auto& g1 = grasps.human[static_cast<std::size_t>(s1.grasp)];
+        if ((g0.hand.translation() - g1.hand.translation()).norm() <
+            settings.two_hand_separation) {
+          continue;
+        }
+        place_hand(screen_data, screen_hands[0], board * g0.hand, g0.aperture + 0.01);
+        place_hand(screen_data, screen_hands[1], board * g1.hand, g1.aperture + 0.01);
+        if (core::in_collision(screen, screen_data, screen_hands[0].all())) continue;
+        best.default_quality = std::max(best.default_quality, q0);
+        if (q > best.quality) {
+          best.quality = q;
+          best.arm = 0;
+          best.grasp = s0.grasp;
+          best.arm_quality = s0.quality;
+          best.second_arm = 1;
+          best.second_grasp = s1.grasp;
+          best.second_quality = s1.quality;
+        }
+      }
+    }
+    park_hand(screen_data, screen_hands[0]);
+    park_hand(screen_data, screen_hands[1]);
+    return best;
+  };
+
+  // --- Eq. 1 candidates and S ----------------------------------------------------------------
+  std::mt19937_64 rng(settings.seed);
+  const double max_rotation = core::deg_to_rad(settings.max_rotation_deg);
+  std::vector<HumanChoice> choices;
+  double best_q = 0.0;
+  while (static_cast<int>(result.candidates.size()) < settings.candidates &&
+         stage.draws < settings.max_draws) {
+    ++stage.draws;
+    core::Pose pose = core::Pose::Identity();
+    pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
+    pose.translation() = target.translation() + random_in_ball(settings.max_offset, rng);
+    screen_data.set_body_pose(screen_board, pose);
+    if (core::in_collision(screen, screen_data, {screen_board})) continue;
+    db::HandoverCandidateRecord c;
+    c.sample = static_cast<int>(result.candidates.size());
+    c.board = pose;
+    c.distance = handover_distance(pose, target, settings.rotation_weight);
+    const HumanChoice h = choose_human(pose);
+    c.quality = h.quality;
+    best_q = std::max(best_q, h.quality);
+    c.status = "uncomfortable";
+    if (h.grasp >= 0) {
+      c.human_arm = comfort.arm_name(h.arm);
+      c.human_grasp_id = h.grasp;
+      c.human_quality = h.arm_quality;
+    } else {
+      c.human_grasp_id = -1;
+    }
+    c.second_grasp_id = -1;
+    if (h.second_grasp >= 0) {
+      c.second_arm = comfort.arm_name(h.second_arm);
+      c.second_grasp_id = h.second_grasp;
+      c.second_quality = h.second_quality;
+    }
+    if (h.default_quality > settings.comfort_threshold) ++stage.comfortable_default_body;
+    if (h.quality > settings.comfort_threshold) {
+      ++stage.comfortable;
+      c.status = "no_shared_grasp";
+    }
+    result.candidates.push_back(c);
+    choices.push_back(h);
+  }
+  screen_data.set_body_pose(screen_board, kParked);
+  stage.candidates = static_cast<int>(result.candidates.size());
+  auto finish = [&](const std::string& failure) {
+    stage.failure = failure;
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  };
+  if (stage.candidates == 0) {
+    return finish("no pose within " + core::format_number(settings.max_rotation_deg) +
+                  " deg and " + core::format_number(settings.max_offset) +
+                  " m of the target is clear of the finished parts, the table and the human (" +
+                  std::to_string(stage.draws) + " draws)");
+  }
+  if (stage.comfortable == 0) {
+    if (best_q <= 0.0) {
+      return finish("the human reaches none of the " + std::to_string(stage.candidates) +
+                    " candidates around the target (is the target within reach of the stance?)");
+    }
+    return finish("no candidate is comfortable: the best human Q is " +
+                  core::format_number(best_q) + ", the threshold " +
+                  core::format_number(settings.comfort_threshold));
+  }
+
+  // --- Robot grasp geometry: opening axis and lever direction in the part frame ---------------
+  const Eigen::Vector3d opening_tcp = cell.spec().gripper.opening_axis.normalized();
+  const double jaw_margin = 0.005;
+  std::vector<Eigen::Vector3d> axis_part, lever_part;
+  for (const auto& g : grasps.robot) {
+    const Eigen::Vector3d a = g.tcp.linear() * opening_tcp;
+    axis_part.push_back(a);
+    lever_part.push_back(core::lever_direction(a, 0.5 * (g.contact_1 + g.contact_2), grasps.com));
+  }
+  auto slip_at = [&](const core::Pose& board, int g) {
+    const auto gi = static_cast<std::size_t>(g);
+    return core::slip_angle_deg(board.linear() * axis_part[gi], board.linear() * lever_part[gi],
+                                kDown);
+  };
+  // Receiving-arm IK for grasp g with the board at `board`: the first collision-free solution
+  // (nearest to home first) of the receiving arm's bodies against everything else as posed.
+  core::UrIkSolutions ik;
+  auto receive = [&](const core::Pose& board, int g, const std::vector<int>& bodies,
+                     Receiving& out) {
+    const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
+    const double slip = slip_at(board, g);
+    if (slip > grasp.theta_c_deg) return false;
+    const core::Pose tcp = receiving_base_inv * board * grasp.tcp;
+    const int n = receiving_arm.ur_ik->solve(tcp, receiving_arm.spec.home, ik);
+    cell.set_jaw(robot_q, receiving_arm,
+                 std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + jaw_margin));
+    for (int s = 0; s < n; ++s) {
+      cell.set_arm(robot_q, receiving_arm, ik.q[static_cast<std::size_t>(s)]);
+      core::set_cell_state(cell, scene.cell, data, robot_q, human_q);
+      if (!core::in_collision(scene.cell.model, data, bodies)) {
+        out.grasp = g;
+        out.joints = ik.q[static_cast<std::size_t>(s)];
+        out.slip_deg = slip;
+        return true;
+      }
+    }
+    return false;
+  };
+  auto restore_receiving = [&] {
+    cell.set_arm(robot_q, receiving_arm, receiving_arm.spec.home);
+    cell.set_jaw(robot_q, receiving_arm, cell.spec().gripper.jaw_max);
+  };
+
+  // --- Robot-robot handover poses ----------------------------------------------------------
+  const auto orientations = spread_orientations(settings.rr_orientations);
+  const int n_pos = static_cast<int>(settings.rr_positions.size());
+  const int n_orient = static_cast<int>(orientations.size());
+  const int n_suction = static_cast<int>(grasps.suction.size());
+  std::vector<int> order(static_cast<std::size_t>(n_pos * n_orient * n_suction));
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  shuffle(order, rng);
+  std::vector<std::vector<Receiving>> rr_grasps;  // per kept robot-robot pose
+  std::vector<int> rr_of_grasp(grasps.robot.size(), -1);  // first rr pose receiving each grasp
+  int examined = 0;
+  for (const int combo : order) {
+    if (examined >= settings.rr_poses) break;
+    const int s = combo % n_suction;
+    const int o = (combo / n_suction) % n_orient;
+    const int p = combo / (n_suction * n_orient);
+    core::Pose board = core::Pose::Identity();
+    board.linear() = orientations[static_cast<std::size_t>(o)].toRotationMatrix();
+    board.translation() = settings.rr_positions[static_cast<std::size_t>(p)];
+    const core::Pose tcp =
+        board * grasps.suction[static_cast<std::size_t>(s)].cup * scene.cup_in_tcp.inverse();
+    const int n = suction_arm.ur_ik->solve(suction_base_inv * tcp, suction_arm.spec.home, ik);
+    if (n == 0) continue;
+    data.set_body_pose(scene.board, board);
+    core::set_tool_held(cell, scene, data, tcp);
+    bool held = false;
+    Eigen::VectorXd suction_q;
+    for (int k = 0; k < n && !held; ++k) {
+      cell.set_arm(robot_q, suction_arm, ik.q[static_cast<std::size_t>(k)]);
+      core::set_cell_state(cell, scene.cell, data, robot_q, human_q);
+      if (!core::in_collision(scene.cell.model, data, suction_bodies)) {
+        held = true;
+        suction_q = ik.q[static_cast<std::size_t>(k)];
+      }
+    }
+    if (held) {
+      ++examined;
+      std::vector<Receiving> received;
+      for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+        Receiving r;
+        if (receive(board, g, receiving_bodies, r)) received.push_back(r);
+      }
+      restore_receiving();
+      if (!received.empty()) {
+        db::RobotHandoverRecord rr;
+        rr.board = board;
+        rr.suction_grasp_id = s;
+        rr.arm = suction_arm.spec.name;
+        rr.joints = suction_q;
+        for (const auto& r : received) {
+          auto& slot = rr_of_grasp[static_cast<std::size_t>(r.grasp)];
+          if (slot < 0) slot = static_cast<int>(result.robot_handovers.size());
+        }
+        result.robot_handovers.push_back(rr);
+        rr_grasps.push_back(std::move(received));
+      }
+    }
+    reset_state();
+  }
+  reset_state();
+  stage.robot_handovers = static_cast<int>(result.robot_handovers.size());
+  if (stage.robot_handovers == 0) {
+    return finish(examined == 0
+                      ? "no robot-robot handover pose: the " + suction_arm.spec.name +
+                            " arm cannot hold the board by suction clear of the cell at any of "
+                            "the shared-workspace poses"
+                      : "no robot-robot handover pose: the " + receiving_arm.spec.name +
+                            " arm reaches no grasp within its slip limit at the " +
+                            std::to_string(examined) + " poses the " + suction_arm.spec.name +
+                            " arm can hold");
+  }
+
+  // --- 𝕊: members of S sharing a grasp with a robot-robot pose, in Eq. 8 order -------------
+  std::vector<int> comfortable;
+  for (std::size_t i = 0; i < result.candidates.size(); ++i) {
+    if (result.candidates[i].status == "no_shared_grasp") comfortable.push_back(static_cast<int>(i));
+  }
+  std::stable_sort(comfortable.begin(), comfortable.end(), [&](int a, int b) {
+    return result.candidates[static_cast<std::size_t>(a)].distance <
+           result.candidates[static_cast<std::size_t>(b)].distance;
+  });
+  // At the robot-human pose the receiving arm and the board it holds move against the rest.
+  std::vector<int> rh_bodies = receiving_bodies;
+  rh_bodies.push_back(scene.board);
+  for (const int ci : comfortable) {
+    auto& c = result.candidates[static_cast<std::size_t>(ci)];
+    const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
+    data.set_body_pose(scene.board, c.board);
+    const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
+    place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + 0.01);
+    if (h.second_grasp >= 0) {
+      const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+      place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + 0.01);
+    }
+    int shared = 0;
+    for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+      const int rr = rr_of_grasp[static_cast<std::size_t>(g)];
+      if (rr < 0) continue;
+      Receiving at_rh;
+      if (!receive(c.board, g, rh_bodies, at_rh)) continue;
+      ++shared;
+      const auto& at_rr = rr_grasps[static_cast<std::size_t>(rr)];
+      const auto it = std::find_if(at_rr.begin(), at_rr.end(),
+                                   [&](const Receiving& r) { return r.grasp == g; });
+      db::SharedGraspRecord s;
+      s.candidate_id = ci;
+      s.robot_grasp_id = g;
+      s.robot_handover_id = rr;
+      s.arm = receiving_arm.spec.name;
+      s.joints_rr = it->joints;
+      s.joints_rh = at_rh.joints;
+      s.inclination_rr_deg = it->slip_deg;
+      s.inclination_rh_deg = at_rh.slip_deg;
+      result.shared.push_back(s);
+      if (shared >= settings.shared_stored) break;  // membership in 𝕊 is settled
+    }
+    restore_receiving();
+    reset_state();
+    if (shared > 0) {
+      c.status = "goal";
+      c.rank = stage.goals++;
+    }
+  }
+  reset_state();
+
+  // --- The human's posture at the first goals (direct IK) ------------------------------------
+  ComfortSettings ik_settings;
+  ik_settings.ik_attempts = 12;
+  ik_settings.seed = settings.seed;
+  for (const int ci : comfortable) {
+    auto& c = result.candidates[static_cast<std::size_t>(ci)];
+    if (c.status != "goal" || c.rank >= settings.human_ik_goals) continue;
+    const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
+    auto solve = [&](int arm, int grasp) {
+      const auto& chain = cell.human_arms()[static_cast<std::size_t>(arm)].chain;
+      const core::Pose hand = comfort.arm_base(arm).inverse() * c.board *
+                              grasps.human[static_cast<std::size_t>(grasp)].hand;
+      const Eigen::VectorXd seed =
+          Eigen::VectorXd::Zero(chain.dof()).cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
+      const ComfortResult r = best_comfort(chain, hand, seed, ik_settings);
+      return r.reachable ? r.joints : Eigen::VectorXd();
+    };
+    c.human_joints = solve(h.arm, h.grasp);
+    if (h.second_grasp >= 0) c.second_joints = solve(h.second_arm, h.second_grasp);
+  }
+
+  if (stage.goals == 0) {
+    return finish("no comfortable candidate shares a grasp with a robot-robot handover pose (|S| = " +
+                  std::to_string(stage.comfortable) + ", " +
+                  std::to_string(stage.robot_handovers) + " robot-robot poses)");
+  }
+  // Shared grasps by goal rank.
+  std::stable_sort(result.shared.begin(), result.shared.end(),
+                   [&](const db::SharedGraspRecord& a, const db::SharedGraspRecord& b) {
+                     return result.candidates[static_cast<std::size_t>(a.candidate_id)].rank <
+                            result.candidates[static_cast<std::size_t>(b.candidate_id)].rank;
+                   });
+  return finish("");
+}
+
+}  // namespace hila::offline
