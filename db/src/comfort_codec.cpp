@@ -4,9 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
+
+#include "list_codec.hpp"
 
 namespace hila::db::detail {
 
@@ -16,23 +17,6 @@ constexpr int kDeflateLevel = 6;
 // zlib cannot expand data by more than about 1032:1, so a stored size beyond this bound is damage
 // (and must not become a huge allocation).
 constexpr std::int64_t kMaxInflateRatio = 1100;
-
-void put_double(std::string& out, double value) {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &value, sizeof(bits));
-  for (int i = 0; i < 8; ++i) {
-    out.push_back(static_cast<char>(bits & 0xff));
-    bits >>= 8;
-  }
-}
-
-double get_double(const unsigned char* bytes) {
-  std::uint64_t bits = 0;
-  for (int i = 7; i >= 0; --i) bits = (bits << 8) | bytes[i];
-  double value = 0.0;
-  std::memcpy(&value, &bits, sizeof(value));
-  return value;
-}
 
 }  // namespace
 
