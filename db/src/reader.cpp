@@ -10,6 +10,7 @@
 #include "comfort_codec.hpp"
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
+#include "list_codec.hpp"
 #include "open_checks.hpp"
 #include "pose_codec.hpp"
 #include "schema.hpp"
@@ -22,23 +23,35 @@ namespace {
 using detail::pose_columns;
 using detail::vector_columns;
 
+// Reads rows of `table` in id order; `read_row` gets the row's id and consumes `columns`.
+template <typename Record>
+std::vector<Record> load_rows(
+    detail::Connection& connection, const std::string& table, const std::string& columns,
+    const std::string& fix,
+    const std::function<void(detail::Statement&, std::int64_t id, Record&)>& read_row) {
+  detail::Statement select(connection, "SELECT id, " + columns + " FROM " + table + " ORDER BY id",
+                           {table, "a readable hila table", fix});
+  std::vector<Record> records;
+  while (select.step()) {
+    Record record;
+    const std::int64_t id = select.next_int64();
+    read_row(select, id, record);
+    records.push_back(std::move(record));
+  }
+  return records;
+}
+
 // Reads rows of `table` in id order; `read_row` consumes the columns after id and part_id.
 template <typename Record>
 std::vector<Record> load_table(detail::Connection& connection, const std::string& table,
                                const std::string& columns, const std::string& fix,
                                const std::function<void(detail::Statement&, Record&)>& read_row) {
-  detail::Statement select(connection,
-                           "SELECT id, part_id, " + columns + " FROM " + table + " ORDER BY id",
-                           {table, "a readable hila table", fix});
-  std::vector<Record> records;
-  while (select.step()) {
-    Record record;
-    record.id = select.next_int64();
-    record.part_id = select.next_int64();
-    read_row(select, record);
-    records.push_back(std::move(record));
-  }
-  return records;
+  return load_rows<Record>(connection, table, "part_id, " + columns, fix,
+                           [&](detail::Statement& s, std::int64_t id, Record& record) {
+                             record.id = id;
+                             record.part_id = s.next_int64();
+                             read_row(s, record);
+                           });
 }
 
 Eigen::Vector3d read_vector(detail::Statement& s) {
@@ -58,6 +71,22 @@ core::Pose read_pose(detail::Statement& s, const std::string& path, const std::s
                         "finite values and a unit quaternion", "something else", fix);
   }
   return *pose;
+}
+
+// A joint vector BLOB: a whole number of little-endian doubles, all finite (the writer refuses
+// anything else, so a bad one is damage).
+Eigen::VectorXd read_joints(detail::Statement& s, const std::string& path, const std::string& table,
+                            const std::string& column, std::int64_t id, const std::string& fix) {
+  const std::string bytes = s.next_blob();
+  Eigen::VectorXd joints;
+  if (!detail::decode_doubles(bytes, joints) || !joints.allFinite()) {
+    throw DatabaseError(path, table + "." + column + " (id " + std::to_string(id) + ")",
+                        "finite joint values as little-endian doubles (8 bytes each)",
+                        bytes.size() % 8 != 0 ? std::to_string(bytes.size()) + " bytes"
+                                              : std::string("a value that is not finite"),
+                        fix);
+  }
+  return joints;
 }
 
 std::string short_hash(const std::string& hash) {
@@ -93,6 +122,9 @@ Meta parse_meta(const std::string& path, const std::map<std::string, std::string
   meta.created_at = map.at("created_at");
   meta.cell_file = map.at("cell_file");
   meta.product_file = map.at("product_file");
+  // Added in version 3: a file without it (hand-made) reads as "the cell's human only".
+  const auto bodies = map.find("human_bodies");
+  meta.human_bodies = bodies == map.end() ? std::string() : bodies->second;
   const std::string& seed = map.at("seed");
   const auto [end, error] = std::from_chars(seed.data(), seed.data() + seed.size(), meta.seed);
   if (seed.empty() || error != std::errc() || end != seed.data() + seed.size()) {
@@ -280,6 +312,82 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.one_hand_stable = s.next_int64() != 0;
       });
   db.comfort_maps_ = load_comfort_maps(*connection, path, fix);
+
+  db.handover_stages_ = load_rows<HandoverStageRecord>(
+      *connection, "handover_stages",
+      "part_id, finished_parts, draws, candidates, comfortable, comfortable_default_body, goals, "
+      "robot_handovers, two_hands, failure",
+      fix, [&](detail::Statement& s, std::int64_t, HandoverStageRecord& r) {
+        r.part_id = s.next_int64();
+        r.finished_parts = detail::decode_names(s.next_text());
+        r.draws = static_cast<int>(s.next_int64());
+        r.candidates = static_cast<int>(s.next_int64());
+        r.comfortable = static_cast<int>(s.next_int64());
+        r.comfortable_default_body = static_cast<int>(s.next_int64());
+        r.goals = static_cast<int>(s.next_int64());
+        r.robot_handovers = static_cast<int>(s.next_int64());
+        r.two_hands = s.next_int64() != 0;
+        r.failure = s.next_text();
+      });
+  db.robot_handovers_ = load_table<RobotHandoverRecord>(
+      *connection, "robot_handovers", pose_columns("board") + ", suction_grasp_id, arm, joints",
+      fix, [&](detail::Statement& s, RobotHandoverRecord& r) {
+        r.board = read_pose(s, path, "robot_handovers", "board", r.id, fix);
+        r.suction_grasp_id = s.next_int64();
+        r.arm = s.next_text();
+        r.joints = read_joints(s, path, "robot_handovers", "joints", r.id, fix);
+      });
+  db.handover_candidates_ = load_table<HandoverCandidateRecord>(
+      *connection, "handover_candidates",
+      "sample, " + pose_columns("board") +
+          ", distance, quality, status, rank, human_arm, human_grasp_id, human_quality, "
+          "second_arm, second_grasp_id, second_quality, human_joints, second_joints",
+      fix, [&](detail::Statement& s, HandoverCandidateRecord& r) {
+        r.sample = static_cast<int>(s.next_int64());
+        r.board = read_pose(s, path, "handover_candidates", "board", r.id, fix);
+        r.distance = s.next_double();
+        r.quality = s.next_double();
+        r.status = s.next_text();
+        r.rank = static_cast<int>(s.next_int64());
+        r.human_arm = s.next_text();
+        r.human_grasp_id = s.next_int64();
+        r.human_quality = s.next_double();
+        r.second_arm = s.next_text();
+        r.second_grasp_id = s.next_int64();
+        r.second_quality = s.next_double();
+        r.human_joints = read_joints(s, path, "handover_candidates", "human_joints", r.id, fix);
+        r.second_joints = read_joints(s, path, "handover_candidates", "second_joints", r.id, fix);
+      });
+  db.shared_grasps_ = load_rows<SharedGraspRecord>(
+      *connection, "shared_grasps",
+      "candidate_id, robot_grasp_id, robot_handover_id, arm, joints_rr, joints_rh, "
+      "inclination_rr_deg, inclination_rh_deg",
+      fix, [&](detail::Statement& s, std::int64_t id, SharedGraspRecord& r) {
+        r.id = id;
+        r.candidate_id = s.next_int64();
+        r.robot_grasp_id = s.next_int64();
+        r.robot_handover_id = s.next_int64();
+        r.arm = s.next_text();
+        r.joints_rr = read_joints(s, path, "shared_grasps", "joints_rr", id, fix);
+        r.joints_rh = read_joints(s, path, "shared_grasps", "joints_rh", id, fix);
+        r.inclination_rr_deg = s.next_double();
+        r.inclination_rh_deg = s.next_double();
+      });
+  db.ergonomics_ = load_rows<ErgonomicsRecord>(
+      *connection, "ergonomics",
+      "part_id, method, reachable, torso_flexion_deg, shoulder_elevated, reach, "
+      "reorientation_deg, quality, arm",
+      fix, [&](detail::Statement& s, std::int64_t, ErgonomicsRecord& r) {
+        r.part_id = s.next_int64();
+        r.method = s.next_text();
+        r.reachable = s.next_int64() != 0;
+        r.torso_flexion_deg = s.next_double();
+        r.shoulder_elevated = s.next_int64() != 0;
+        r.reach = s.next_double();
+        r.reorientation_deg = s.next_double();
+        r.quality = s.next_double();
+        r.arm = s.next_text();
+      });
   return db;
 }
 
@@ -321,6 +429,43 @@ std::vector<SuctionGraspRecord> Database::suction_grasps(std::int64_t part_id) c
 
 std::vector<HumanGraspRecord> Database::human_grasps(std::int64_t part_id) const {
   return for_part(human_grasps_, part_id);
+}
+
+const HandoverStageRecord* Database::handover_stage(std::int64_t part_id) const {
+  for (const auto& stage : handover_stages_) {
+    if (stage.part_id == part_id) return &stage;
+  }
+  return nullptr;
+}
+
+std::vector<RobotHandoverRecord> Database::robot_handovers(std::int64_t part_id) const {
+  return for_part(robot_handovers_, part_id);
+}
+
+std::vector<HandoverCandidateRecord> Database::handover_candidates(std::int64_t part_id) const {
+  return for_part(handover_candidates_, part_id);
+}
+
+std::vector<HandoverCandidateRecord> Database::handover_goals(std::int64_t part_id) const {
+  std::vector<HandoverCandidateRecord> goals;
+  for (const auto& c : handover_candidates_) {
+    if (c.part_id == part_id && c.status == "goal") goals.push_back(c);
+  }
+  // Stable: equal ranks (only in a hand-edited file) stay in id order.
+  std::stable_sort(goals.begin(), goals.end(),
+                   [](const auto& a, const auto& b) { return a.rank < b.rank; });
+  return goals;
+}
+
+std::vector<SharedGraspRecord> Database::shared_grasps(std::int64_t candidate_id) const {
+  std::vector<SharedGraspRecord> selected;
+  std::copy_if(shared_grasps_.begin(), shared_grasps_.end(), std::back_inserter(selected),
+               [&](const SharedGraspRecord& g) { return g.candidate_id == candidate_id; });
+  return selected;
+}
+
+std::vector<ErgonomicsRecord> Database::ergonomics(std::int64_t part_id) const {
+  return for_part(ergonomics_, part_id);
 }
 
 }  // namespace hila::db

@@ -7,7 +7,7 @@ namespace hila::db {
 
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 2;
+  return 3;
 }
 
 namespace detail {
@@ -39,10 +39,109 @@ CREATE TABLE comfort_maps (
 );
 )sql";
 
+// The handover and ergonomics tables as schema version 3 defines them, one constant per table
+// (with its indexes). Both the current schema and the 2 -> 3 migration step create them from this
+// text; like kCreateComfortMapsV2, a later change goes into schema_sql() and leaves these to the
+// step.
+//
+// handover_stages.finished_parts is the part names joined by "\n" ("" for none); joint vectors
+// (robot_handovers.joints, handover_candidates.human_joints/second_joints, shared_grasps.joints_rr
+// and joints_rh) are BLOBs of little-endian IEEE doubles, 8 bytes per joint (empty: no joints).
+constexpr const char* kCreateHandoverStagesV3 = R"sql(
+CREATE TABLE handover_stages (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL UNIQUE REFERENCES parts(id),
+  finished_parts TEXT NOT NULL,
+  draws INTEGER NOT NULL,
+  candidates INTEGER NOT NULL,
+  comfortable INTEGER NOT NULL,
+  comfortable_default_body INTEGER NOT NULL,
+  goals INTEGER NOT NULL,
+  robot_handovers INTEGER NOT NULL,
+  two_hands INTEGER NOT NULL CHECK (two_hands IN (0, 1)),
+  failure TEXT NOT NULL
+);
+)sql";
+
+constexpr const char* kCreateRobotHandoversV3 = R"sql(
+CREATE TABLE robot_handovers (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  board_x REAL NOT NULL, board_y REAL NOT NULL, board_z REAL NOT NULL,
+  board_qw REAL NOT NULL, board_qx REAL NOT NULL, board_qy REAL NOT NULL, board_qz REAL NOT NULL,
+  suction_grasp_id INTEGER NOT NULL REFERENCES suction_grasps(id),
+  arm TEXT NOT NULL,
+  joints BLOB NOT NULL
+);
+CREATE INDEX robot_handovers_part_id ON robot_handovers(part_id);
+)sql";
+
+constexpr const char* kCreateHandoverCandidatesV3 = R"sql(
+CREATE TABLE handover_candidates (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  sample INTEGER NOT NULL,
+  board_x REAL NOT NULL, board_y REAL NOT NULL, board_z REAL NOT NULL,
+  board_qw REAL NOT NULL, board_qx REAL NOT NULL, board_qy REAL NOT NULL, board_qz REAL NOT NULL,
+  distance REAL NOT NULL,
+  quality REAL NOT NULL,
+  status TEXT NOT NULL CHECK (status IN ('uncomfortable', 'no_shared_grasp', 'goal')),
+  rank INTEGER NOT NULL,
+  human_arm TEXT NOT NULL,
+  human_grasp_id INTEGER NOT NULL,
+  human_quality REAL NOT NULL,
+  second_arm TEXT NOT NULL,
+  second_grasp_id INTEGER NOT NULL,
+  second_quality REAL NOT NULL,
+  human_joints BLOB NOT NULL,
+  second_joints BLOB NOT NULL,
+  CHECK ((status = 'goal' AND rank >= 0) OR (status <> 'goal' AND rank = -1))
+);
+CREATE INDEX handover_candidates_part_id ON handover_candidates(part_id);
+)sql";
+
+constexpr const char* kCreateSharedGraspsV3 = R"sql(
+CREATE TABLE shared_grasps (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  robot_handover_id INTEGER NOT NULL REFERENCES robot_handovers(id),
+  arm TEXT NOT NULL,
+  joints_rr BLOB NOT NULL,
+  joints_rh BLOB NOT NULL,
+  inclination_rr_deg REAL NOT NULL,
+  inclination_rh_deg REAL NOT NULL
+);
+CREATE INDEX shared_grasps_candidate_id ON shared_grasps(candidate_id);
+)sql";
+
+constexpr const char* kCreateErgonomicsV3 = R"sql(
+CREATE TABLE ergonomics (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  method TEXT NOT NULL CHECK (method IN ('hila', 'table', 'alone')),
+  reachable INTEGER NOT NULL CHECK (reachable IN (0, 1)),
+  torso_flexion_deg REAL NOT NULL,
+  shoulder_elevated INTEGER NOT NULL CHECK (shoulder_elevated IN (0, 1)),
+  reach REAL NOT NULL,
+  reorientation_deg REAL NOT NULL,
+  quality REAL NOT NULL,
+  arm TEXT NOT NULL,
+  UNIQUE (part_id, method)
+);
+)sql";
+
+// Every table schema version 3 adds, in schema order.
+std::string create_tables_v3() {
+  return std::string(kCreateHandoverStagesV3) + kCreateRobotHandoversV3 +
+         kCreateHandoverCandidatesV3 + kCreateSharedGraspsV3 + kCreateErgonomicsV3;
+}
+
 }  // namespace
 
 // Written out in full (not generated) so this file is the readable reference of the schema (the
-// comfort_maps table is kCreateComfortMapsV2 above).
+// comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
+// kCreate...V3 constants).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
@@ -122,7 +221,8 @@ CREATE TABLE human_grasps (
   one_hand_stable INTEGER NOT NULL CHECK (one_hand_stable IN (0, 1))
 );
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
-)sql" + std::string(kCreateComfortMapsV2);
+)sql" + std::string(kCreateComfortMapsV2) +
+                                 create_tables_v3();
   return sql;
 }
 
@@ -133,6 +233,10 @@ const std::vector<MigrationStep>& migration_steps() {
       // 1 -> 2: human comfort maps (a new table; the old tables are unchanged, and a migrated file
       // has no maps until it is rebuilt).
       {1, kCreateComfortMapsV2},
+      // 2 -> 3: handover goals and ergonomics (new tables, empty in a migrated file until it is
+      // rebuilt) and the meta key human_bodies (empty: the cell's human only).
+      {2, create_tables_v3() +
+              "INSERT OR IGNORE INTO meta (key, value) VALUES ('human_bodies', '');\n"},
   };
   return steps;
 }

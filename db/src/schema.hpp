@@ -14,15 +14,21 @@ struct TableInfo {
   const char* name;
   int since_version;  // the schema version that added the table
 };
-inline constexpr std::array<TableInfo, 7> kTables = {{{"meta", 1},
-                                                      {"parts", 1},
-                                                      {"placements", 1},
-                                                      {"robot_grasps", 1},
-                                                      {"suction_grasps", 1},
-                                                      {"human_grasps", 1},
-                                                      {"comfort_maps", 2}}};
+inline constexpr std::array<TableInfo, 12> kTables = {{{"meta", 1},
+                                                       {"parts", 1},
+                                                       {"placements", 1},
+                                                       {"robot_grasps", 1},
+                                                       {"suction_grasps", 1},
+                                                       {"human_grasps", 1},
+                                                       {"comfort_maps", 2},
+                                                       {"handover_stages", 3},
+                                                       {"robot_handovers", 3},
+                                                       {"handover_candidates", 3},
+                                                       {"shared_grasps", 3},
+                                                       {"ergonomics", 3}}};
 
-// The meta keys every database carries.
+// The meta keys every database carries. Keys added later are optional when reading: the writer
+// always writes human_bodies (since version 3), the reader takes a missing one as "".
 inline constexpr std::array<const char*, 10> kMetaKeys = {
     "schema_version", "hila_version", "product_name", "cell_hash", "product_hash",
     "settings_hash",  "seed",         "created_at",   "cell_file", "product_file"};

@@ -1,4 +1,5 @@
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <optional>
 #include <stdexcept>
@@ -6,6 +7,7 @@
 #include "atomic_file.hpp"
 #include "comfort_codec.hpp"
 #include "hila/db/database.hpp"
+#include "list_codec.hpp"
 #include "pose_codec.hpp"
 #include "schema.hpp"
 #include "sqlite_handle.hpp"
@@ -31,6 +33,49 @@ void bind_vector(detail::Statement& statement, const Eigen::Vector3d& v) {
   for (int i = 0; i < 3; ++i) statement.bind_next(v[i]);
 }
 
+void bind_joints(detail::Statement& statement, const Eigen::VectorXd& joints) {
+  statement.bind_blob(detail::encode_doubles(joints));
+}
+
+// Refuses non-finite values of the version 3 tables before anything is written (SQLite would turn
+// NaN into NULL and a BLOB would keep it silently): std::invalid_argument naming the call, the
+// table's column and the record, e.g. "DatabaseWriter::add_robot_handovers:
+// robot_handovers.joints[2] (record 0 of 3, part id 1) must be finite, got nan".
+class FiniteCheck {
+ public:
+  FiniteCheck(std::string call, std::string table)
+      : call_(std::move(call)), table_(std::move(table)) {}
+
+  // What identifies the record being checked, e.g. "record 0 of 3, part id 1".
+  void set_record(std::string record) { record_ = std::move(record); }
+
+  void value(const std::string& column, double v) const {
+    if (!std::isfinite(v)) {
+      throw std::invalid_argument("DatabaseWriter::" + call_ + ": " + table_ + "." + column + " (" +
+                                  record_ + ") must be finite, got " + std::to_string(v));
+    }
+  }
+  void pose(const std::string& prefix, const core::Pose& pose) const {
+    static constexpr const char* kSuffixes[] = {"_x", "_y", "_z", "_qw", "_qx", "_qy", "_qz"};
+    const detail::PoseColumns columns = detail::encode_pose(pose);
+    for (std::size_t i = 0; i < columns.size(); ++i) value(prefix + kSuffixes[i], columns[i]);
+  }
+  void joints(const std::string& column, const Eigen::VectorXd& joints) const {
+    for (Eigen::Index i = 0; i < joints.size(); ++i) {
+      value(column + "[" + std::to_string(i) + "]", joints[i]);
+    }
+  }
+
+ private:
+  std::string call_;
+  std::string table_;
+  std::string record_;
+};
+
+std::string record_label(std::size_t index, std::size_t count, const std::string& owner) {
+  return "record " + std::to_string(index) + " of " + std::to_string(count) + ", " + owner;
+}
+
 // "INSERT INTO table (a, b) VALUES (?, ?)" for a comma-separated column list.
 std::string insert_sql(const std::string& table, const std::string& columns) {
   std::string placeholders = "?";
@@ -48,7 +93,8 @@ struct DatabaseWriter::Impl {
   std::unique_ptr<detail::Connection> connection;
   // Prepared once, reused for every row; destroyed before the connection closes.
   std::optional<detail::Statement> insert_meta, insert_part, insert_placement, insert_robot,
-      insert_suction, insert_human, insert_comfort;
+      insert_suction, insert_human, insert_comfort, insert_stage, insert_robot_handover,
+      insert_candidate, insert_shared, insert_ergonomics;
   bool meta_written = false;
   bool committed = false;
   std::string failure;  // the first error: a writer that failed never commits
@@ -88,6 +134,15 @@ struct DatabaseWriter::Impl {
     insert_suction.reset();
     insert_human.reset();
     insert_comfort.reset();
+    insert_stage.reset();
+    insert_robot_handover.reset();
+    insert_candidate.reset();
+    insert_shared.reset();
+    insert_ergonomics.reset();
+  }
+
+  std::int64_t last_id() const {
+    return static_cast<std::int64_t>(sqlite3_last_insert_rowid(connection->get()));
   }
 };
 
@@ -151,6 +206,37 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
                                        "orientations, value_bytes, values_deflate, samples, seed, "
                                        "coverage"),
         m.context("comfort_maps"));
+    m.insert_stage.emplace(
+        *m.connection,
+        insert_sql("handover_stages",
+                   "part_id, finished_parts, draws, candidates, comfortable, "
+                   "comfortable_default_body, goals, robot_handovers, two_hands, failure"),
+        m.context("handover_stages"));
+    m.insert_robot_handover.emplace(
+        *m.connection,
+        insert_sql("robot_handovers",
+                   "part_id, " + pose_columns("board") + ", suction_grasp_id, arm, joints"),
+        m.context("robot_handovers"));
+    m.insert_candidate.emplace(
+        *m.connection,
+        insert_sql("handover_candidates",
+                   "part_id, sample, " + pose_columns("board") +
+                       ", distance, quality, status, rank, human_arm, human_grasp_id, "
+                       "human_quality, second_arm, second_grasp_id, second_quality, human_joints, "
+                       "second_joints"),
+        m.context("handover_candidates"));
+    m.insert_shared.emplace(
+        *m.connection,
+        insert_sql("shared_grasps",
+                   "candidate_id, robot_grasp_id, robot_handover_id, arm, joints_rr, joints_rh, "
+                   "inclination_rr_deg, inclination_rh_deg"),
+        m.context("shared_grasps"));
+    m.insert_ergonomics.emplace(
+        *m.connection,
+        insert_sql("ergonomics",
+                   "part_id, method, reachable, torso_flexion_deg, shoulder_elevated, reach, "
+                   "reorientation_deg, quality, arm"),
+        m.context("ergonomics"));
   } catch (...) {
     m.finalize_statements();
     m.connection.reset();
@@ -191,6 +277,7 @@ void DatabaseWriter::write_meta(const Meta& meta) {
     put("created_at", meta.created_at.empty() ? utc_now_iso8601() : meta.created_at);
     put("cell_file", meta.cell_file);
     put("product_file", meta.product_file);
+    put("human_bodies", meta.human_bodies);
     m.meta_written = true;
   });
 }
@@ -217,7 +304,7 @@ std::int64_t DatabaseWriter::add_part(const PartRecord& part) {
     bind_pose(s, part.target);
     bind_pose(s, part.initial);
     s.run();
-    return static_cast<std::int64_t>(sqlite3_last_insert_rowid(m.connection->get()));
+    return m.last_id();
   });
 }
 
@@ -236,11 +323,13 @@ void DatabaseWriter::add_placements(std::int64_t part_id,
   });
 }
 
-void DatabaseWriter::add_robot_grasps(std::int64_t part_id,
-                                      const std::vector<RobotGraspRecord>& grasps) {
+std::vector<std::int64_t> DatabaseWriter::add_robot_grasps(
+    std::int64_t part_id, const std::vector<RobotGraspRecord>& grasps) {
   Impl& m = *impl_;
-  m.guarded("add_robot_grasps", [&] {
+  return m.guarded("add_robot_grasps", [&] {
     detail::Statement& s = *m.insert_robot;
+    std::vector<std::int64_t> ids;
+    ids.reserve(grasps.size());
     s.set_context(m.context("robot_grasps (part id " + std::to_string(part_id) + ")"));
     for (const auto& g : grasps) {
       s.bind_next(part_id);
@@ -255,15 +344,19 @@ void DatabaseWriter::add_robot_grasps(std::int64_t part_id,
       s.bind_next(g.lever);
       s.bind_next(g.theta_c_deg);
       s.run();
+      ids.push_back(m.last_id());
     }
+    return ids;
   });
 }
 
-void DatabaseWriter::add_suction_grasps(std::int64_t part_id,
-                                        const std::vector<SuctionGraspRecord>& grasps) {
+std::vector<std::int64_t> DatabaseWriter::add_suction_grasps(
+    std::int64_t part_id, const std::vector<SuctionGraspRecord>& grasps) {
   Impl& m = *impl_;
-  m.guarded("add_suction_grasps", [&] {
+  return m.guarded("add_suction_grasps", [&] {
     detail::Statement& s = *m.insert_suction;
+    std::vector<std::int64_t> ids;
+    ids.reserve(grasps.size());
     s.set_context(m.context("suction_grasps (part id " + std::to_string(part_id) + ")"));
     for (const auto& g : grasps) {
       s.bind_next(part_id);
@@ -272,15 +365,19 @@ void DatabaseWriter::add_suction_grasps(std::int64_t part_id,
       s.bind_next(g.force_margin);
       s.bind_next(g.moment_margin);
       s.run();
+      ids.push_back(m.last_id());
     }
+    return ids;
   });
 }
 
-void DatabaseWriter::add_human_grasps(std::int64_t part_id,
-                                      const std::vector<HumanGraspRecord>& grasps) {
+std::vector<std::int64_t> DatabaseWriter::add_human_grasps(
+    std::int64_t part_id, const std::vector<HumanGraspRecord>& grasps) {
   Impl& m = *impl_;
-  m.guarded("add_human_grasps", [&] {
+  return m.guarded("add_human_grasps", [&] {
     detail::Statement& s = *m.insert_human;
+    std::vector<std::int64_t> ids;
+    ids.reserve(grasps.size());
     s.set_context(m.context("human_grasps (part id " + std::to_string(part_id) + ")"));
     for (const auto& g : grasps) {
       s.bind_next(part_id);
@@ -291,7 +388,9 @@ void DatabaseWriter::add_human_grasps(std::int64_t part_id,
       s.bind_next(g.quality);
       s.bind_next(static_cast<std::int64_t>(g.one_hand_stable ? 1 : 0));
       s.run();
+      ids.push_back(m.last_id());
     }
+    return ids;
   });
 }
 
@@ -313,6 +412,166 @@ void DatabaseWriter::add_comfort_map(const ComfortMapRecord& map) {
     s.bind_next(static_cast<std::int64_t>(map.seed));  // the bit pattern: SQLite has no uint64
     s.bind_next(map.coverage);
     s.run();
+  });
+}
+
+void DatabaseWriter::add_handover_stage(const HandoverStageRecord& stage) {
+  Impl& m = *impl_;
+  m.guarded("add_handover_stage", [&] {
+    const std::string owner = "part id " + std::to_string(stage.part_id);
+    const int bad = detail::invalid_name(stage.finished_parts);
+    if (bad >= 0) {
+      throw std::invalid_argument(
+          "DatabaseWriter::add_handover_stage: handover_stages.finished_parts (" + owner +
+          "): name " + std::to_string(bad) + " is " +
+          (stage.finished_parts[bad].empty() ? "empty" : "'" + stage.finished_parts[bad] + "'") +
+          ", but names must be non-empty and free of newlines (they are stored newline-joined)");
+    }
+    detail::Statement& s = *m.insert_stage;
+    s.set_context(m.context("handover_stages (" + owner + ")"));
+    s.bind_next(stage.part_id);
+    s.bind_next(detail::encode_names(stage.finished_parts));
+    for (const int count : {stage.draws, stage.candidates, stage.comfortable,
+                            stage.comfortable_default_body, stage.goals, stage.robot_handovers}) {
+      s.bind_next(static_cast<std::int64_t>(count));
+    }
+    s.bind_next(static_cast<std::int64_t>(stage.two_hands ? 1 : 0));
+    s.bind_next(stage.failure);
+    s.run();
+  });
+}
+
+std::vector<std::int64_t> DatabaseWriter::add_robot_handovers(
+    std::int64_t part_id, const std::vector<RobotHandoverRecord>& handovers) {
+  Impl& m = *impl_;
+  return m.guarded("add_robot_handovers", [&] {
+    const std::string owner = "part id " + std::to_string(part_id);
+    FiniteCheck check("add_robot_handovers", "robot_handovers");
+    for (std::size_t i = 0; i < handovers.size(); ++i) {
+      check.set_record(record_label(i, handovers.size(), owner));
+      check.pose("board", handovers[i].board);
+      check.joints("joints", handovers[i].joints);
+    }
+    detail::Statement& s = *m.insert_robot_handover;
+    s.set_context(m.context("robot_handovers (" + owner + ")"));
+    std::vector<std::int64_t> ids;
+    ids.reserve(handovers.size());
+    for (const auto& h : handovers) {
+      s.bind_next(part_id);
+      bind_pose(s, h.board);
+      s.bind_next(h.suction_grasp_id);
+      s.bind_next(h.arm);
+      bind_joints(s, h.joints);
+      s.run();
+      ids.push_back(m.last_id());
+    }
+    return ids;
+  });
+}
+
+std::vector<std::int64_t> DatabaseWriter::add_handover_candidates(
+    std::int64_t part_id, const std::vector<HandoverCandidateRecord>& candidates) {
+  Impl& m = *impl_;
+  return m.guarded("add_handover_candidates", [&] {
+    const std::string owner = "part id " + std::to_string(part_id);
+    FiniteCheck check("add_handover_candidates", "handover_candidates");
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      const auto& c = candidates[i];
+      check.set_record(record_label(i, candidates.size(), owner));
+      check.pose("board", c.board);
+      check.value("distance", c.distance);
+      check.value("quality", c.quality);
+      check.value("human_quality", c.human_quality);
+      check.value("second_quality", c.second_quality);
+      check.joints("human_joints", c.human_joints);
+      check.joints("second_joints", c.second_joints);
+    }
+    detail::Statement& s = *m.insert_candidate;
+    s.set_context(m.context("handover_candidates (" + owner + ")"));
+    std::vector<std::int64_t> ids;
+    ids.reserve(candidates.size());
+    for (const auto& c : candidates) {
+      s.bind_next(part_id);
+      s.bind_next(static_cast<std::int64_t>(c.sample));
+      bind_pose(s, c.board);
+      s.bind_next(c.distance);
+      s.bind_next(c.quality);
+      s.bind_next(c.status);
+      s.bind_next(static_cast<std::int64_t>(c.rank));
+      s.bind_next(c.human_arm);
+      s.bind_next(c.human_grasp_id);
+      s.bind_next(c.human_quality);
+      s.bind_next(c.second_arm);
+      s.bind_next(c.second_grasp_id);
+      s.bind_next(c.second_quality);
+      bind_joints(s, c.human_joints);
+      bind_joints(s, c.second_joints);
+      s.run();
+      ids.push_back(m.last_id());
+    }
+    return ids;
+  });
+}
+
+void DatabaseWriter::add_shared_grasps(const std::vector<SharedGraspRecord>& grasps) {
+  Impl& m = *impl_;
+  m.guarded("add_shared_grasps", [&] {
+    FiniteCheck check("add_shared_grasps", "shared_grasps");
+    for (std::size_t i = 0; i < grasps.size(); ++i) {
+      const auto& g = grasps[i];
+      check.set_record(
+          record_label(i, grasps.size(), "candidate id " + std::to_string(g.candidate_id)));
+      check.joints("joints_rr", g.joints_rr);
+      check.joints("joints_rh", g.joints_rh);
+      check.value("inclination_rr_deg", g.inclination_rr_deg);
+      check.value("inclination_rh_deg", g.inclination_rh_deg);
+    }
+    detail::Statement& s = *m.insert_shared;
+    for (const auto& g : grasps) {
+      s.set_context(m.context("shared_grasps (candidate id " + std::to_string(g.candidate_id) +
+                              ", robot grasp id " + std::to_string(g.robot_grasp_id) +
+                              ", robot handover id " + std::to_string(g.robot_handover_id) + ")"));
+      s.bind_next(g.candidate_id);
+      s.bind_next(g.robot_grasp_id);
+      s.bind_next(g.robot_handover_id);
+      s.bind_next(g.arm);
+      bind_joints(s, g.joints_rr);
+      bind_joints(s, g.joints_rh);
+      s.bind_next(g.inclination_rr_deg);
+      s.bind_next(g.inclination_rh_deg);
+      s.run();
+    }
+  });
+}
+
+void DatabaseWriter::add_ergonomics(std::int64_t part_id,
+                                    const std::vector<ErgonomicsRecord>& rows) {
+  Impl& m = *impl_;
+  m.guarded("add_ergonomics", [&] {
+    const std::string owner = "part id " + std::to_string(part_id);
+    FiniteCheck check("add_ergonomics", "ergonomics");
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto& e = rows[i];
+      check.set_record(record_label(i, rows.size(), owner));
+      check.value("torso_flexion_deg", e.torso_flexion_deg);
+      check.value("reach", e.reach);
+      check.value("reorientation_deg", e.reorientation_deg);
+      check.value("quality", e.quality);
+    }
+    detail::Statement& s = *m.insert_ergonomics;
+    for (const auto& e : rows) {
+      s.set_context(m.context("ergonomics (" + owner + ", method '" + e.method + "')"));
+      s.bind_next(part_id);
+      s.bind_next(e.method);
+      s.bind_next(static_cast<std::int64_t>(e.reachable ? 1 : 0));
+      s.bind_next(e.torso_flexion_deg);
+      s.bind_next(static_cast<std::int64_t>(e.shoulder_elevated ? 1 : 0));
+      s.bind_next(e.reach);
+      s.bind_next(e.reorientation_deg);
+      s.bind_next(e.quality);
+      s.bind_next(e.arm);
+      s.run();
+    }
   });
 }
 

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -21,6 +23,13 @@ struct SamplePart {
   std::vector<RobotGraspRecord> robot_grasps;
   std::vector<SuctionGraspRecord> suction_grasps;
   std::vector<HumanGraspRecord> human_grasps;
+  // Schema version 3. The ids in these records (id, part_id, suction_grasp_id, candidate_id,
+  // robot_grasp_id, robot_handover_id) are the ones write_sample's writer assigns.
+  std::optional<HandoverStageRecord> handover_stage;
+  std::vector<RobotHandoverRecord> robot_handovers;
+  std::vector<HandoverCandidateRecord> handover_candidates;
+  std::vector<SharedGraspRecord> shared_grasps;  // of this part's candidates
+  std::vector<ErgonomicsRecord> ergonomics;
 };
 
 struct Sample {
@@ -61,8 +70,131 @@ inline ComfortMapRecord make_comfort_map(const std::string& arm, std::uint64_t s
   return map;
 }
 
+inline Eigen::VectorXd random_joints(std::mt19937_64& rng, int count) {
+  std::uniform_real_distribution<double> u(-3.14, 3.14);
+  Eigen::VectorXd joints(count);
+  for (int i = 0; i < count; ++i) joints[i] = u(rng);
+  return joints;
+}
+
+// Handover records for the sample's two parts (written after their grasps, so their references are
+// the ids the writer assigns in order). Part 1 is assembled first: no finished parts, three robot
+// handovers (one with no joints), six candidates of every status whose goals are written out of
+// rank order, shared grasps, and all three ergonomics methods. Part 2 (two hands, no suction
+// grasps, so no robot handovers) failed: candidates but no goal, two ergonomics methods. Every
+// value is finite (the writer refuses anything else in these tables) but awkward: subnormal, huge,
+// -0.0 in a joint blob, non-ASCII text.
+inline void add_handover_records(Sample& s, std::mt19937_64& rng) {
+  std::int64_t robot_grasp_base = 0;  // robot grasp ids before this part
+  std::int64_t suction_base = 0;
+  std::int64_t robot_handover_id = 0;
+  std::int64_t candidate_id = 0;
+  std::int64_t shared_id = 0;
+  for (std::size_t k = 0; k < s.parts.size(); ++k) {
+    SamplePart& p = s.parts[k];
+    const auto part_id = static_cast<std::int64_t>(k + 1);
+
+    HandoverStageRecord stage;
+    stage.part_id = part_id;
+    if (k == 1) stage.finished_parts = {s.parts[0].part.name, "shelf 'top' / ü"};
+    stage.draws = k == 0 ? 812 : 2147483647;
+    stage.candidates = k == 0 ? 6 : 3;
+    stage.comfortable = k == 0 ? 5 : 0;
+    stage.comfortable_default_body = k == 0 ? 6 : 1;
+    stage.goals = k == 0 ? 3 : 0;
+    stage.robot_handovers = k == 0 ? 3 : 0;
+    stage.two_hands = k == 1;
+    stage.failure = k == 0 ? "" : "no comfortable pose: the board needs two hands — 手";
+    p.handover_stage = stage;
+
+    for (std::size_t i = 0; i < p.suction_grasps.size() + (p.suction_grasps.empty() ? 0 : 1); ++i) {
+      RobotHandoverRecord h;
+      h.id = ++robot_handover_id;
+      h.part_id = part_id;
+      h.board = test::random_pose(rng, 0.8);
+      h.suction_grasp_id =
+          suction_base + 1 + static_cast<std::int64_t>(i % p.suction_grasps.size());
+      h.arm = "right";
+      if (i != 1) {
+        h.joints = random_joints(rng, 6);
+        h.joints[2] = -0.0;
+        h.joints[4] = std::numeric_limits<double>::denorm_min();
+      }
+      p.robot_handovers.push_back(h);
+    }
+
+    const std::vector<std::string> statuses =
+        k == 0 ? std::vector<std::string>{"uncomfortable", "goal", "no_shared_grasp",
+                                          "goal",          "goal", "uncomfortable"}
+               : std::vector<std::string>{"uncomfortable", "uncomfortable", "uncomfortable"};
+    const int goal_ranks[] = {2, 0, 1};  // the goals in id order have these ranks
+    int goal = 0;
+    for (std::size_t i = 0; i < statuses.size(); ++i) {
+      HandoverCandidateRecord c;
+      c.id = ++candidate_id;
+      c.part_id = part_id;
+      c.sample = static_cast<int>(3 * i + k);
+      c.board = test::random_pose(rng, 0.5);
+      c.distance = 0.05 * static_cast<double>(i + 1) + 1e-17;
+      c.quality = i == 0 ? 1e-310 : 0.5 + 0.01 * static_cast<double>(i);
+      c.status = statuses[i];
+      c.rank = c.status == "goal" ? goal_ranks[goal++] : -1;
+      if (c.status != "uncomfortable" || i == 5) {
+        c.human_arm = "right";
+        c.human_grasp_id = 2 - static_cast<std::int64_t>(i % 2);
+        c.human_quality = c.quality + 0.125;
+      }
+      if (k == 1) {
+        c.second_arm = "left ✋";
+        c.second_grasp_id = 3;
+        c.second_quality = -1e300;
+      }
+      if (c.status == "goal") {
+        c.human_joints = random_joints(rng, 7);
+        if (goal == 2) c.second_joints = random_joints(rng, 7);
+      }
+      p.handover_candidates.push_back(c);
+
+      for (std::size_t j = 0; c.status == "goal" && j < p.robot_handovers.size(); ++j) {
+        SharedGraspRecord g;
+        g.id = ++shared_id;
+        g.candidate_id = c.id;
+        g.robot_grasp_id = robot_grasp_base + 1 + static_cast<std::int64_t>((i + j) % 4);
+        g.robot_handover_id = p.robot_handovers[j].id;
+        g.arm = "left";
+        g.joints_rr = random_joints(rng, 6);
+        if (j != 2) g.joints_rh = random_joints(rng, 6);
+        g.inclination_rr_deg = 12.5 * static_cast<double>(j);
+        g.inclination_rh_deg = 89.999999999999986;
+        p.shared_grasps.push_back(g);
+      }
+    }
+
+    const std::vector<std::string> methods =
+        k == 0 ? std::vector<std::string>{"hila", "table", "alone"}
+               : std::vector<std::string>{"table", "alone"};
+    for (std::size_t i = 0; i < methods.size(); ++i) {
+      ErgonomicsRecord e;
+      e.part_id = part_id;
+      e.method = methods[i];
+      e.reachable = i != 2;
+      e.torso_flexion_deg = 17.25 * static_cast<double>(i) + 1e-13;
+      e.shoulder_elevated = i == 1;
+      e.reach = 0.62 + 1e-16;
+      e.reorientation_deg = i == 0 ? 0.0 : 179.75;
+      e.quality = 0.9 - 0.3 * static_cast<double>(i);
+      e.arm = i == 2 ? "left" : "right";
+      p.ergonomics.push_back(e);
+    }
+
+    robot_grasp_base += static_cast<std::int64_t>(p.robot_grasps.size());
+    suction_base += static_cast<std::int64_t>(p.suction_grasps.size());
+  }
+}
+
 // Two parts with different record counts (part 2 has no suction grasps), values that are
-// negative, tiny, huge, subnormal and infinite, a non-ASCII part name, and two comfort maps.
+// negative, tiny, huge, subnormal and infinite, a non-ASCII part name, handover records (see
+// add_handover_records), and two comfort maps.
 inline Sample make_sample(std::uint64_t seed = 7) {
   std::mt19937_64 rng(seed);
   Sample s;
@@ -75,6 +207,7 @@ inline Sample make_sample(std::uint64_t seed = 7) {
   s.meta.created_at = "2024-06-11T10:00:00Z";
   s.meta.cell_file = "meshes/cell/cell.yaml";
   s.meta.product_file = "meshes/cabinet/product.yaml";
+  s.meta.human_bodies = "1.75 male; 1.55 female";
 
   for (int k = 0; k < 2; ++k) {
     SamplePart p;
@@ -137,14 +270,18 @@ inline Sample make_sample(std::uint64_t seed = 7) {
     }
     s.parts.push_back(p);
   }
+  add_handover_records(s, rng);
   // Two small comfort maps of different shapes (the values' size is what the writer checks).
   s.comfort_maps.push_back(make_comfort_map("right", seed + 1, {4, 3, 2}, 10));
   s.comfort_maps.push_back(make_comfort_map("left", seed + 2, {2, 5, 3}, 7, 0.5));
   return s;
 }
 
-// Writes `sample` to `path` through DatabaseWriter (parts, then comfort maps) and returns the part
-// ids in order.
+// Writes `sample` to `path` through DatabaseWriter and returns the part ids in order: first each
+// part with its placements and grasps, then each part's handover and ergonomics records (so they
+// may refer to grasps of any part), then the comfort maps. The candidate and robot handover ids
+// the shared grasps refer to are translated from the sample's ids to the ones the writer returns
+// (the same unless a test reorders the sample's parts).
 inline std::vector<std::int64_t> write_sample(const std::string& path, const Sample& sample) {
   DatabaseWriter writer(path);
   writer.write_meta(sample.meta);
@@ -156,6 +293,35 @@ inline std::vector<std::int64_t> write_sample(const std::string& path, const Sam
     writer.add_suction_grasps(id, p.suction_grasps);
     writer.add_human_grasps(id, p.human_grasps);
     ids.push_back(id);
+  }
+  std::map<std::int64_t, std::int64_t> handover_ids;
+  std::map<std::int64_t, std::int64_t> candidate_ids;
+  const auto remember = [](std::map<std::int64_t, std::int64_t>& map, const auto& records,
+                           const std::vector<std::int64_t>& written) {
+    for (std::size_t i = 0; i < records.size(); ++i) map[records[i].id] = written.at(i);
+  };
+  const auto translate = [](const std::map<std::int64_t, std::int64_t>& map, std::int64_t id) {
+    const auto it = map.find(id);
+    return it == map.end() ? id : it->second;
+  };
+  for (std::size_t k = 0; k < sample.parts.size(); ++k) {
+    const SamplePart& p = sample.parts[k];
+    if (p.handover_stage) {
+      HandoverStageRecord stage = *p.handover_stage;
+      stage.part_id = ids[k];
+      writer.add_handover_stage(stage);
+    }
+    remember(handover_ids, p.robot_handovers,
+             writer.add_robot_handovers(ids[k], p.robot_handovers));
+    remember(candidate_ids, p.handover_candidates,
+             writer.add_handover_candidates(ids[k], p.handover_candidates));
+    std::vector<SharedGraspRecord> shared = p.shared_grasps;
+    for (auto& g : shared) {
+      g.candidate_id = translate(candidate_ids, g.candidate_id);
+      g.robot_handover_id = translate(handover_ids, g.robot_handover_id);
+    }
+    writer.add_shared_grasps(shared);
+    writer.add_ergonomics(ids[k], p.ergonomics);
   }
   for (const auto& map : sample.comfort_maps) writer.add_comfort_map(map);
   writer.commit();

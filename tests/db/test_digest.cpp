@@ -73,6 +73,60 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
     q.w() = std::nextafter(q.w(), 2.0);
   });
   add("comfort map arm name", [](Sample& s) { s.comfort_maps[1].arm = "Left"; });
+  // Schema version 3: the handover and ergonomics tables and meta.human_bodies.
+  add("meta human bodies", [](Sample& s) { s.meta.human_bodies = "1.75 male"; });
+  add("no human bodies", [](Sample& s) { s.meta.human_bodies.clear(); });
+  add("stage failure", [](Sample& s) { s.parts[1].handover_stage->failure += "."; });
+  add("stage finished parts order", [](Sample& s) {
+    auto& names = s.parts[1].handover_stage->finished_parts;
+    std::swap(names[0], names[1]);
+  });
+  add("stage count", [](Sample& s) { s.parts[0].handover_stage->comfortable_default_body += 1; });
+  add("stage flag", [](Sample& s) { s.parts[0].handover_stage->two_hands = true; });
+  add("no stage", [](Sample& s) { s.parts[1].handover_stage.reset(); });
+  add("robot handover arm", [](Sample& s) { s.parts[0].robot_handovers[1].arm = "left"; });
+  add("robot handover suction grasp",
+      [](Sample& s) { s.parts[0].robot_handovers[0].suction_grasp_id = 2; });
+  add("robot handover joint ulp", [](Sample& s) {
+    double& q = s.parts[0].robot_handovers[2].joints[5];
+    q = std::nextafter(q, 10.0);
+  });
+  add("robot handover joint -0.0 to +0.0",
+      [](Sample& s) { s.parts[0].robot_handovers[0].joints[2] = 0.0; });
+  add("an empty joint vector gets one joint",
+      [](Sample& s) { s.parts[0].robot_handovers[1].joints = Eigen::VectorXd::Zero(1); });
+  add("candidate distance ulp", [](Sample& s) {
+    double& d = s.parts[0].handover_candidates[2].distance;
+    d = std::nextafter(d, 1.0);
+  });
+  add("candidate ranks swapped", [](Sample& s) {
+    std::swap(s.parts[0].handover_candidates[1].rank, s.parts[0].handover_candidates[3].rank);
+  });
+  add("candidate status",
+      [](Sample& s) { s.parts[0].handover_candidates[0].status = "no_shared_grasp"; });
+  add("candidate human grasp",
+      [](Sample& s) { s.parts[0].handover_candidates[5].human_grasp_id = 3; });
+  add("candidate second joints",
+      [](Sample& s) { s.parts[0].handover_candidates[3].second_joints.conservativeResize(6); });
+  add("shared grasp inclination ulp", [](Sample& s) {
+    double& a = s.parts[0].shared_grasps[4].inclination_rr_deg;
+    a = std::nextafter(a, 90.0);
+  });
+  add("shared grasp robot grasp",
+      [](Sample& s) { s.parts[0].shared_grasps[8].robot_grasp_id = 5; });
+  add("shared grasp joints swapped", [](Sample& s) {
+    auto& g = s.parts[0].shared_grasps[3];
+    std::swap(g.joints_rr, g.joints_rh);
+  });
+  add("a shared grasp less", [](Sample& s) { s.parts[0].shared_grasps.pop_back(); });
+  add("ergonomics flag", [](Sample& s) { s.parts[1].ergonomics[0].shoulder_elevated = true; });
+  add("ergonomics reach", [](Sample& s) {
+    double& r = s.parts[0].ergonomics[2].reach;
+    r = std::nextafter(r, 0.0);
+  });
+  add("ergonomics order",
+      [](Sample& s) { std::swap(s.parts[0].ergonomics[0], s.parts[0].ergonomics[1]); });
+  add("ergonomics arm", [](Sample& s) { s.parts[1].ergonomics[1].arm = "left ✋"; });
   for (const auto& [name, sample] : variants) {
     const std::string path = dir + "/variant.db";
     write_sample(path, sample);

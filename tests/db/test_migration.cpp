@@ -17,12 +17,18 @@ namespace fs = std::filesystem;
 namespace {
 
 // A "version 0" database: what schema 1 would look like if robot_grasps had no theta_c_deg yet
-// (and, as in schema 1, there were no comfort maps).
+// (and, as in schema 1, there were no comfort maps, handover or ergonomics tables).
 std::string write_v0(const std::string& dir) {
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
   execute_script(path,
                  "DROP TABLE comfort_maps;"
+                 "DROP TABLE shared_grasps;"
+                 "DROP TABLE handover_candidates;"
+                 "DROP TABLE robot_handovers;"
+                 "DROP TABLE handover_stages;"
+                 "DROP TABLE ergonomics;"
+                 "DELETE FROM meta WHERE key = 'human_bodies';"
                  "ALTER TABLE robot_grasps DROP COLUMN theta_c_deg;"
                  "UPDATE meta SET value = '0' WHERE key = 'schema_version';");
   return path;
@@ -32,7 +38,7 @@ std::string write_v0(const std::string& dir) {
 const std::vector<MigrationStep> kSteps = {
     {0, "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"}};
 
-// kSteps followed by the real steps (1 -> 2, ...): a version 0 file to the current version.
+// kSteps followed by the real steps (1 -> 2, 2 -> 3, ...): a version 0 file to the current version.
 std::vector<MigrationStep> steps_from_v0() {
   std::vector<MigrationStep> steps = kSteps;
   steps.insert(steps.end(), migration_steps().begin(), migration_steps().end());
@@ -127,13 +133,31 @@ CREATE TABLE human_grasps (
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql";
 
-// A version 1 file made by hand (no DatabaseWriter involved): meta, one part with a placement and
-// one grasp of each kind. Values are exact in binary so the writer would store the same bits.
-std::string write_v1(const std::string& dir) {
-  const std::string path = dir + "/v1.db";
-  execute_script(path, std::string(kSchemaV1) + R"sql(
+// What schema version 2 added to version 1, exactly as hila (schema 2) wrote it, frozen here like
+// kSchemaV1.
+const char* const kSchemaV2Additions = R"sql(
+CREATE TABLE comfort_maps (
+  id INTEGER PRIMARY KEY,
+  arm TEXT UNIQUE NOT NULL,
+  origin_x REAL NOT NULL, origin_y REAL NOT NULL, origin_z REAL NOT NULL,
+  spacing REAL NOT NULL,
+  dim_x INTEGER NOT NULL, dim_y INTEGER NOT NULL, dim_z INTEGER NOT NULL,
+  orientation_count INTEGER NOT NULL,
+  orientations BLOB NOT NULL,
+  value_bytes INTEGER NOT NULL,
+  values_deflate BLOB NOT NULL,
+  samples INTEGER NOT NULL,
+  seed INTEGER NOT NULL,
+  coverage REAL NOT NULL
+);
+)sql";
+
+// Meta and one part with a placement and one grasp of each kind, as rows of the version 1 tables
+// (meta without schema_version). Values are exact in binary so the writer would store the same
+// bits.
+const char* const kV1Rows = R"sql(
 INSERT INTO meta (key, value) VALUES
-  ('schema_version', '1'), ('hila_version', '0.1.0'), ('product_name', 'cabinet'),
+  ('hila_version', '0.1.0'), ('product_name', 'cabinet'),
   ('cell_hash', 'cccc'), ('product_hash', 'aaaa'), ('settings_hash', '5555'),
   ('seed', '18446744073709551615'), ('created_at', '2024-06-11T10:00:00Z'),
   ('cell_file', 'cell.yaml'), ('product_file', 'product.yaml');
@@ -146,12 +170,31 @@ INSERT INTO robot_grasps VALUES (1, 1, 0.0, 0.0, 0.25, 1.0, 0.0, 0.0, 0.0, 0.5,
 INSERT INTO suction_grasps VALUES (1, 1, 0.0, 0.125, 0.0, 1.0, 0.0, 0.0, 0.0, -90.0, 4.5, 0.5);
 INSERT INTO human_grasps VALUES (1, 1, 0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0, 0.0625,
   0.03125, 0.0, 0.0, -0.03125, 0.0, 0.0, 0.5, 1);
+)sql";
+
+// A version 1 file made by hand (no DatabaseWriter involved): kV1Rows.
+std::string write_v1(const std::string& dir) {
+  const std::string path = dir + "/v1.db";
+  execute_script(path, std::string(kSchemaV1) + kV1Rows +
+                           "INSERT INTO meta (key, value) VALUES ('schema_version', '1');");
+  return path;
+}
+
+// A version 2 file made by hand: kV1Rows and one comfort map (1 x 1 x 1 nodes, no orientations,
+// so no values: the zlib stream of nothing, as compress2 at level 6 writes it).
+std::string write_v2(const std::string& dir) {
+  const std::string path = dir + "/v2.db";
+  execute_script(path, std::string(kSchemaV1) + kSchemaV2Additions + kV1Rows + R"sql(
+INSERT INTO meta (key, value) VALUES ('schema_version', '2');
+INSERT INTO comfort_maps VALUES (1, 'right', 0.25, -0.5, 1.0, 0.03125, 1, 1, 1, 0, x'', 0,
+  x'789c030000000001', 2000000, -1, 0.375);
 )sql");
   return path;
 }
 
-// The same content written by this hila's DatabaseWriter (schema 2, no comfort maps).
-void write_v1_content_as_v2(const std::string& path) {
+// The same content written by this hila's DatabaseWriter (no handover or ergonomics records, an
+// empty meta.human_bodies), with the comfort map of write_v2 when `with_comfort_map`.
+void write_reference_content(const std::string& path, bool with_comfort_map) {
   Meta meta;
   meta.hila_version = "0.1.0";
   meta.product_name = "cabinet";
@@ -201,6 +244,14 @@ void write_v1_content_as_v2(const std::string& path) {
   human.contact_2 = {-0.03125, 0.0, 0.0};
   human.quality = 0.5;
   human.one_hand_stable = true;
+  ComfortMapRecord map;
+  map.arm = "right";
+  map.origin = {0.25, -0.5, 1.0};
+  map.spacing = 0.03125;
+  map.dims = {1, 1, 1};
+  map.samples = 2000000;
+  map.seed = 18446744073709551615ull;  // stored as -1
+  map.coverage = 0.375;
 
   DatabaseWriter writer(path);
   writer.write_meta(meta);
@@ -209,27 +260,12 @@ void write_v1_content_as_v2(const std::string& path) {
   writer.add_robot_grasps(id, {robot});
   writer.add_suction_grasps(id, {suction});
   writer.add_human_grasps(id, {human});
+  if (with_comfort_map) writer.add_comfort_map(map);
   writer.commit();
 }
 
-}  // namespace
-
-TEST(Migration, Version1FileIsUpgradedToVersion2) {
-  const std::string dir = temp_dir("db_migration_v1");
-  const std::string path = write_v1(dir);
-  expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "written by schema version 1 (an older hila)",
-                      "rebuild with: hila build product.yaml -o " + path,
-                      "(or migrate it in place with hila::db::migrate_in_place)"});
-  const std::string digest_v1 = content_digest(path);  // an old file still has a digest
-
-  migrate_in_place(path);
-
-  const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 2);
-  EXPECT_EQ(db.meta().product_name, "cabinet");
-  EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
-  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+// The part of write_v1 as a migrated file holds it.
+void expect_v1_records(const Database& db) {
   ASSERT_EQ(db.parts().size(), 1u);
   const PartRecord& part = db.part("bracket");
   EXPECT_EQ(part.id, 1);
@@ -244,15 +280,49 @@ TEST(Migration, Version1FileIsUpgradedToVersion2) {
   EXPECT_EQ(db.suction_grasps(1)[0].force_margin, 4.5);
   ASSERT_EQ(db.human_grasps(1).size(), 1u);
   EXPECT_TRUE(db.human_grasps(1)[0].one_hand_stable);
+}
+
+// A migrated file has the version 3 tables, empty, and an empty meta.human_bodies.
+void expect_no_handover_records(const Database& db) {
+  EXPECT_EQ(db.meta().human_bodies, "");
+  EXPECT_TRUE(db.handover_stages().empty());
+  EXPECT_EQ(db.handover_stage(1), nullptr);
+  EXPECT_TRUE(db.robot_handovers(1).empty());
+  EXPECT_TRUE(db.handover_candidates(1).empty());
+  EXPECT_TRUE(db.handover_goals(1).empty());
+  EXPECT_TRUE(db.shared_grasps(1).empty());
+  EXPECT_TRUE(db.ergonomics(1).empty());
+}
+
+}  // namespace
+
+TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
+  const std::string dir = temp_dir("db_migration_v1");
+  const std::string path = write_v1(dir);
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta.schema_version", "written by schema version 1 (an older hila)",
+                      "rebuild with: hila build product.yaml -o " + path,
+                      "(or migrate it in place with hila::db::migrate_in_place)"});
+  const std::string digest_v1 = content_digest(path);  // an old file still has a digest
+
+  migrate_in_place(path);  // 1 -> 2 -> 3
+
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 3);
+  EXPECT_EQ(db.meta().product_name, "cabinet");
+  EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
+  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+  expect_v1_records(db);
   EXPECT_TRUE(db.comfort_maps().empty()) << "a migrated file has no maps until it is rebuilt";
   expect_input_error([&] { db.comfort_map("right"); },
                      {path + ": comfort_maps", "a comfort map for arm 'right' (arms: none)"});
+  expect_no_handover_records(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v1.db"}) << "no temporary copy left";
 
   // The migrated file holds exactly what this hila writes for the same records: same tables,
   // columns, types and values.
   const std::string fresh = dir + "/fresh.db";
-  write_v1_content_as_v2(fresh);
+  write_reference_content(fresh, false);
   EXPECT_EQ(content_digest(path), content_digest(fresh));
   EXPECT_NE(content_digest(path), digest_v1);
 
@@ -260,6 +330,66 @@ TEST(Migration, Version1FileIsUpgradedToVersion2) {
   const std::string after = read_file(path);
   migrate_in_place(path);
   EXPECT_EQ(read_file(path), after);
+}
+
+TEST(Migration, Version2FileIsUpgradedToVersion3) {
+  const std::string dir = temp_dir("db_migration_v2");
+  const std::string path = write_v2(dir);
+  // Unmigrated, the file is refused as outdated, with the way out.
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 3), got one "
+       "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  EXPECT_THROW(Database::open(path), DatabaseError);
+  const std::string digest_v2 = content_digest(path);
+
+  migrate_in_place(path);
+
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 3);
+  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+  expect_v1_records(db);
+  ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
+  EXPECT_EQ(db.comfort_map("right").origin, Eigen::Vector3d(0.25, -0.5, 1.0));
+  EXPECT_EQ(db.comfort_map("right").seed, 18446744073709551615ull);
+  EXPECT_TRUE(db.comfort_map("right").values.empty());
+  expect_no_handover_records(db);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"v2.db"}) << "no temporary copy left";
+
+  // Same content as this hila writes: the new tables (empty) and meta.human_bodies ("") included.
+  const std::string fresh = dir + "/fresh.db";
+  write_reference_content(fresh, true);
+  EXPECT_EQ(content_digest(path), content_digest(fresh));
+  EXPECT_NE(content_digest(path), digest_v2);
+
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after);
+}
+
+TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
+  // A hand-made version 2 file that already has the key: the step does not overwrite it.
+  const std::string dir = temp_dir("db_migration_v2_bodies");
+  const std::string path = write_v2(dir);
+  execute_script(path, "INSERT INTO meta (key, value) VALUES ('human_bodies', '1.80 male')");
+  migrate_in_place(path);
+  EXPECT_EQ(Database::open(path).meta().human_bodies, "1.80 male");
+}
+
+TEST(Migration, Version2FileThatAlreadyHasTheNewTablesFailsCleanly) {
+  // Version 3 content with the version number set back: the 2 -> 3 step's CREATE TABLE fails and
+  // the file is left as it was.
+  const std::string dir = temp_dir("db_migration_v2_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '2' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 2 -> 3", "table handover_stages already exists"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
 TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
@@ -270,7 +400,7 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   migrate_with_steps(path, steps_from_v0(), current_schema_version());
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 2);
+  EXPECT_EQ(db.meta().schema_version, 3);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -281,28 +411,31 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
     EXPECT_EQ(grasps[i].quality, sample.parts[0].robot_grasps[i].quality) << "data kept";
   }
   EXPECT_TRUE(db.comfort_maps().empty());
+  expect_no_handover_records(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"}) << "no temporary copy left";
 }
 
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 2 -> 3 needs the table step 0 -> 1 creates and the one step 1 -> 2 creates; listed
-  // first to prove ordering.
-  std::vector<MigrationStep> steps = {{2,
-                                       "INSERT INTO notes (text) VALUES ('from step 2');"
-                                       "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"}};
+  // Step 3 -> 4 needs the table step 0 -> 1 creates and the ones steps 1 -> 2 and 2 -> 3 create;
+  // listed first to prove ordering.
+  std::vector<MigrationStep> steps = {{3,
+                                       "INSERT INTO notes (text) VALUES ('from step 3');"
+                                       "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
+                                       "INSERT INTO notes (text) SELECT arm FROM ergonomics;"}};
+  steps.push_back(migration_steps().at(1));
   steps.push_back(migration_steps().at(0));
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 3));
-  migrate_with_steps(path, steps, 3);
-  // The file is now version 3: this hila (2) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 3"});
-  // Migrating to 3 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 4));
+  migrate_with_steps(path, steps, 4);
+  // The file is now version 4: this hila (3) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 4"});
+  // Migrating to 4 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 3);
+  migrate_with_steps(path, steps, 4);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -326,6 +459,7 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
   const std::string before = read_file(path);
   EXPECT_FALSE(can_migrate({}, 0, 1));
   EXPECT_FALSE(can_migrate(kSteps, 0, 2));
+  EXPECT_FALSE(can_migrate({migration_steps().at(0)}, 1, 3)) << "1 -> 2 alone does not reach 3";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },

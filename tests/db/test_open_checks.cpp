@@ -123,7 +123,7 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   const std::string path = write_small(temp_dir("db_open_older"));
   detail::execute_script(path, "UPDATE meta SET value = '0' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "this hila reads (schema version 2)",
+                     {path + ": meta.schema_version", "this hila reads (schema version 3)",
                       "written by schema version 0 (an older hila)",
                       "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
   // There is no step from version 0, so the message must not offer one.
@@ -142,17 +142,35 @@ TEST(OpenChecks, Version1OffersMigration) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 2), "
+       ": meta.schema_version: expected a database this hila reads (schema version 3), "
        "got one written by schema version 1 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
 }
 
+TEST(OpenChecks, Version2OffersMigration) {
+  const std::string path = write_small(temp_dir("db_open_v2"));
+  detail::execute_script(path,
+                         "DROP TABLE shared_grasps; DROP TABLE handover_candidates;"
+                         "DROP TABLE robot_handovers; DROP TABLE handover_stages;"
+                         "DROP TABLE ergonomics; DELETE FROM meta WHERE key = 'human_bodies';"
+                         "UPDATE meta SET value = '2' WHERE key = 'schema_version'");
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 3), "
+       "got one written by schema version 2 (an older hila); rebuild with: hila build "
+       "meshes/cabinet/product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  // The digest still reads it (a version 2 file has no version 3 tables to hash).
+  EXPECT_EQ(content_digest(path).size(), 64u);
+}
+
 TEST(OpenChecks, NewerSchemaVersion) {
   const std::string path = write_small(temp_dir("db_open_newer"));
-  detail::execute_script(path, "UPDATE meta SET value = '3' WHERE key = 'schema_version'");
+  detail::execute_script(path, "UPDATE meta SET value = '4' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "written by schema version 3 (a newer hila)",
+                     {path + ": meta.schema_version", "written by schema version 4 (a newer hila)",
                       "upgrade hila, or rebuild with: hila build"});
 }
 

@@ -61,6 +61,7 @@ TEST_F(ReaderRoundTrip, Meta) {
   EXPECT_EQ(m.created_at, e.created_at);
   EXPECT_EQ(m.cell_file, e.cell_file);
   EXPECT_EQ(m.product_file, e.product_file);
+  EXPECT_EQ(m.human_bodies, e.human_bodies);
   EXPECT_EQ(db.path(), path_);
 }
 
@@ -306,6 +307,8 @@ TEST(Reader, EmptyDatabaseOpens) {
   const Database db = Database::open(path);
   EXPECT_TRUE(db.parts().empty());
   EXPECT_TRUE(db.comfort_maps().empty());
+  EXPECT_TRUE(db.handover_stages().empty());
   EXPECT_EQ(db.meta().seed, 0u);
+  EXPECT_EQ(db.meta().human_bodies, "");
   expect_input_error([&] { db.part("x"); }, {"parts: none"});
 }

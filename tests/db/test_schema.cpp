@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
@@ -20,17 +21,42 @@ std::string schema_only_database(const std::string& name) {
   return path;
 }
 
+// The CREATE statements in `sql` ("CREATE ... ;"), in order.
+std::vector<std::string> create_statements(const std::string& sql) {
+  std::vector<std::string> statements;
+  for (std::size_t at = sql.find("CREATE "); at != std::string::npos;
+       at = sql.find("CREATE ", at + 1)) {
+    statements.push_back(sql.substr(at, sql.find(';', at) + 1 - at));
+  }
+  return statements;
+}
+
 }  // namespace
 
-TEST(Schema, VersionIsTwoWithTheStepFromOne) {
-  EXPECT_EQ(current_schema_version(), 2);
-  ASSERT_EQ(migration_steps().size(), 1u);
+TEST(Schema, VersionIsThreeWithStepsFromOneAndTwo) {
+  EXPECT_EQ(current_schema_version(), 3);
+  ASSERT_EQ(migration_steps().size(), 2u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
+  EXPECT_EQ(migration_steps()[1].from_version, 2);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
-  // The step creates the table exactly as a fresh database has it.
+  // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
   EXPECT_NE(schema_sql().find(migration_steps()[0].sql), std::string::npos);
+  const auto created = create_statements(migration_steps()[1].sql);
+  ASSERT_EQ(created.size(), 8u) << "5 tables, 3 indexes";
+  for (const std::string table : {"handover_stages", "robot_handovers", "handover_candidates",
+                                  "shared_grasps", "ergonomics"}) {
+    EXPECT_NE(migration_steps()[1].sql.find("CREATE TABLE " + table + " ("), std::string::npos)
+        << table;
+  }
+  for (const auto& statement : created) {
+    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  EXPECT_NE(migration_steps()[1].sql.find(
+                "INSERT OR IGNORE INTO meta (key, value) VALUES ('human_bodies', '');"),
+            std::string::npos);
 }
 
 TEST(Schema, ColumnListHelpers) {
@@ -39,17 +65,65 @@ TEST(Schema, ColumnListHelpers) {
 }
 
 TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
-  ASSERT_EQ(kTables.size(), 7u);
+  ASSERT_EQ(kTables.size(), 12u);
   EXPECT_STREQ(kTables[0].name, "meta");
   EXPECT_STREQ(kTables[1].name, "parts");
   EXPECT_STREQ(kTables[6].name, "comfort_maps");
   EXPECT_EQ(kTables[6].since_version, 2);
+  EXPECT_STREQ(kTables[7].name, "handover_stages");
+  EXPECT_STREQ(kTables[8].name, "robot_handovers");
+  EXPECT_STREQ(kTables[9].name, "handover_candidates");
+  EXPECT_STREQ(kTables[10].name, "shared_grasps");
+  EXPECT_STREQ(kTables[11].name, "ergonomics");
+  for (std::size_t i = 7; i < kTables.size(); ++i) EXPECT_EQ(kTables[i].since_version, 3);
   for (const auto& table : kTables) {
     EXPECT_NE(schema_sql().find(std::string("CREATE TABLE ") + table.name + " ("),
               std::string::npos)
         << table.name;
     EXPECT_GE(table.since_version, 1);
     EXPECT_LE(table.since_version, current_schema_version());
+  }
+  // And the SQL has no table the digest would miss.
+  std::size_t tables = 0;
+  for (const auto& statement : create_statements(schema_sql())) {
+    tables += statement.rfind("CREATE TABLE ", 0) == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(tables, kTables.size());
+}
+
+TEST(Schema, HandoverAndErgonomicsColumnsAreDeclared) {
+  const std::string& sql = schema_sql();
+  for (const std::string column : {
+           "part_id INTEGER NOT NULL UNIQUE REFERENCES parts(id)",
+           "finished_parts TEXT NOT NULL",
+           "draws INTEGER NOT NULL",
+           "comfortable_default_body INTEGER NOT NULL",
+           "two_hands INTEGER NOT NULL CHECK (two_hands IN (0, 1))",
+           "failure TEXT NOT NULL",
+           "suction_grasp_id INTEGER NOT NULL REFERENCES suction_grasps(id)",
+           "joints BLOB NOT NULL",
+           "sample INTEGER NOT NULL",
+           "distance REAL NOT NULL",
+           "status TEXT NOT NULL CHECK (status IN ('uncomfortable', 'no_shared_grasp', 'goal'))",
+           "rank INTEGER NOT NULL",
+           "human_arm TEXT NOT NULL",
+           "human_grasp_id INTEGER NOT NULL",
+           "second_quality REAL NOT NULL",
+           "human_joints BLOB NOT NULL",
+           "second_joints BLOB NOT NULL",
+           "candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id)",
+           "robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id)",
+           "robot_handover_id INTEGER NOT NULL REFERENCES robot_handovers(id)",
+           "joints_rr BLOB NOT NULL",
+           "joints_rh BLOB NOT NULL",
+           "inclination_rr_deg REAL NOT NULL",
+           "method TEXT NOT NULL CHECK (method IN ('hila', 'table', 'alone'))",
+           "reachable INTEGER NOT NULL CHECK (reachable IN (0, 1))",
+           "shoulder_elevated INTEGER NOT NULL CHECK (shoulder_elevated IN (0, 1))",
+           "reorientation_deg REAL NOT NULL",
+           "UNIQUE (part_id, method)",
+       }) {
+    EXPECT_NE(sql.find(column), std::string::npos) << column;
   }
 }
 
@@ -68,7 +142,8 @@ TEST(Schema, ComfortMapColumnsAreDeclaredNotNull) {
 
 TEST(Schema, EveryPoseAndVectorColumnIsDeclared) {
   const std::string& sql = schema_sql();
-  for (const std::string prefix : {"target", "initial", "part_in_plane", "tcp", "cup", "hand"}) {
+  for (const std::string prefix :
+       {"target", "initial", "part_in_plane", "tcp", "cup", "hand", "board"}) {
     for (const std::string suffix : {"_x ", "_y ", "_z ", "_qw ", "_qx ", "_qy ", "_qz "}) {
       EXPECT_NE(sql.find(prefix + suffix + "REAL NOT NULL"), std::string::npos) << prefix << suffix;
     }
@@ -85,13 +160,20 @@ TEST(Schema, SqlRunsOnAnEmptyFileAndCreatesThePartIdIndexes) {
   const std::string path = schema_only_database("db_schema_indexes");
   // Creating an index that already exists fails: that is how the test sees the index without SQL
   // access of its own.
-  for (const std::string table : {"placements", "robot_grasps", "suction_grasps", "human_grasps"}) {
+  for (const std::string table : {"placements", "robot_grasps", "suction_grasps", "human_grasps",
+                                  "robot_handovers", "handover_candidates"}) {
     expect_input_error(
         [&] {
           execute_script(path, "CREATE INDEX " + table + "_part_id ON " + table + "(part_id)");
         },
         {path, "already exists"});
   }
+  expect_input_error(
+      [&] {
+        execute_script(path,
+                       "CREATE INDEX shared_grasps_candidate_id ON shared_grasps(candidate_id)");
+      },
+      {path, "already exists"});
 }
 
 TEST(Schema, ConstraintsRejectBadRows) {

@@ -38,15 +38,44 @@ class DatabaseWriter {
   DatabaseWriter(const DatabaseWriter&) = delete;
   DatabaseWriter& operator=(const DatabaseWriter&) = delete;
 
-  // Record ids are assigned by the database (1, 2, ... in call order); the records' own id and
-  // part_id fields are ignored. An empty meta.created_at is filled with the current UTC time.
-  // After any failed call the writer refuses to commit (the temporary file is discarded).
+  // Record ids are assigned by the database (1, 2, ... per table in call order; the add_ calls
+  // that return ids return them in record order); the records' own id and, where the call takes a
+  // part_id, their part_id fields are ignored. An empty meta.created_at is filled with the current
+  // UTC time. A part_id (and any other id a record refers to) must name a record written before,
+  // otherwise DatabaseError (FOREIGN KEY constraint failed). After any failed call the writer
+  // refuses to commit (the temporary file is discarded).
   void write_meta(const Meta& meta);              // schema_version is set by the writer
   std::int64_t add_part(const PartRecord& part);  // returns the part id
   void add_placements(std::int64_t part_id, const std::vector<PlacementRecord>& placements);
-  void add_robot_grasps(std::int64_t part_id, const std::vector<RobotGraspRecord>& grasps);
-  void add_suction_grasps(std::int64_t part_id, const std::vector<SuctionGraspRecord>& grasps);
-  void add_human_grasps(std::int64_t part_id, const std::vector<HumanGraspRecord>& grasps);
+  std::vector<std::int64_t> add_robot_grasps(std::int64_t part_id,
+                                             const std::vector<RobotGraspRecord>& grasps);
+  std::vector<std::int64_t> add_suction_grasps(std::int64_t part_id,
+                                               const std::vector<SuctionGraspRecord>& grasps);
+  std::vector<std::int64_t> add_human_grasps(std::int64_t part_id,
+                                             const std::vector<HumanGraspRecord>& grasps);
+
+  // Handover goals and ergonomics (schema version 3). Every double of these records (poses, joint
+  // values included) must be finite: otherwise std::invalid_argument naming the call, table.column,
+  // the record and the value, before anything of the call is written.
+  //
+  // One stage per part, for stage.part_id: DatabaseError for a second stage of the same part
+  // (UNIQUE constraint failed: handover_stages.part_id) or an unknown part. finished_parts names
+  // must be non-empty and free of '\n' (std::invalid_argument): they are stored "\n"-joined.
+  void add_handover_stage(const HandoverStageRecord& stage);
+  // suction_grasp_id must be a written suction grasp.
+  std::vector<std::int64_t> add_robot_handovers(std::int64_t part_id,
+                                                const std::vector<RobotHandoverRecord>& handovers);
+  // status must be "uncomfortable", "no_shared_grasp" or "goal", rank >= 0 for a goal and -1
+  // otherwise (DatabaseError: CHECK constraint failed). human_grasp_id and second_grasp_id are
+  // stored as given (0: none), not checked against human_grasps.
+  std::vector<std::int64_t> add_handover_candidates(
+      std::int64_t part_id, const std::vector<HandoverCandidateRecord>& candidates);
+  // candidate_id, robot_grasp_id and robot_handover_id are taken from each record and must name
+  // written records.
+  void add_shared_grasps(const std::vector<SharedGraspRecord>& grasps);
+  // method must be "hila", "table" or "alone", at most one row per part and method (DatabaseError:
+  // CHECK / UNIQUE constraint failed).
+  void add_ergonomics(std::int64_t part_id, const std::vector<ErgonomicsRecord>& rows);
   // One map per human arm; the values are stored zlib-compressed. Throws std::invalid_argument
   // for an empty arm name, spacing <= 0, a dimension <= 0, values.size() != dims.prod() *
   // orientations.size() or an orientation that is not a unit quaternion (to 1e-9), and
@@ -88,6 +117,17 @@ class Database {
   const std::vector<ComfortMapRecord>& comfort_maps() const { return comfort_maps_; }
   const ComfortMapRecord& comfort_map(const std::string& arm) const;  // throws core::InputError
 
+  // Handover goals and ergonomics. The part's stage, or nullptr when the database has none for it
+  // (the pointer stays valid as long as this Database). All stages in id order.
+  const HandoverStageRecord* handover_stage(std::int64_t part_id) const;
+  const std::vector<HandoverStageRecord>& handover_stages() const { return handover_stages_; }
+  std::vector<RobotHandoverRecord> robot_handovers(std::int64_t part_id) const;          // id order
+  std::vector<HandoverCandidateRecord> handover_candidates(std::int64_t part_id) const;  // id order
+  // The part's candidates with status "goal", by rank ascending (then id).
+  std::vector<HandoverCandidateRecord> handover_goals(std::int64_t part_id) const;
+  std::vector<SharedGraspRecord> shared_grasps(std::int64_t candidate_id) const;  // id order
+  std::vector<ErgonomicsRecord> ergonomics(std::int64_t part_id) const;  // id (write) order
+
  private:
   std::string path_;
   Meta meta_;
@@ -97,6 +137,11 @@ class Database {
   std::vector<SuctionGraspRecord> suction_grasps_;
   std::vector<HumanGraspRecord> human_grasps_;
   std::vector<ComfortMapRecord> comfort_maps_;
+  std::vector<HandoverStageRecord> handover_stages_;
+  std::vector<RobotHandoverRecord> robot_handovers_;
+  std::vector<HandoverCandidateRecord> handover_candidates_;
+  std::vector<SharedGraspRecord> shared_grasps_;
+  std::vector<ErgonomicsRecord> ergonomics_;
 };
 
 // Upgrades a database written by an older schema version to current_schema_version(): copies it
@@ -105,9 +150,9 @@ class Database {
 // Throws DatabaseError for a newer, foreign or corrupt file, or when no migration path exists.
 void migrate_in_place(const std::string& path);
 
-// A hash of the database content (every table, rows in id order, doubles by their exact bits,
-// comfort map values uncompressed), ignoring meta.created_at: two builds from the same inputs and
-// seed have the same digest.
+// A hash of the database content (every table of the file's schema version, rows in id order,
+// doubles by their exact bits, comfort map values uncompressed), ignoring meta.created_at: two
+// builds from the same inputs and seed have the same digest.
 std::string content_digest(const std::string& path);
 
 }  // namespace hila::db

@@ -12,7 +12,8 @@ struct MigrationStep {
   std::string sql;
 };
 
-// The steps this build of hila knows, in order (1 -> 2 adds comfort_maps).
+// The steps this build of hila knows, in order (1 -> 2 adds comfort_maps, 2 -> 3 the handover and
+// ergonomics tables and meta.human_bodies).
 const std::vector<MigrationStep>& migration_steps();
 
 // True if `steps` hold one step for every version from `from_version` up to `to_version` - 1.

@@ -93,6 +93,80 @@ struct ComfortMapRecord {
   double coverage = 0.0;  // share of in-reach bins holding a value
 };
 
+// Robot-human handover goals of one board at its assembly stage (paper §IV, §VI-B): the boards
+// assembled before it stand at their targets. One row per board.
+struct HandoverStageRecord {
+  std::int64_t part_id = 0;
+  std::vector<std::string> finished_parts;  // in assembly order
+  int draws = 0;                            // poses drawn to obtain the candidates
+  int candidates = 0;   // poses satisfying Eq. 1 (rotation < 45 deg, offset < 0.5 m, no collision)
+  int comfortable = 0;  // |S|: best human grasp above the comfort threshold (every body of the set)
+  int comfortable_default_body = 0;  // |S| for the cell's own human alone
+  int goals = 0;                     // |𝕊|: members of S with a shared grasp
+  int robot_handovers = 0;           // feasible robot-robot handover poses
+  bool two_hands = false;            // no one-hand human grasp holds the board
+  std::string failure;               // empty when goals > 0, else why there is none
+};
+
+// A robot-robot handover pose: the right arm holds the board by suction at its centre of mass.
+struct RobotHandoverRecord {
+  std::int64_t id = 0;
+  std::int64_t part_id = 0;
+  core::Pose board = core::Pose::Identity();  // world
+  std::int64_t suction_grasp_id = 0;
+  std::string arm;         // the arm holding the suction tool
+  Eigen::VectorXd joints;  // its IK solution, rad
+};
+
+// A sampled robot-human handover pose (Eq. 1) with its evaluation. Status: "uncomfortable" (not
+// in S), "no_shared_grasp" (in S, not in 𝕊), "goal" (in 𝕊; rank is its Eq. 8 position).
+struct HandoverCandidateRecord {
+  std::int64_t id = 0;
+  std::int64_t part_id = 0;
+  int sample = 0;                             // index among the Eq. 1 candidates
+  core::Pose board = core::Pose::Identity();  // world
+  double distance = 0.0;  // Eq. 8: position offset + rotation weight * rotation angle, m
+  double quality = 0.0;   // best human Q (weaker hand for two-hand boards, worst body of the set)
+  std::string status;
+  int rank = -1;                    // 0-based among the goals, -1 for the others
+  std::string human_arm;            // arm of the best human grasp ("" when none)
+  std::int64_t human_grasp_id = 0;  // 0 when none
+  double human_quality = 0.0;       // that hand's Q
+  std::string second_arm;           // the other hand for two-hand boards ("" otherwise)
+  std::int64_t second_grasp_id = 0;
+  double second_quality = 0.0;
+  Eigen::VectorXd human_joints;   // goals: best-Q IK of human_arm (empty otherwise), rad
+  Eigen::VectorXd second_joints;  // goals of two-hand boards: IK of second_arm
+};
+
+// A robot grasp valid at both handover poses of a goal (the receiving arm's IK at each).
+struct SharedGraspRecord {
+  std::int64_t id = 0;
+  std::int64_t candidate_id = 0;  // a "goal" candidate
+  std::int64_t robot_grasp_id = 0;
+  std::int64_t robot_handover_id = 0;  // the robot-robot pose it is received at
+  std::string arm;                     // the receiving arm
+  Eigen::VectorXd joints_rr;           // at the robot-robot pose, rad
+  Eigen::VectorXd joints_rh;           // at the robot-human pose, rad
+  double inclination_rr_deg = 0.0;     // opening axis vs gravity at each pose (<= theta_c)
+  double inclination_rh_deg = 0.0;
+};
+
+// One way of getting a board to the human, as the human's body experiences it (the paper's
+// Table 2 in numbers). Method: "hila" (the first goal), "table" (laid flat on the table in front
+// of the human), "alone" (the human takes it from the stack).
+struct ErgonomicsRecord {
+  std::int64_t part_id = 0;
+  std::string method;
+  bool reachable = false;          // some grasp reachable with the torso bent up to its limit
+  double torso_flexion_deg = 0.0;  // least forward bend needed
+  bool shoulder_elevated = false;  // elbow at or above shoulder height
+  double reach = 0.0;              // shoulder to hand, m
+  double reorientation_deg = 0.0;  // rotation left to bring the board to its target
+  double quality = 0.0;            // comfort Q of the posture
+  std::string arm;                 // the human arm used
+};
+
 // Self-description of a database (the `meta` table, one key per field).
 struct Meta {
   int schema_version = 0;
@@ -105,6 +179,9 @@ struct Meta {
   std::string created_at;  // ISO 8601 UTC; excluded from the content digest
   std::string cell_file;
   std::string product_file;
+  // The human bodies every handover goal was checked for, "STATURE SEX" joined by "; " (empty:
+  // the cell's human only).
+  std::string human_bodies;
 };
 
 }  // namespace hila::db
