@@ -3,6 +3,7 @@
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/convex.h>
 #include <fcl/geometry/shape/cylinder.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/collision.h>
@@ -33,7 +34,38 @@ struct CollisionModelImpl {
 
 namespace {
 
+// A closed mesh is convex when no vertex lies in front of any triangle's plane. Checked only for
+// small meshes (boards, boxes), where it pays: FCL refits an OBB of the other shape on every
+// shape-vs-mesh query, while a Convex goes through GJK.
+bool is_small_convex(const TriangleMesh& mesh) {
+  if (mesh.triangles.empty() || mesh.triangles.size() > 64) return false;
+  const double size = (mesh.max_corner() - mesh.min_corner()).norm();
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(t[0])];
+    const Eigen::Vector3d n = (mesh.vertices[static_cast<std::size_t>(t[1])] - a)
+                                  .cross(mesh.vertices[static_cast<std::size_t>(t[2])] - a);
+    if (n.norm() <= 0.0) return false;
+    const Eigen::Vector3d unit = n.normalized();
+    for (const auto& v : mesh.vertices) {
+      if (unit.dot(v - a) > 1e-9 * size) return false;
+    }
+  }
+  return true;
+}
+
+FclGeometry make_convex_geometry(const TriangleMesh& mesh, const Eigen::Vector3d& scale) {
+  auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
+  for (const auto& v : mesh.vertices) vertices->emplace_back(v.cwiseProduct(scale));
+  auto faces = std::make_shared<std::vector<int>>();
+  for (const auto& t : mesh.triangles) faces->insert(faces->end(), {3, t[0], t[1], t[2]});
+  auto convex = std::make_shared<fcl::Convexd>(vertices, static_cast<int>(mesh.triangles.size()),
+                                               faces);
+  convex->computeLocalAABB();
+  return convex;
+}
+
 FclGeometry make_mesh_geometry(const TriangleMesh& mesh, const Eigen::Vector3d& scale) {
+  if (is_small_convex(mesh)) return make_convex_geometry(mesh, scale);
   auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
   std::vector<fcl::Vector3d> points;
   points.reserve(mesh.vertices.size());

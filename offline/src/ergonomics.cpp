@@ -114,7 +114,7 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
     q[vars[i]] = posture.arm_joints[static_cast<Eigen::Index>(i)];
   }
   human.link_poses(q, links);
-  auto joint_position = [&](const std::string& name) {
+  auto joint_position = [&](const std::string& name) -> Eigen::Vector3d {
     const auto& joint = human.joints()[static_cast<std::size_t>(human.joint_index(name))];
     return (stance * links[static_cast<std::size_t>(joint.child_link)]).translation();
   };

@@ -485,6 +485,19 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     return result.candidates[static_cast<std::size_t>(a)].distance <
            result.candidates[static_cast<std::size_t>(b)].distance;
   });
+  ComfortSettings ik_settings;
+  ik_settings.ik_attempts = 12;
+  ik_settings.seed = settings.seed;
+  auto solve_human = [&](const core::Pose& board, int arm, int grasp) {
+    const auto& chain = cell.human_arms()[static_cast<std::size_t>(arm)].chain;
+    const core::Pose hand =
+        comfort.arm_base(arm).inverse() * board * grasps.human[static_cast<std::size_t>(grasp)].hand;
+    const Eigen::VectorXd seed = Eigen::VectorXd::Zero(chain.dof())
+                                     .cwiseMax(chain.lower_limits())
+                                     .cwiseMin(chain.upper_limits());
+    return best_comfort(chain, hand, seed, ik_settings);
+  };
+  int verified = 0;
   // At the robot-human pose the receiving arm and the board it holds move against the rest.
   std::vector<int> rh_bodies = receiving_bodies;
   rh_bodies.push_back(scene.board);
@@ -522,33 +535,40 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     restore_receiving();
     reset_state();
-    if (shared > 0) {
-      c.status = "goal";
-      c.rank = stage.goals++;
+    if (shared == 0) continue;
+    // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
+    // are coarse, so a bin's Q may come from a neighbouring hand orientation.
+    if (verified < settings.human_ik_goals) {
+      const ComfortResult first = solve_human(c.board, h.arm, h.grasp);
+      ComfortResult second;
+      if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
+      const double q = h.second_grasp >= 0 ? std::min(first.quality, second.quality)
+                                            : first.quality;
+      if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) ||
+          q <= settings.comfort_threshold) {
+        // Not comfortable after all: out of S, and its shared grasps go.
+        c.status = "uncomfortable";
+        c.quality = q;
+        --stage.comfortable;
+        result.shared.erase(std::remove_if(result.shared.begin(), result.shared.end(),
+                                           [&](const db::SharedGraspRecord& r) {
+                                             return r.candidate_id == ci;
+                                           }),
+                            result.shared.end());
+        continue;
+      }
+      ++verified;
+      c.human_joints = first.joints;
+      c.human_quality = first.quality;
+      if (h.second_grasp >= 0) {
+        c.second_joints = second.joints;
+        c.second_quality = second.quality;
+      }
     }
+    c.status = "goal";
+    c.rank = stage.goals++;
   }
   reset_state();
-
-  // --- The human's posture at the first goals (direct IK) ------------------------------------
-  ComfortSettings ik_settings;
-  ik_settings.ik_attempts = 12;
-  ik_settings.seed = settings.seed;
-  for (const int ci : comfortable) {
-    auto& c = result.candidates[static_cast<std::size_t>(ci)];
-    if (c.status != "goal" || c.rank >= settings.human_ik_goals) continue;
-    const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
-    auto solve = [&](int arm, int grasp) {
-      const auto& chain = cell.human_arms()[static_cast<std::size_t>(arm)].chain;
-      const core::Pose hand = comfort.arm_base(arm).inverse() * c.board *
-                              grasps.human[static_cast<std::size_t>(grasp)].hand;
-      const Eigen::VectorXd seed =
-          Eigen::VectorXd::Zero(chain.dof()).cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
-      const ComfortResult r = best_comfort(chain, hand, seed, ik_settings);
-      return r.reachable ? r.joints : Eigen::VectorXd();
-    };
-    c.human_joints = solve(h.arm, h.grasp);
-    if (h.second_grasp >= 0) c.second_joints = solve(h.second_arm, h.second_grasp);
-  }
 
   if (stage.goals == 0) {
     return finish("no comfortable candidate shares a grasp with a robot-robot handover pose (|S| = " +

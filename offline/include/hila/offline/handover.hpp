@@ -36,7 +36,9 @@ struct HandoverSettings {
   int rr_orientations = 64;  // board orientations tried per position (spread over SO(3))
   int rr_poses = 24;         // suction-feasible robot-robot poses examined for receiving grasps
   int shared_stored = 8;     // shared grasps searched for and stored per goal
-  int human_ik_goals = 5;    // goals whose human posture is solved by direct IK and stored
+  // The first goals in Eq. 8 order are confirmed by direct IK of the human arm (best Q over
+  // restarts; a candidate failing it leaves S) and carry the human's posture.
+  int human_ik_goals = 10;
   std::uint64_t seed = 3;
 };
 

@@ -1,0 +1,125 @@
+#include <gtest/gtest.h>
+
+#include "hila/core/product.hpp"
+#include "hila/offline/ergonomics.hpp"
+#include "hila/offline/handover.hpp"
+#include "hila/offline/human_grasps.hpp"
+#include "hila/offline/part_analysis.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+// Maps with fewer samples than the default: sparse, but the posture search confirms every
+// candidate by direct IK, so they only steer it.
+const offline::HumanComfort& comfort() {
+  static const offline::HumanComfort c = [] {
+    const auto cell = test::reference_cell();
+    std::vector<offline::ComfortMap> maps;
+    offline::ComfortMapSettings s;
+    s.samples = 300000;
+    for (const auto& arm : cell->human_arms()) maps.push_back(offline::ComfortMap::build(arm.chain, s));
+    return offline::HumanComfort(*cell, maps);
+  }();
+  return c;
+}
+
+struct Board {
+  core::PartSpec spec;
+  offline::PartAnalysis analysis;
+  std::vector<db::HumanGraspRecord> grasps;
+  std::vector<int> one_hand;
+};
+
+Board shelf_board() {
+  static const core::ProductSpec product = core::load_product(test::product_path());
+  Board b;
+  b.spec = product.part("back_lower");  // 0.22 kg: one hand holds it
+  b.analysis = offline::analyze_part(b.spec.name, b.spec.mesh, b.spec.mass);
+  offline::HumanGraspSettings s;
+  s.samples = 300;
+  b.grasps = offline::plan_human_grasps(b.analysis.mesh, b.analysis, b.spec.mass,
+                                        *test::reference_cell(), s);
+  for (std::size_t g = 0; g < b.grasps.size(); ++g) {
+    if (b.grasps[g].one_hand_stable) b.one_hand.push_back(static_cast<int>(g));
+  }
+  return b;
+}
+
+// Shoulder of the human arm in the world, by the human model's own FK at the neutral posture
+// bent by `flexion_deg` (an independent path from the posture search's).
+Eigen::Vector3d shoulder_in_world(const core::Cell& cell, int arm, double flexion_deg) {
+  Eigen::VectorXd q = cell.human_neutral();
+  q[cell.human().joints()[static_cast<std::size_t>(cell.human().joint_index("torso_flexion"))]
+        .variable] = core::deg_to_rad(flexion_deg);
+  std::vector<core::Pose> links;
+  cell.human().link_poses(q, links);
+  const auto& chain = cell.human_arms()[static_cast<std::size_t>(arm)].chain;
+  const auto torso = links[static_cast<std::size_t>(cell.human().link_index(chain.base_link()))];
+  return cell.spec().human_stance * torso * chain.first_joint_position();
+}
+
+}  // namespace
+
+TEST(Ergonomics, BoardHeldInFrontAtWaistHeightNeedsNoBendAndReachIsShoulderToHand) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  // Flat, 35 cm in front of the human, 10 cm above the table.
+  core::Pose board = core::Pose::Identity();
+  board.translation() = cell->spec().human_stance * Eigen::Vector3d(0.35, 0.0, 1.10);
+  const offline::ErgonomicsSettings settings;
+  const auto p = offline::receiving_posture(*cell, comfort(), cell->spec().human_stance, board,
+                                            b.grasps, b.one_hand, -1, settings);
+  ASSERT_TRUE(p.reachable);
+  EXPECT_EQ(p.torso_flexion_deg, 0.0);
+  EXPECT_FALSE(p.shoulder_elevated);
+  const Eigen::Vector3d hand =
+      (board * b.grasps[static_cast<std::size_t>(p.grasp)].hand).translation();
+  EXPECT_NEAR(p.reach, (hand - shoulder_in_world(*cell, p.arm, 0.0)).norm(), 1e-9);
+  EXPECT_LT(p.reach, 0.8);
+  EXPECT_GT(p.quality, 0.0);
+  // The posture's joints put the hand on the grasp (direct FK of the arm).
+  const auto& arm = cell->human_arms()[static_cast<std::size_t>(p.arm)];
+  const core::Pose base = comfort().arm_base(p.arm);
+  EXPECT_LT(((base * arm.chain.fk(p.arm_joints)).translation() - hand).norm(), 1e-4);
+}
+
+TEST(Ergonomics, BoardOnTheStackFarAcrossTheTableNeedsABend) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  core::Pose stance = cell->spec().human_stance;
+  stance.translation().y() = b.spec.initial.translation().y();
+  const auto p = offline::receiving_posture(*cell, comfort(), stance, b.spec.initial, b.grasps,
+                                            b.one_hand, -1, offline::ErgonomicsSettings{});
+  if (p.reachable) {
+    EXPECT_GE(p.torso_flexion_deg, 20.0);
+  }
+  // Upright, the board on the stack is out of reach: no grasp's hand pose has an IK solution.
+  offline::ErgonomicsSettings upright;
+  upright.flexion_step_deg = 1000.0;  // only 0 degrees
+  EXPECT_FALSE(offline::receiving_posture(*cell, comfort(), stance, b.spec.initial, b.grasps,
+                                          b.one_hand, -1, upright)
+                   .reachable);
+}
+
+TEST(Ergonomics, TableDropPoseLiesFlatOnTheTableAtTheSpot) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  const offline::ErgonomicsSettings settings;
+  const core::Pose pose =
+      offline::table_drop_pose(*cell, b.analysis.placements.front().part_in_plane, settings);
+  // The lowest vertex touches the table top (z = 1.094) and the longest side runs along y.
+  double lowest = 1e9;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (const auto& v : b.analysis.mesh.vertices) {
+    const Eigen::Vector3d w = pose * v;
+    lowest = std::min(lowest, w.z());
+    lo = lo.cwiseMin(w);
+    hi = hi.cwiseMax(w);
+  }
+  EXPECT_NEAR(lowest, 1.094, 1e-6);
+  EXPECT_GT(hi.y() - lo.y(), hi.x() - lo.x());
+  EXPECT_NEAR(0.5 * (lo.x() + hi.x()), settings.table_spot_x, 1e-6);
+  EXPECT_NEAR(0.5 * (lo.y() + hi.y()), settings.table_spot_y, 1e-6);
+}
