@@ -1,0 +1,261 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+
+#include "hila/core/product.hpp"
+#include "hila/core/stage_scene.hpp"
+#include "hila/offline/handover.hpp"
+#include "hila/offline/human_grasps.hpp"
+#include "hila/offline/part_analysis.hpp"
+#include "hila/offline/robot_grasps.hpp"
+#include "hila/offline/suction_grasps.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+const core::ProductSpec& product() {
+  static const core::ProductSpec p = core::load_product(test::product_path());
+  return p;
+}
+
+// Maps with a third of the default samples: sparser, which only makes S smaller.
+const offline::HumanComfort& comfort() {
+  static const offline::HumanComfort c = [] {
+    const auto cell = test::reference_cell();
+    std::vector<offline::ComfortMap> maps;
+    offline::ComfortMapSettings s;
+    s.samples = 1000000;
+    for (const auto& arm : cell->human_arms()) maps.push_back(offline::ComfortMap::build(arm.chain, s));
+    return offline::HumanComfort(*cell, maps);
+  }();
+  return c;
+}
+
+offline::BoardGrasps board_grasps(std::size_t index) {
+  const auto cell = test::reference_cell();
+  const auto& part = product().parts[index];
+  const auto analysis = offline::analyze_part(part.name, part.mesh, part.mass);
+  offline::BoardGrasps g;
+  g.robot = offline::plan_robot_grasps(analysis.mesh, analysis, part.mass, *cell, {});
+  g.suction = offline::plan_suction_grasps(analysis.mesh, analysis, part.mass, *cell, {});
+  offline::HumanGraspSettings human;
+  human.samples = 400;
+  g.human = offline::plan_human_grasps(analysis.mesh, analysis, part.mass, *cell, human);
+  g.com = analysis.mass_properties.com;
+  return g;
+}
+
+// Oriented box of a board (its mesh's bounding box in the part frame, placed in the world).
+struct Obb {
+  Eigen::Vector3d centre;
+  Eigen::Matrix3d axes;
+  Eigen::Vector3d half;
+};
+
+Obb board_box(const core::PartSpec& part, const core::Pose& pose) {
+  const Eigen::Vector3d lo = part.mesh.min_corner(), hi = part.mesh.max_corner();
+  return {pose * (0.5 * (lo + hi)), pose.linear(), 0.5 * (hi - lo)};
+}
+
+// Separating-axis test of two oriented boxes (Gottschalk), with a small tolerance so touching
+// faces do not count: independent of FCL.
+bool boxes_overlap(const Obb& a, const Obb& b) {
+  std::vector<Eigen::Vector3d> axes;
+  for (int i = 0; i < 3; ++i) {
+    axes.push_back(a.axes.col(i));
+    axes.push_back(b.axes.col(i));
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d c = a.axes.col(i).cross(b.axes.col(j));
+      if (c.norm() > 1e-9) axes.push_back(c.normalized());
+    }
+  }
+  const Eigen::Vector3d d = b.centre - a.centre;
+  for (const auto& axis : axes) {
+    double ra = 0.0, rb = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      ra += a.half[k] * std::abs(axis.dot(a.axes.col(k)));
+      rb += b.half[k] * std::abs(axis.dot(b.axes.col(k)));
+    }
+    if (std::abs(axis.dot(d)) > ra + rb - 1e-6) return false;
+  }
+  return true;
+}
+
+double angle_between(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  const double dot = std::abs(Eigen::Quaterniond(a).dot(Eigen::Quaterniond(b)));
+  return 2.0 * std::acos(std::min(1.0, dot));
+}
+
+void check_stage(std::size_t index) {
+  const auto cell = test::reference_cell();
+  const auto& part = product().parts[index];
+  const auto grasps = board_grasps(index);
+  const offline::HandoverSettings settings;
+  const auto result =
+      offline::plan_handover_goals(*cell, product(), index, grasps, comfort(), settings);
+  const auto& stage = result.stage;
+  ASSERT_EQ(stage.failure, "") << part.name;
+  ASSERT_GT(stage.goals, 0);
+  const core::Pose target = product().target_in_world(part);
+
+  // Every candidate satisfies Eq. 1, checked independently (quaternion angle, SAT boxes).
+  EXPECT_EQ(stage.candidates, settings.candidates);
+  EXPECT_EQ(static_cast<int>(result.candidates.size()), stage.candidates);
+  int comfortable = 0, goals = 0;
+  for (const auto& c : result.candidates) {
+    EXPECT_LT(angle_between(c.board.linear(), target.linear()), core::deg_to_rad(45.0));
+    EXPECT_LT((c.board.translation() - target.translation()).norm(), 0.5);
+    for (std::size_t f = 0; f < index; ++f) {
+      const auto& other = product().parts[f];
+      EXPECT_FALSE(boxes_overlap(board_box(part, c.board),
+                                 board_box(other, product().target_in_world(other))))
+          << "candidate " << c.sample << " overlaps " << other.name;
+    }
+    comfortable += c.status != "uncomfortable" ? 1 : 0;
+    goals += c.status == "goal" ? 1 : 0;
+    if (c.status != "uncomfortable") {
+      EXPECT_GT(c.quality, settings.comfort_threshold);
+    }
+  }
+  EXPECT_EQ(comfortable, stage.comfortable);
+  EXPECT_EQ(goals, stage.goals);
+
+  // Eq. 8: goals ranked by the distance, recomputed independently.
+  std::vector<const db::HandoverCandidateRecord*> ranked;
+  for (const auto& c : result.candidates) {
+    if (c.status == "goal") ranked.push_back(&c);
+  }
+  std::sort(ranked.begin(), ranked.end(), [](auto* a, auto* b) { return a->rank < b->rank; });
+  for (std::size_t r = 0; r < ranked.size(); ++r) {
+    const auto& c = *ranked[r];
+    EXPECT_EQ(c.rank, static_cast<int>(r));
+    const double d = (c.board.translation() - target.translation()).norm() +
+                     settings.rotation_weight * angle_between(c.board.linear(), target.linear());
+    EXPECT_NEAR(c.distance, d, 1e-9);
+    if (r > 0) EXPECT_LE(ranked[r - 1]->distance, c.distance);
+  }
+
+  // Every member of 𝕊 re-verified: FK (not IK) of the stored joints, joint limits, the slip
+  // torque from the board's geometry, and a brute-force collision check of the whole scene.
+  const core::Arm& receiving = cell->arm(settings.receiving_arm);
+  const core::Arm& suction_arm = cell->arm(settings.suction_arm);
+  const core::Pose receiving_base = core::arm_base_in_world(*cell, receiving);
+  const core::Pose suction_base = core::arm_base_in_world(*cell, suction_arm);
+  std::vector<core::PlacedPart> finished;
+  for (std::size_t f = 0; f < index; ++f) {
+    const auto& p = product().parts[f];
+    finished.push_back({p.name, &p.mesh, product().target_in_world(p)});
+  }
+  core::StageScene scene =
+      core::build_stage_scene(*cell, part.mesh, finished, settings.suction_arm);
+  core::CollisionData data(scene.cell.model);
+  const double weight = part.mass * cell->spec().gravity;
+  auto slip_ok = [&](const core::Pose& board, const db::RobotGraspRecord& g) {
+    const Eigen::Vector3d axis =
+        board.linear() * g.tcp.linear() * cell->spec().gripper.opening_axis.normalized();
+    const Eigen::Vector3d centre = board * (0.5 * (g.contact_1 + g.contact_2));
+    const Eigen::Vector3d com = board * grasps.com;
+    const double torque =
+        std::abs(axis.dot((com - centre).cross(Eigen::Vector3d(0, 0, -weight))));
+    return torque <= weight * g.lever * std::sin(core::deg_to_rad(g.theta_c_deg)) + 1e-9;
+  };
+  int checked = 0;
+  for (const auto& s : result.shared) {
+    const auto& c = result.candidates[static_cast<std::size_t>(s.candidate_id)];
+    ASSERT_EQ(c.status, "goal");
+    const auto& g = grasps.robot[static_cast<std::size_t>(s.robot_grasp_id)];
+    const auto& rr = result.robot_handovers[static_cast<std::size_t>(s.robot_handover_id)];
+    for (const auto* joints : {&s.joints_rr, &s.joints_rh}) {
+      EXPECT_TRUE(receiving.chain.within_limits(*joints, 1e-9));
+    }
+    EXPECT_TRUE(suction_arm.chain.within_limits(rr.joints, 1e-9));
+    const core::Pose tcp_rr = receiving_base * receiving.chain.fk(s.joints_rr);
+    const core::Pose tcp_rh = receiving_base * receiving.chain.fk(s.joints_rh);
+    EXPECT_LT((tcp_rr.matrix() - (rr.board * g.tcp).matrix()).norm(), 1e-6);
+    EXPECT_LT((tcp_rh.matrix() - (c.board * g.tcp).matrix()).norm(), 1e-6);
+    const core::Pose suction_tcp = suction_base * suction_arm.chain.fk(rr.joints);
+    const auto& cup = grasps.suction[static_cast<std::size_t>(rr.suction_grasp_id)].cup;
+    EXPECT_LT(((suction_tcp * scene.cup_in_tcp).matrix() - (rr.board * cup).matrix()).norm(),
+              1e-6);
+    EXPECT_TRUE(slip_ok(rr.board, g));
+    EXPECT_TRUE(slip_ok(c.board, g));
+
+    // Robot-robot pose: both arms at their solutions, the tool held, the board on the cup.
+    Eigen::VectorXd q = cell->home_configuration();
+    cell->set_arm(q, receiving, s.joints_rr);
+    cell->set_jaw(q, receiving, std::min(0.085, g.jaw_width + 0.005));
+    cell->set_arm(q, suction_arm, rr.joints);
+    core::set_cell_state(*cell, scene.cell, data, q, cell->human_neutral());
+    core::set_tool_held(*cell, scene, data, suction_tcp);
+    data.set_body_pose(scene.board, rr.board);
+    core::CollisionPair pair;
+    EXPECT_FALSE(core::in_collision_brute_force(scene.cell.model, data, &pair))
+        << "rr: " << core::describe_pair(scene.cell.model, pair);
+    // Robot-human pose: the suction arm back home with the tool.
+    q = cell->home_configuration();
+    cell->set_arm(q, receiving, s.joints_rh);
+    cell->set_jaw(q, receiving, std::min(0.085, g.jaw_width + 0.005));
+    core::set_cell_state(*cell, scene.cell, data, q, cell->human_neutral());
+    core::set_tool_held(*cell, scene, data,
+                        suction_base * suction_arm.chain.fk(suction_arm.spec.home));
+    data.set_body_pose(scene.board, c.board);
+    EXPECT_FALSE(core::in_collision_brute_force(scene.cell.model, data, &pair))
+        << "rh: " << core::describe_pair(scene.cell.model, pair);
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+
+  // Goals with a solved human posture: the hand is on the chosen grasp.
+  for (const auto* c : ranked) {
+    if (c->human_joints.size() == 0) continue;
+    int arm = 0;
+    while (comfort().arm_name(arm) != c->human_arm) ++arm;
+    const auto& chain = cell->human_arms()[static_cast<std::size_t>(arm)].chain;
+    const core::Pose hand = comfort().arm_base(arm) * chain.fk(c->human_joints);
+    const core::Pose want =
+        c->board * grasps.human[static_cast<std::size_t>(c->human_grasp_id)].hand;
+    EXPECT_LT((hand.translation() - want.translation()).norm(), 1e-4);
+  }
+}
+
+}  // namespace
+
+TEST(Handover, OneHandBoardWithTwoFinishedBoards) {
+  check_stage(2);  // back_lower: 0.22 kg, one hand; base and lateral_right finished
+}
+
+TEST(Handover, TwoHandLateralBesideTheBase) {
+  check_stage(1);  // lateral_right: 1.8 kg, two hands, a tight slip limit
+}
+
+TEST(Handover, SameSeedSameGoals) {
+  const auto cell = test::reference_cell();
+  const auto grasps = board_grasps(0);
+  offline::HandoverSettings settings;
+  settings.candidates = 120;
+  const auto a = offline::plan_handover_goals(*cell, product(), 0, grasps, comfort(), settings);
+  const auto b = offline::plan_handover_goals(*cell, product(), 0, grasps, comfort(), settings);
+  ASSERT_EQ(a.candidates.size(), b.candidates.size());
+  for (std::size_t i = 0; i < a.candidates.size(); ++i) {
+    EXPECT_TRUE(a.candidates[i].board.isApprox(b.candidates[i].board, 0.0));
+    EXPECT_EQ(a.candidates[i].status, b.candidates[i].status);
+    EXPECT_EQ(a.candidates[i].rank, b.candidates[i].rank);
+  }
+  EXPECT_EQ(a.shared.size(), b.shared.size());
+}
+
+TEST(Handover, UnreachableTargetFailsWithAReason) {
+  // The same board with its target 1.5 m behind the robot: no human can reach it.
+  const auto cell = test::reference_cell();
+  core::ProductSpec moved = product();
+  moved.parts[0].target.translation() += Eigen::Vector3d(-1.8, 0.0, 0.0);
+  offline::HandoverSettings settings;
+  settings.candidates = 60;
+  const auto r =
+      offline::plan_handover_goals(*cell, moved, 0, board_grasps(0), comfort(), settings);
+  EXPECT_EQ(r.stage.goals, 0);
+  EXPECT_NE(r.stage.failure.find("reaches none"), std::string::npos) << r.stage.failure;
+}
