@@ -358,4 +358,27 @@ void set_cell_state(const Cell& cell, const CellScene& scene, CollisionData& dat
   set_robot_pose(data, scene.human, poses, cell.spec().human_stance);
 }
 
+void check_human_stance(const Cell& cell) {
+  CollisionModel model;
+  const RobotBodies robot = add_robot(model, cell.robot(), "robot/", true);
+  const RobotBodies human = add_robot(model, cell.human(), "human/");
+  for (const auto& o : cell.spec().obstacles) {
+    GeometrySpec box;
+    box.box_size = o.size;
+    model.add_body(o.name, {box}, true, o.pose);
+  }
+  CollisionData data(model);
+  std::vector<Pose> poses;
+  cell.robot().link_poses(cell.home_configuration(), poses);
+  set_robot_pose(data, robot, poses);
+  cell.human().link_poses(cell.human_neutral(), poses);
+  set_robot_pose(data, human, poses, cell.spec().human_stance);
+  CollisionPair pair;
+  if (in_collision(model, data, &pair)) {
+    throw InputError(cell.spec().file, "human.stance",
+                     "a stance where the human stands clear of the table, obstacles and robot",
+                     "the human intersecting them (" + describe_pair(model, pair) + ")");
+  }
+}
+
 }  // namespace hila::core

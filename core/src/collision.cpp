@@ -58,8 +58,8 @@ FclGeometry make_convex_geometry(const TriangleMesh& mesh, const Eigen::Vector3d
   for (const auto& v : mesh.vertices) vertices->emplace_back(v.cwiseProduct(scale));
   auto faces = std::make_shared<std::vector<int>>();
   for (const auto& t : mesh.triangles) faces->insert(faces->end(), {3, t[0], t[1], t[2]});
-  auto convex = std::make_shared<fcl::Convexd>(vertices, static_cast<int>(mesh.triangles.size()),
-                                               faces);
+  auto convex =
+      std::make_shared<fcl::Convexd>(vertices, static_cast<int>(mesh.triangles.size()), faces);
   convex->computeLocalAABB();
   return convex;
 }

@@ -50,13 +50,13 @@ StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
                      "'" + suction_arm + "'");
   }
   const Arm& arm = arms[static_cast<std::size_t>(scene.suction_arm)];
-  const int handle = body_of_link_or_ancestor(
-      tool, scene.tool, tool.link_index(cell.spec().suction.handle_link));
-  const int cup = body_of_link_or_ancestor(tool, scene.tool,
-                                           tool.link_index(cell.spec().suction.cup_link));
+  const int handle =
+      body_of_link_or_ancestor(tool, scene.tool, tool.link_index(cell.spec().suction.handle_link));
+  const int cup =
+      body_of_link_or_ancestor(tool, scene.tool, tool.link_index(cell.spec().suction.cup_link));
   // The handle sits in the hand: it may touch every body from the flange on.
-  const auto hand = subtree_bodies(cell.robot(), scene.cell.robot,
-                                   cell.robot().link_index(arm.spec.flange_link));
+  const auto hand =
+      subtree_bodies(cell.robot(), scene.cell.robot, cell.robot().link_index(arm.spec.flange_link));
   for (const int h : hand) {
     if (handle >= 0) model.allow(handle, h);
   }

@@ -244,6 +244,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
                            std::to_string(settings.jobs));
   }
   const auto cell = core::Cell::load(cell_path);
+  core::check_human_stance(*cell);
   const core::ProductSpec product = core::load_product(product_path);
   // Open the writer first: an unwritable destination fails before minutes of work.
   db::DatabaseWriter writer(output_path);

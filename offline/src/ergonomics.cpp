@@ -54,8 +54,7 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
   Posture posture;
   const auto& human = cell.human();
   const int torso = torso_variable(cell);
-  const double max_flexion =
-      torso < 0 ? 0.0 : core::rad_to_deg(human.upper_limits()[torso]);
+  const double max_flexion = torso < 0 ? 0.0 : core::rad_to_deg(human.upper_limits()[torso]);
   Eigen::VectorXd q = cell.human_neutral();
   std::vector<core::Pose> links;
   ComfortSettings ik;
@@ -126,8 +125,7 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
   }
   const Eigen::Vector3d elbow = joint_position(elbow_name);
   posture.shoulder_elevated = elbow.z() >= shoulder.z();
-  const core::Pose hand_world =
-      board * human_grasps[static_cast<std::size_t>(posture.grasp)].hand;
+  const core::Pose hand_world = board * human_grasps[static_cast<std::size_t>(posture.grasp)].hand;
   posture.reach = (hand_world.translation() - shoulder).norm();
   return posture;
 }
@@ -164,15 +162,15 @@ std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
     out.push_back(record("hila", in.goal, p));
   }
   const core::Pose table = table_drop_pose(cell, in.table_placement, settings);
-  out.push_back(record("table", table,
-                       receiving_posture(cell, comfort, stance, table, grasps, usable, -1,
-                                         settings)));
+  out.push_back(
+      record("table", table,
+             receiving_posture(cell, comfort, stance, table, grasps, usable, -1, settings)));
   // Alone, the human steps sideways to face the stack.
   core::Pose at_stack = stance;
   at_stack.translation().y() = in.initial.translation().y();
-  out.push_back(record("alone", in.initial,
-                       receiving_posture(cell, comfort, at_stack, in.initial, grasps, usable, -1,
-                                         settings)));
+  out.push_back(
+      record("alone", in.initial,
+             receiving_posture(cell, comfort, at_stack, in.initial, grasps, usable, -1, settings)));
   return out;
 }
 

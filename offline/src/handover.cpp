@@ -78,10 +78,8 @@ HandBodies add_hand(core::CollisionModel& model, const HandGeometry& hand, const
 void place_hand(core::CollisionData& data, const HandBodies& h, const core::Pose& grasp_world,
                 double opening) {
   data.set_body_pose(h.fixed, grasp_world);
-  data.set_body_pose(h.finger_pos,
-                     grasp_world * Eigen::Translation3d(0.0, 0.5 * opening, 0.0));
-  data.set_body_pose(h.finger_neg,
-                     grasp_world * Eigen::Translation3d(0.0, -0.5 * opening, 0.0));
+  data.set_body_pose(h.finger_pos, grasp_world * Eigen::Translation3d(0.0, 0.5 * opening, 0.0));
+  data.set_body_pose(h.finger_neg, grasp_world * Eigen::Translation3d(0.0, -0.5 * opening, 0.0));
 }
 
 void park_hand(core::CollisionData& data, const HandBodies& h) {
@@ -105,8 +103,7 @@ struct ScoredGrasp {
 };
 
 // Grasps of `arm` at `board`, best first, with positive Q.
-std::vector<ScoredGrasp> score_grasps(const HumanComfort& comfort, int arm,
-                                      const core::Pose& board,
+std::vector<ScoredGrasp> score_grasps(const HumanComfort& comfort, int arm, const core::Pose& board,
                                       const std::vector<db::HumanGraspRecord>& grasps,
                                       const std::vector<int>& eligible) {
   std::vector<ScoredGrasp> out;
@@ -192,7 +189,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   const core::Arm& suction_arm = cell.arms()[static_cast<std::size_t>(scene.suction_arm)];
   const core::Arm& receiving_arm = cell.arm(settings.receiving_arm);
   int receiving_index = 0;
-  while (&cell.arms()[static_cast<std::size_t>(receiving_index)] != &receiving_arm) ++receiving_index;
+  while (&cell.arms()[static_cast<std::size_t>(receiving_index)] != &receiving_arm)
+    ++receiving_index;
   const std::vector<int>& receiving_bodies =
       scene.cell.arm_bodies[static_cast<std::size_t>(receiving_index)];
   std::vector<int> suction_bodies =
@@ -271,8 +269,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         if (q <= best.quality && q0 <= best.default_quality) continue;
         const auto& g0 = grasps.human[static_cast<std::size_t>(s0.grasp)];
         const auto& g1 = grasps.human[static_cast<std::size_t>(s1.grasp)];
-        if ((g0.hand.translation() - g1.hand.translation()).norm() <
-            settings.two_hand_separation) {
+        if ((g0.hand.translation() - g1.hand.translation()).norm() < settings.two_hand_separation) {
           continue;
         }
         place_hand(screen_data, screen_hands[0], board * g0.hand, g0.aperture + 0.01);
@@ -346,8 +343,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     return result;
   };
   if (stage.candidates == 0) {
-    return finish("no pose within " + core::format_number(settings.max_rotation_deg) +
-                  " deg and " + core::format_number(settings.max_offset) +
+    return finish("no pose within " + core::format_number(settings.max_rotation_deg) + " deg and " +
+                  core::format_number(settings.max_offset) +
                   " m of the target is clear of the finished parts, the table and the human (" +
                   std::to_string(stage.draws) + " draws)");
   }
@@ -405,14 +402,47 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   };
 
   // --- Robot-robot handover poses ----------------------------------------------------------
-  const auto orientations = spread_orientations(settings.rr_orientations);
+  // Board orientations: first those a transfer to the goals favours (the target orientation
+  // turned about the vertical, and the board lying flat, where every grasp's axis is vertical),
+  // then an even spread over SO(3). Each group is tried in a seeded random order.
+  std::vector<Eigen::Matrix3d> orientations;
+  for (int k = 0; k < 8; ++k) {
+    orientations.push_back(Eigen::AngleAxisd(k * core::kPi / 4, Eigen::Vector3d::UnitZ()) *
+                           target.linear());
+  }
+  {
+    // Flat: the part's thinnest axis vertical (up and down).
+    const Eigen::Vector3d extent = part.mesh.max_corner() - part.mesh.min_corner();
+    Eigen::Index thin = 0;
+    extent.minCoeff(&thin);
+    const Eigen::Matrix3d to_up =
+        Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::Unit(thin), Eigen::Vector3d::UnitZ())
+            .toRotationMatrix();
+    for (int flip = 0; flip < 2; ++flip) {
+      const Eigen::Matrix3d r =
+          flip ? Eigen::Matrix3d(Eigen::AngleAxisd(core::kPi, Eigen::Vector3d::UnitX()) * to_up)
+               : to_up;
+      for (int k = 0; k < 4; ++k) {
+        orientations.push_back(Eigen::AngleAxisd(k * core::kPi / 2, Eigen::Vector3d::UnitZ()) * r);
+      }
+    }
+  }
+  const int n_favoured = static_cast<int>(orientations.size());
+  for (const auto& q : spread_orientations(settings.rr_orientations)) {
+    orientations.push_back(q.toRotationMatrix());
+  }
   const int n_pos = static_cast<int>(settings.rr_positions.size());
   const int n_orient = static_cast<int>(orientations.size());
   const int n_suction = static_cast<int>(grasps.suction.size());
-  std::vector<int> order(static_cast<std::size_t>(n_pos * n_orient * n_suction));
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  shuffle(order, rng);
-  std::vector<std::vector<Receiving>> rr_grasps;  // per kept robot-robot pose
+  std::vector<int> favoured, spread;
+  for (int i = 0; i < n_pos * n_orient * n_suction; ++i) {
+    ((i / n_suction) % n_orient < n_favoured ? favoured : spread).push_back(i);
+  }
+  shuffle(favoured, rng);
+  shuffle(spread, rng);
+  std::vector<int> order = favoured;
+  order.insert(order.end(), spread.begin(), spread.end());
+  std::vector<std::vector<Receiving>> rr_grasps;          // per kept robot-robot pose
   std::vector<int> rr_of_grasp(grasps.robot.size(), -1);  // first rr pose receiving each grasp
   int examined = 0;
   for (const int combo : order) {
@@ -421,7 +451,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     const int o = (combo / n_suction) % n_orient;
     const int p = combo / (n_suction * n_orient);
     core::Pose board = core::Pose::Identity();
-    board.linear() = orientations[static_cast<std::size_t>(o)].toRotationMatrix();
+    board.linear() = orientations[static_cast<std::size_t>(o)];
     board.translation() = settings.rr_positions[static_cast<std::size_t>(p)];
     const core::Pose tcp =
         board * grasps.suction[static_cast<std::size_t>(s)].cup * scene.cup_in_tcp.inverse();
@@ -479,7 +509,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // --- 𝕊: members of S sharing a grasp with a robot-robot pose, in Eq. 8 order -------------
   std::vector<int> comfortable;
   for (std::size_t i = 0; i < result.candidates.size(); ++i) {
-    if (result.candidates[i].status == "no_shared_grasp") comfortable.push_back(static_cast<int>(i));
+    if (result.candidates[i].status == "no_shared_grasp")
+      comfortable.push_back(static_cast<int>(i));
   }
   std::stable_sort(comfortable.begin(), comfortable.end(), [&](int a, int b) {
     return result.candidates[static_cast<std::size_t>(a)].distance <
@@ -490,8 +521,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   ik_settings.seed = settings.seed;
   auto solve_human = [&](const core::Pose& board, int arm, int grasp) {
     const auto& chain = cell.human_arms()[static_cast<std::size_t>(arm)].chain;
-    const core::Pose hand =
-        comfort.arm_base(arm).inverse() * board * grasps.human[static_cast<std::size_t>(grasp)].hand;
+    const core::Pose hand = comfort.arm_base(arm).inverse() * board *
+                            grasps.human[static_cast<std::size_t>(grasp)].hand;
     const Eigen::VectorXd seed = Eigen::VectorXd::Zero(chain.dof())
                                      .cwiseMax(chain.lower_limits())
                                      .cwiseMin(chain.upper_limits());
@@ -542,19 +573,18 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       const ComfortResult first = solve_human(c.board, h.arm, h.grasp);
       ComfortResult second;
       if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
-      const double q = h.second_grasp >= 0 ? std::min(first.quality, second.quality)
-                                            : first.quality;
+      const double q =
+          h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
       if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) ||
           q <= settings.comfort_threshold) {
         // Not comfortable after all: out of S, and its shared grasps go.
         c.status = "uncomfortable";
         c.quality = q;
         --stage.comfortable;
-        result.shared.erase(std::remove_if(result.shared.begin(), result.shared.end(),
-                                           [&](const db::SharedGraspRecord& r) {
-                                             return r.candidate_id == ci;
-                                           }),
-                            result.shared.end());
+        result.shared.erase(
+            std::remove_if(result.shared.begin(), result.shared.end(),
+                           [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; }),
+            result.shared.end());
         continue;
       }
       ++verified;
@@ -571,9 +601,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   reset_state();
 
   if (stage.goals == 0) {
-    return finish("no comfortable candidate shares a grasp with a robot-robot handover pose (|S| = " +
-                  std::to_string(stage.comfortable) + ", " +
-                  std::to_string(stage.robot_handovers) + " robot-robot poses)");
+    return finish(
+        "no comfortable candidate shares a grasp with a robot-robot handover pose (|S| = " +
+        std::to_string(stage.comfortable) + ", " + std::to_string(stage.robot_handovers) +
+        " robot-robot poses)");
   }
   // Shared grasps by goal rank.
   std::stable_sort(result.shared.begin(), result.shared.end(),

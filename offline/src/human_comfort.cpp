@@ -40,8 +40,8 @@ HumanComfort::HumanComfort(const core::Cell& cell, std::vector<ComfortMap> maps,
   }
   for (const auto& spec : bodies) {
     const std::string label = body_label(spec);
-    const core::RobotModel model = core::RobotModel::load_urdf_string(
-        core::generate_human_urdf(spec), "human body " + label);
+    const core::RobotModel model =
+        core::RobotModel::load_urdf_string(core::generate_human_urdf(spec), "human body " + label);
     Body body;
     body.spec = spec;
     for (const auto& arm : arms) {

@@ -207,6 +207,15 @@ TEST(Cell, NanInHumanStance) {
   expect_input_error([&] { Cell::load(path); }, {path, "human.stance.xyz[1]", "finite"});
 }
 
+TEST(Cell, StanceInsideTheTableIsRejected) {
+  EXPECT_NO_THROW(check_human_stance(*Cell::load(write_cell("stance_ok", cell_text()))));
+  // The human moved 0.5 m toward the robot: the pelvis is inside the table.
+  const std::string text =
+      replace_once(cell_text(), "stance: {xyz: [1.15, 0.0, 0.1]", "stance: {xyz: [0.65, 0.0, 0.1]");
+  const auto cell = Cell::load(write_cell("stance_table", text));
+  expect_input_error([&] { check_human_stance(*cell); }, {"human.stance", "table"});
+}
+
 TEST(Cell, NonOrthonormalStanceRotation) {
   const std::string text = replace_once(
       cell_text(), "stance: {xyz: [1.15, 0.0, 0.1], rpy_deg: [0, 0, 180]}",

@@ -197,9 +197,9 @@ TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
       if (attempt > 0) {
         aim.translation() += Eigen::Vector3d(offset(rng), offset(rng), offset(rng));
         const Eigen::Vector3d axis(normal(rng), normal(rng), normal(rng));
-        aim.linear() = centre.linear() *
-                       Eigen::AngleAxisd(0.4 * std::abs(normal(rng)), axis.normalized())
-                           .toRotationMatrix();
+        aim.linear() =
+            centre.linear() *
+            Eigen::AngleAxisd(0.4 * std::abs(normal(rng)), axis.normalized()).toRotationMatrix();
         if (offline::nearest_orientation(map.orientations(), Eigen::Quaterniond(aim.linear())) !=
             o) {
           continue;

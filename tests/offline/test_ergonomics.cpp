@@ -19,7 +19,8 @@ const offline::HumanComfort& comfort() {
     std::vector<offline::ComfortMap> maps;
     offline::ComfortMapSettings s;
     s.samples = 300000;
-    for (const auto& arm : cell->human_arms()) maps.push_back(offline::ComfortMap::build(arm.chain, s));
+    for (const auto& arm : cell->human_arms())
+      maps.push_back(offline::ComfortMap::build(arm.chain, s));
     return offline::HumanComfort(*cell, maps);
   }();
   return c;
@@ -51,7 +52,8 @@ Board shelf_board() {
 // bent by `flexion_deg` (an independent path from the posture search's).
 Eigen::Vector3d shoulder_in_world(const core::Cell& cell, int arm, double flexion_deg) {
   Eigen::VectorXd q = cell.human_neutral();
-  q[cell.human().joints()[static_cast<std::size_t>(cell.human().joint_index("torso_flexion"))]
+  q[cell.human()
+        .joints()[static_cast<std::size_t>(cell.human().joint_index("torso_flexion"))]
         .variable] = core::deg_to_rad(flexion_deg);
   std::vector<core::Pose> links;
   cell.human().link_poses(q, links);

@@ -28,7 +28,8 @@ const offline::HumanComfort& comfort() {
     std::vector<offline::ComfortMap> maps;
     offline::ComfortMapSettings s;
     s.samples = 1000000;
-    for (const auto& arm : cell->human_arms()) maps.push_back(offline::ComfortMap::build(arm.chain, s));
+    for (const auto& arm : cell->human_arms())
+      maps.push_back(offline::ComfortMap::build(arm.chain, s));
     return offline::HumanComfort(*cell, maps);
   }();
   return c;
@@ -135,7 +136,9 @@ void check_stage(std::size_t index) {
     const double d = (c.board.translation() - target.translation()).norm() +
                      settings.rotation_weight * angle_between(c.board.linear(), target.linear());
     EXPECT_NEAR(c.distance, d, 1e-9);
-    if (r > 0) EXPECT_LE(ranked[r - 1]->distance, c.distance);
+    if (r > 0) {
+      EXPECT_LE(ranked[r - 1]->distance, c.distance);
+    }
   }
 
   // Every member of 𝕊 re-verified: FK (not IK) of the stored joints, joint limits, the slip
@@ -158,8 +161,7 @@ void check_stage(std::size_t index) {
         board.linear() * g.tcp.linear() * cell->spec().gripper.opening_axis.normalized();
     const Eigen::Vector3d centre = board * (0.5 * (g.contact_1 + g.contact_2));
     const Eigen::Vector3d com = board * grasps.com;
-    const double torque =
-        std::abs(axis.dot((com - centre).cross(Eigen::Vector3d(0, 0, -weight))));
+    const double torque = std::abs(axis.dot((com - centre).cross(Eigen::Vector3d(0, 0, -weight))));
     return torque <= weight * g.lever * std::sin(core::deg_to_rad(g.theta_c_deg)) + 1e-9;
   };
   int checked = 0;
@@ -178,8 +180,7 @@ void check_stage(std::size_t index) {
     EXPECT_LT((tcp_rh.matrix() - (c.board * g.tcp).matrix()).norm(), 1e-6);
     const core::Pose suction_tcp = suction_base * suction_arm.chain.fk(rr.joints);
     const auto& cup = grasps.suction[static_cast<std::size_t>(rr.suction_grasp_id)].cup;
-    EXPECT_LT(((suction_tcp * scene.cup_in_tcp).matrix() - (rr.board * cup).matrix()).norm(),
-              1e-6);
+    EXPECT_LT(((suction_tcp * scene.cup_in_tcp).matrix() - (rr.board * cup).matrix()).norm(), 1e-6);
     EXPECT_TRUE(slip_ok(rr.board, g));
     EXPECT_TRUE(slip_ok(c.board, g));
 

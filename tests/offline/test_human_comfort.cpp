@@ -73,7 +73,8 @@ TEST(HumanComfort, OtherBodiesMatchDirectIkOfTheirOwnArms) {
   Eigen::VectorXd stretched = Eigen::VectorXd::Zero(chain.dof());
   stretched[0] = core::deg_to_rad(150.0);  // arm raised forward
   const core::Pose tall_base = [&] {
-    const auto model = core::RobotModel::load_urdf_string(core::generate_human_urdf(bodies[1]), "b");
+    const auto model =
+        core::RobotModel::load_urdf_string(core::generate_human_urdf(bodies[1]), "b");
     std::vector<core::Pose> links;
     model.link_poses(cell->human_neutral(), links);
     return cell->spec().human_stance *

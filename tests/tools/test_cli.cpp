@@ -133,7 +133,7 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
   const std::string dir = test::temp_dir("cli_build");
   const std::string out = dir + "/cabinet.hila";
   const CommandRun build = run("build " + test::product_path() + " --cell " + test::cell_path() +
-                               " -o " + out + " --seed 3 --jobs 2 --comfort-samples 20000");
+                               " -o " + out + " --jobs 2");
   ASSERT_EQ(build.status, 0) << build.out;
   // Not a terminal: no progress lines, just the summary.
   EXPECT_EQ(build.out.find("\r"), std::string::npos);
@@ -143,7 +143,7 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
   ASSERT_EQ(summary.status, 0) << summary.out;
   const auto j = nlohmann::json::parse(json_part(summary.out));
   ASSERT_EQ(j["parts"].size(), 7u);
-  EXPECT_EQ(j["seed"], 3);
+  EXPECT_EQ(j["seed"], 1);
   for (const auto& p : j["parts"]) {
     EXPECT_GT(p["robot_grasps"].get<int>(), 0) << p["name"];
     EXPECT_LE(p["theta_c_min_deg"].get<double>(), p["theta_c_max_deg"].get<double>());
@@ -167,14 +167,54 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
   EXPECT_LE(c["q_max"].get<double>(), 1.0);
   EXPECT_EQ(run("inspect " + out + " comfort --arm tail").status, 2);
 
+  // Handover goals: every board has ranked goals with shared grasps.
+  for (const char* board : {"base", "lateral_right", "back_upper"}) {
+    const CommandRun handover = run("inspect " + out + " handover --part " + board + " --json");
+    ASSERT_EQ(handover.status, 0) << handover.out;
+    const auto h = nlohmann::json::parse(json_part(handover.out));
+    EXPECT_EQ(h["candidates"], 500);
+    EXPECT_GT(h["goals"].get<int>(), 0) << board;
+    EXPECT_EQ(h["ranked_goals"].size(), h["goals"].get<std::size_t>());
+    EXPECT_EQ(h["failure"], "");
+    EXPECT_FALSE(h["ranked_goals"][0]["shared_grasps"].empty());
+  }
+  EXPECT_NE(build.out.find("|𝕊|"), std::string::npos) << build.out;
+  // The ergonomics report: hila's handover needs no forward bend wherever the human alone does.
+  const CommandRun report = run("report ergonomics " + out + " --json");
+  ASSERT_EQ(report.status, 0) << report.out;
+  const auto e = nlohmann::json::parse(json_part(report.out));
+  ASSERT_EQ(e["boards"].size(), 7u);
+  int alone_bent = 0;
+  for (const auto& b : e["boards"]) {
+    ASSERT_TRUE(b["hila"]["reachable"].get<bool>()) << b["part"];
+    EXPECT_FALSE(b["hila"]["bent_forward"].get<bool>()) << b["part"];
+    if (b["alone"]["reachable"].get<bool>() && b["alone"]["bent_forward"].get<bool>()) ++alone_bent;
+    EXPECT_LT(b["hila"]["reorientation_deg"].get<double>(), 45.0);
+  }
+  EXPECT_GT(alone_bent, 0);
+  EXPECT_EQ(e["verdicts_hila_vs"]["alone"]["bent_forward"], "eliminated");
+  const CommandRun report_text = run("report ergonomics " + out);
+  EXPECT_NE(report_text.out.find("bent forward eliminated"), std::string::npos) << report_text.out;
+
   const CommandRun digest1 = run("inspect " + out + " digest");
   ASSERT_EQ(digest1.status, 0);
   EXPECT_EQ(digest1.out.size(), 65u);  // 64 hex digits and a newline
-  ASSERT_EQ(run("build " + test::product_path() + " --cell " + test::cell_path() + " -o " + dir +
-                "/again.hila --seed 3 --jobs 1 --comfort-samples 20000")
-                .status,
-            0);
-  EXPECT_EQ(run("inspect " + dir + "/again.hila digest").out, digest1.out);
+}
+
+TEST(Cli, SameSeedSameDigestWhateverTheJobs) {
+  // Sparse maps keep this quick; boards without goals (exit 1) are part of the content too.
+  const std::string dir = test::temp_dir("cli_digest");
+  const std::string options =
+      " --cell " + test::cell_path() + " --seed 3 --comfort-samples 20000 --handover-candidates 60";
+  const int a =
+      run("build " + test::product_path() + options + " --jobs 2 -o " + dir + "/a.hila").status;
+  const int b =
+      run("build " + test::product_path() + options + " --jobs 1 -o " + dir + "/b.hila").status;
+  EXPECT_EQ(a, b);
+  EXPECT_LE(a, 1);
+  const CommandRun digest1 = run("inspect " + dir + "/a.hila digest");
+  ASSERT_EQ(digest1.status, 0);
+  EXPECT_EQ(run("inspect " + dir + "/b.hila digest").out, digest1.out);
 }
 
 TEST(Cli, BuildAndInspectBadInputs) {
@@ -191,7 +231,24 @@ TEST(Cli, BuildAndInspectBadInputs) {
   EXPECT_EQ(no_dir.status, 2);
   EXPECT_NE(no_dir.out.find("no/dir"), std::string::npos) << no_dir.out;
   EXPECT_NE(run("build " + test::product_path() + " -o " + dir + "/x.hila --jobs 0").status, 0);
-  ASSERT_EQ(run("build " + test::product_path() + " -o " + dir + "/ok.hila --comfort-samples 20000").status, 0);
+  // No board can be comfortable at Q > 0.99: the build finishes every board, writes the database
+  // with the reasons, names each failing board and exits 1.
+  const CommandRun strict = run("build " + test::product_path() + " -o " + dir +
+                                "/ok.hila --comfort-samples 20000 --handover-candidates 40 "
+                                "--comfort-threshold 0.99");
+  EXPECT_EQ(strict.status, 1) << strict.out;
+  EXPECT_NE(strict.out.find("lateral_left: no handover goal: no candidate is comfortable"),
+            std::string::npos)
+      << strict.out;
+  EXPECT_NE(strict.out.find("7 of 7 boards"), std::string::npos) << strict.out;
+  const CommandRun failed = run("inspect " + dir + "/ok.hila handover --part top --json");
+  ASSERT_EQ(failed.status, 0) << failed.out;
+  const auto f = nlohmann::json::parse(json_part(failed.out));
+  EXPECT_EQ(f["goals"], 0);
+  EXPECT_NE(f["failure"].get<std::string>().find("threshold 0.99"), std::string::npos);
+  EXPECT_NE(
+      run("build " + test::product_path() + " -o " + dir + "/x.hila --comfort-threshold 2").status,
+      0);
   const CommandRun part = run("inspect " + dir + "/ok.hila grasps --part drawer");
   EXPECT_EQ(part.status, 2);
   EXPECT_NE(part.out.find("drawer"), std::string::npos) << part.out;

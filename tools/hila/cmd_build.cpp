@@ -29,7 +29,8 @@ int run_build(const BuildOptions& opt) {
   settings.comfort.samples = opt.comfort_samples;
   settings.handover.candidates = opt.handover_candidates;
   settings.handover.comfort_threshold = opt.comfort_threshold;
-  if (!opt.bodies.empty()) settings.human_bodies = offline::parse_human_bodies(opt.bodies, "--bodies");
+  if (!opt.bodies.empty())
+    settings.human_bodies = offline::parse_human_bodies(opt.bodies, "--bodies");
   // Progress only for a person watching a terminal; logs and pipes stay clean.
   const bool terminal = isatty(fileno(stderr)) != 0;
   offline::BuildProgress progress;
@@ -52,13 +53,15 @@ int run_build(const BuildOptions& opt) {
               << p.theta_c_min_deg << "-" << p.theta_c_max_deg << "\n";
   }
   for (const auto& m : summary.comfort_maps) {
-    std::cout << "  comfort map, " << m.arm << " arm: " << m.filled_bins << " bins filled, coverage "
-              << std::setprecision(1) << 100.0 * m.coverage << " % (" << std::setprecision(2)
-              << m.seconds << " s)\n";
+    std::cout << "  comfort map, " << m.arm << " arm: " << m.filled_bins
+              << " bins filled, coverage " << std::setprecision(1) << 100.0 * m.coverage << " % ("
+              << std::setprecision(2) << m.seconds << " s)\n";
   }
-  std::cout << "  handover goals (Eq. 1 candidates, S comfortable" << (settings.human_bodies.empty() ? "" : " for every body")
+  std::cout << "  handover goals (Eq. 1 candidates, S comfortable"
+            << (settings.human_bodies.empty() ? "" : " for every body")
             << ", 𝕊 with a shared grasp):\n";
-  std::cout << "  #  part           candidates    |S|    |𝕊|  rr poses  goal Q  distance m   time s\n";
+  std::cout
+      << "  #  part           candidates    |S|    |𝕊|  rr poses  goal Q  distance m   time s\n";
   for (const auto& p : summary.parts) {
     std::cout << "  " << p.order << "  " << std::left << std::setw(14) << p.name << std::right
               << std::setw(11) << p.handover_candidates << std::setw(7) << p.comfortable
@@ -105,16 +108,19 @@ void add_build_command(CLI::App& app, Action& action) {
   build->add_option("--cell", opt->cell_file, "cell YAML file")->capture_default_str();
   build->add_option("--seed", opt->seed, "random seed (same seed, same content)")
       ->capture_default_str();
-  build->add_option("--comfort-samples", opt->comfort_samples,
-                    "arm postures sampled per human comfort map")
+  build
+      ->add_option("--comfort-samples", opt->comfort_samples,
+                   "arm postures sampled per human comfort map")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  build->add_option("--handover-candidates", opt->handover_candidates,
-                    "Eq. 1 candidate poses per board")
+  build
+      ->add_option("--handover-candidates", opt->handover_candidates,
+                   "Eq. 1 candidate poses per board")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  build->add_option("--comfort-threshold", opt->comfort_threshold,
-                    "least human comfort Q of a handover goal (S)")
+  build
+      ->add_option("--comfort-threshold", opt->comfort_threshold,
+                   "least human comfort Q of a handover goal (S)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   build->add_option("--bodies", opt->bodies,

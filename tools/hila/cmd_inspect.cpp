@@ -163,7 +163,9 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
   }
   nlohmann::json rr = nlohmann::json::array();
   for (const auto& r : database.robot_handovers(part.id)) {
-    rr.push_back({{"id", r.id}, {"arm", r.arm}, {"suction_grasp", r.suction_grasp_id},
+    rr.push_back({{"id", r.id},
+                  {"arm", r.arm},
+                  {"suction_grasp", r.suction_grasp_id},
                   {"pose", pose_json(r.board)}});
   }
   return {{"part", part_name},
@@ -222,7 +224,8 @@ int run_inspect(const InspectOptions& opt) {
     return 0;
   }
   if (opt.what == "comfort") {
-    if (opt.arm.empty()) throw core::InputError("command line", "--arm", "a human arm name", "nothing");
+    if (opt.arm.empty())
+      throw core::InputError("command line", "--arm", "a human arm name", "nothing");
     const auto j = comfort_json(database, opt.arm);
     if (opt.json) {
       std::cout << j.dump(2) << "\n";
@@ -235,8 +238,8 @@ int run_inspect(const InspectOptions& opt) {
               << std::fixed << std::setprecision(1) << 100.0 * j["coverage"].get<double>()
               << " %, from " << j["samples"].get<long>() << " sampled postures\n"
               << "  Q max " << std::setprecision(3) << j["q_max"].get<double>() << ", mean "
-              << j["q_mean"].get<double>() << "\n  Q histogram (tenths): "
-              << j["q_histogram_tenths"].dump() << "\n";
+              << j["q_mean"].get<double>()
+              << "\n  Q histogram (tenths): " << j["q_histogram_tenths"].dump() << "\n";
     return 0;
   }
   if (opt.what == "handover") {
@@ -249,13 +252,11 @@ int run_inspect(const InspectOptions& opt) {
       return 0;
     }
     std::cout << "handover goals of " << opt.part << " (finished before it: "
-              << (j["finished_parts"].empty() ? std::string("none")
-                                              : j["finished_parts"].dump())
+              << (j["finished_parts"].empty() ? std::string("none") : j["finished_parts"].dump())
               << ")\n  " << j["candidates"].get<int>() << " Eq. 1 candidates ("
-              << j["draws"].get<int>() << " draws), |S| " << j["comfortable"].get<int>()
-              << ", |𝕊| " << j["goals"].get<int>() << ", " << j["robot_handovers"].get<int>()
-              << " robot-robot poses" << (j["two_hands"].get<bool>() ? ", two hands" : "")
-              << "\n";
+              << j["draws"].get<int>() << " draws), |S| " << j["comfortable"].get<int>() << ", |𝕊| "
+              << j["goals"].get<int>() << ", " << j["robot_handovers"].get<int>()
+              << " robot-robot poses" << (j["two_hands"].get<bool>() ? ", two hands" : "") << "\n";
     if (!j["failure"].get<std::string>().empty()) {
       std::cout << "  no goal: " << j["failure"].get<std::string>() << "\n";
     }
@@ -275,8 +276,9 @@ int run_inspect(const InspectOptions& opt) {
       }
       std::string shared;
       for (const auto& s : g["shared_grasps"]) {
-        shared += (shared.empty() ? "" : ", ") + std::to_string(s["robot_grasp"].get<std::int64_t>()) +
-                  " (" + std::to_string(static_cast<int>(s["theta_c_deg"].get<double>())) + ")";
+        shared += (shared.empty() ? "" : ", ") +
+                  std::to_string(s["robot_grasp"].get<std::int64_t>()) + " (" +
+                  std::to_string(static_cast<int>(s["theta_c_deg"].get<double>())) + ")";
       }
       std::cout << std::setw(6) << g["rank"].get<int>() << std::setw(12) << std::fixed
                 << std::setprecision(3) << g["distance"].get<double>() << "  " << std::setw(5)
@@ -320,7 +322,8 @@ void add_inspect_command(CLI::App& app, Action& action) {
   inspect->add_option("what", opt->what, "summary (default), grasps, comfort, handover or digest")
       ->capture_default_str();
   inspect->add_option("--part", opt->part, "part name (for grasps and handover)");
-  inspect->add_option("--limit", opt->limit, "goals listed (handover, text)")->capture_default_str();
+  inspect->add_option("--limit", opt->limit, "goals listed (handover, text)")
+      ->capture_default_str();
   inspect->add_option("--arm", opt->arm, "human arm name (for comfort)");
   inspect->add_flag("--json", opt->json, "print JSON");
   inspect->callback([opt, &action] { action = [opt] { return run_inspect(*opt); }; });

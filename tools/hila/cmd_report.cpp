@@ -96,13 +96,13 @@ nlohmann::json ergonomics_json(const db::Database& database) {
     verdicts[baseline] = {
         {"bent_forward",
          fewer(a["bent_forward"].get<int>(), b["bent_forward"].get<int>(), "eliminated")},
-        {"shoulder_work", fewer(a["shoulder_elevated"].get<int>(),
-                                b["shoulder_elevated"].get<int>(), "eliminated")},
+        {"shoulder_work",
+         fewer(a["shoulder_elevated"].get<int>(), b["shoulder_elevated"].get<int>(), "eliminated")},
         {"reaching", compare(a["mean_reach"].get<double>(), b["mean_reach"].get<double>(), 0.02,
                              "shorter", "longer")},
-        {"reorientation", compare(a["mean_reorientation_deg"].get<double>(),
-                                  b["mean_reorientation_deg"].get<double>(), 2.0, "decreased",
-                                  "increased")},
+        {"reorientation",
+         compare(a["mean_reorientation_deg"].get<double>(),
+                 b["mean_reorientation_deg"].get<double>(), 2.0, "decreased", "increased")},
         {"comfort", compare(-a["mean_quality"].get<double>(), -b["mean_quality"].get<double>(),
                             0.005, "more comfortable", "less comfortable")}};
   }
@@ -142,7 +142,8 @@ int run_report(const ReportOptions& opt) {
             << "  per method: torso flexion deg / elbow at or above the shoulder / reach m / "
                "re-orientation left deg / comfort Q\n";
   std::cout << "  #  board          " << std::left << std::setw(27) << "(a) hila" << std::setw(27)
-            << "(b) table" << "(c) alone" << std::right << "\n";
+            << "(b) table"
+            << "(c) alone" << std::right << "\n";
   for (const auto& b : j["boards"]) {
     std::cout << "  " << b["order"].get<int>() << "  " << std::left << std::setw(15)
               << b["part"].get<std::string>() << std::setw(27)
@@ -156,8 +157,9 @@ int run_report(const ReportOptions& opt) {
             << j["summary"]["alone"]["bent_forward"].get<int>() << "\n";
   for (const char* baseline : {"alone", "table"}) {
     const auto& v = j["verdicts_hila_vs"][baseline];
-    std::cout << "  hila vs " << baseline << ": bent forward " << v["bent_forward"].get<std::string>()
-              << "; shoulder work " << v["shoulder_work"].get<std::string>() << "; reaching "
+    std::cout << "  hila vs " << baseline << ": bent forward "
+              << v["bent_forward"].get<std::string>() << "; shoulder work "
+              << v["shoulder_work"].get<std::string>() << "; reaching "
               << v["reaching"].get<std::string>() << "; re-orientation "
               << v["reorientation"].get<std::string>() << "; comfort "
               << v["comfort"].get<std::string>() << "\n";

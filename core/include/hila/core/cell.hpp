@@ -169,6 +169,10 @@ struct CellSceneOptions {
 
 CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options = {});
 
+// Throws InputError (field human.stance) when the human at the stance, in the neutral posture,
+// intersects an obstacle (the table) or the robot at home: a stance inside the table.
+void check_human_stance(const Cell& cell);
+
 // Poses every robot and human body for the given configurations.
 void set_cell_state(const Cell& cell, const CellScene& scene, CollisionData& data,
                     const Eigen::VectorXd& robot_q, const Eigen::VectorXd& human_q);

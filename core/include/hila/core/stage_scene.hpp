@@ -22,11 +22,11 @@ struct PlacedPart {
 // tool's cup: those pairs are allowed. Built once per stage; one CollisionData per thread.
 struct StageScene {
   CellScene cell;
-  std::vector<int> finished;       // bodies of the finished parts
-  int board = -1;                  // the board being handled
-  RobotBodies tool;                // suction tool links
-  std::vector<int> tool_bodies;    // their bodies
-  int suction_arm = -1;            // index into Cell::arms()
+  std::vector<int> finished;           // bodies of the finished parts
+  int board = -1;                      // the board being handled
+  RobotBodies tool;                    // suction tool links
+  std::vector<int> tool_bodies;        // their bodies
+  int suction_arm = -1;                // index into Cell::arms()
   Pose cup_in_tcp = Pose::Identity();  // the cup face in the suction arm's TCP while held
 };
 
@@ -35,8 +35,7 @@ StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
                              const std::string& suction_arm);
 
 // Poses the tool held by the suction arm whose TCP is at `tcp` (world).
-void set_tool_held(const Cell& cell, const StageScene& scene, CollisionData& data,
-                   const Pose& tcp);
+void set_tool_held(const Cell& cell, const StageScene& scene, CollisionData& data, const Pose& tcp);
 
 // An arm's base link pose in the world (fixed for a fixed-base robot).
 Pose arm_base_in_world(const Cell& cell, const Arm& arm);

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "hila/core/cell.hpp"
-#include "hila/core/product.hpp"
 #include "hila/core/human_model.hpp"
+#include "hila/core/product.hpp"
 #include "hila/offline/comfort_map.hpp"
 #include "hila/offline/ergonomics.hpp"
 #include "hila/offline/handover.hpp"
@@ -51,8 +51,8 @@ struct PartBuildSummary {
   int goals = 0;                     // |𝕊|
   int robot_handovers = 0;
   bool two_hands = false;
-  double goal_quality = 0.0;   // the first goal's
-  double goal_distance = 0.0;  // Eq. 8
+  double goal_quality = 0.0;     // the first goal's
+  double goal_distance = 0.0;    // Eq. 8
   std::string handover_failure;  // empty when the board has goals
   double handover_seconds = 0.0;
 };
@@ -66,7 +66,7 @@ struct ComfortMapSummary {
 
 struct BuildSummary {
   std::string output;
-  std::vector<PartBuildSummary> parts;  // in assembly order
+  std::vector<PartBuildSummary> parts;          // in assembly order
   std::vector<ComfortMapSummary> comfort_maps;  // in the cell's human-arm order
   double seconds = 0.0;
   // Boards without a handover goal (the database is still written, with the reason stored).

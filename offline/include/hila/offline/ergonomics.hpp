@@ -43,8 +43,8 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
                           const ErgonomicsSettings& settings);
 
 struct ErgonomicsInputs {
-  core::Pose target = core::Pose::Identity();   // world
-  core::Pose initial = core::Pose::Identity();  // on the stack, world
+  core::Pose target = core::Pose::Identity();           // world
+  core::Pose initial = core::Pose::Identity();          // on the stack, world
   core::Pose table_placement = core::Pose::Identity();  // part in plane (z up), most stable
   const std::vector<db::HumanGraspRecord>* human_grasps = nullptr;
   // The first handover goal, if any: board pose, arm index and grasp index.

@@ -30,9 +30,9 @@ struct HandoverSettings {
   std::string suction_arm = "right";
   std::string receiving_arm = "left";
   std::vector<Eigen::Vector3d> rr_positions = {
-      {0.35, -0.08, 1.30}, {0.35, 0.0, 1.30}, {0.35, 0.08, 1.30}, {0.45, -0.08, 1.30},
-      {0.45, 0.0, 1.30},   {0.45, 0.08, 1.30}, {0.35, 0.0, 1.42}, {0.45, 0.0, 1.42},
-      {0.40, 0.0, 1.20}};
+      {0.35, -0.08, 1.30}, {0.35, 0.0, 1.30}, {0.35, 0.08, 1.30},
+      {0.45, -0.08, 1.30}, {0.45, 0.0, 1.30}, {0.45, 0.08, 1.30},
+      {0.35, 0.0, 1.42},   {0.45, 0.0, 1.42}, {0.40, 0.0, 1.20}};
   int rr_orientations = 64;  // board orientations tried per position (spread over SO(3))
   int rr_poses = 24;         // suction-feasible robot-robot poses examined for receiving grasps
   int shared_stored = 8;     // shared grasps searched for and stored per goal

@@ -43,9 +43,9 @@ class HumanComfort {
  private:
   struct Body {
     core::HumanBodySpec spec;
-    std::vector<core::Pose> world_to_base;     // per arm: inverse of the torso pose
-    std::vector<Eigen::Vector3d> shoulder;     // per arm, base frame
-    double scale = 1.0;                        // cell reach / this body's reach
+    std::vector<core::Pose> world_to_base;  // per arm: inverse of the torso pose
+    std::vector<Eigen::Vector3d> shoulder;  // per arm, base frame
+    double scale = 1.0;                     // cell reach / this body's reach
   };
   std::vector<ComfortMap> maps_;
   std::vector<std::string> arm_names_;
