@@ -278,7 +278,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
       maps[t] = ComfortMap::build(arm.chain, comfort_seed(t));
       auto& s = map_summaries[t];
       s.arm = arm.spec.name;
-      for (const auto v : maps[t].values()) s.filled_bins += v > 0 ? 1 : 0;
+      s.filled_bins = maps[t].filled_bins();
       s.coverage = maps[t].coverage();
       s.seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_map).count();

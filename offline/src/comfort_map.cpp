@@ -41,6 +41,98 @@ int nearest_orientation(const std::vector<Eigen::Quaterniond>& set, const Eigen:
   return best;
 }
 
+namespace {
+
+// Face (largest |component|) and cell of a quaternion in the cube-face grid; the quaternion is
+// folded so that component is positive.
+int orientation_cell(const Eigen::Vector4d& q, int n) {
+  // Branch-free argmax of |q_k|: a query's face is unpredictable.
+  const Eigen::Vector4d a = q.cwiseAbs();
+  const int f01 = a[1] > a[0] ? 1 : 0;
+  const int f23 = a[3] > a[2] ? 3 : 2;
+  const int face = a[f23] > a[f01] ? f23 : f01;
+  const double inv = 0.5 * n / q[face];  // the sign fold: divides by the signed component
+  int cell = face;
+  for (int k = 0; k < 4; ++k) {
+    if (k == face) continue;
+    const int c = static_cast<int>(q[k] * inv + 0.5 * n);  // u = q_k / q_face in [-1, 1]
+    cell = cell * n + std::min(std::max(c, 0), n - 1);
+  }
+  return cell;
+}
+
+double rotation_metric(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
+  return std::acos(std::min(1.0, std::abs(a.dot(b))));
+}
+
+}  // namespace
+
+OrientationIndex::OrientationIndex(const std::vector<Eigen::Quaterniond>& set, int n) : n_(n) {
+  for (const auto& q : set) set_.emplace_back(q.w(), q.x(), q.y(), q.z());
+  const int cells = 4 * n * n * n;
+  offsets_.assign(static_cast<std::size_t>(cells) + 1, 0);
+  std::vector<std::vector<int>> lists(static_cast<std::size_t>(cells));
+  for (int face = 0; face < 4; ++face) {
+    for (int c = 0; c < n * n * n; ++c) {
+      // The cell's box in the face's coordinates, its centre and its angular radius (the
+      // farthest point of a gnomonic cell from its centre is a corner).
+      const int idx[3] = {c / (n * n), (c / n) % n, c % n};
+      auto point = [&](const double* u) {
+        Eigen::Vector4d q;
+        int j = 0;
+        for (int k = 0; k < 4; ++k) q[k] = k == face ? 1.0 : u[j++];
+        return Eigen::Vector4d(q.normalized());
+      };
+      double centre_u[3];
+      for (int k = 0; k < 3; ++k) centre_u[k] = -1.0 + (2.0 * idx[k] + 1.0) / n;
+      const Eigen::Vector4d centre = point(centre_u);
+      double radius = 0.0;
+      for (int corner = 0; corner < 8; ++corner) {
+        double u[3];
+        for (int k = 0; k < 3; ++k) u[k] = -1.0 + 2.0 * (idx[k] + ((corner >> k) & 1)) / n;
+        radius = std::max(radius, rotation_metric(centre, point(u)));
+      }
+      std::vector<double> d(set_.size());
+      double nearest = 10.0;
+      for (std::size_t i = 0; i < set_.size(); ++i) {
+        d[i] = rotation_metric(centre, set_[i]);
+        nearest = std::min(nearest, d[i]);
+      }
+      auto& list = lists[static_cast<std::size_t>(face * n * n * n + c)];
+      for (std::size_t i = 0; i < set_.size(); ++i) {
+        if (d[i] <= nearest + 2.0 * radius + 1e-9) list.push_back(static_cast<int>(i));
+      }
+    }
+  }
+  for (int cell = 0; cell < cells; ++cell) {
+    const auto& list = lists[static_cast<std::size_t>(cell)];
+    offsets_[static_cast<std::size_t>(cell) + 1] =
+        offsets_[static_cast<std::size_t>(cell)] + static_cast<int>(list.size());
+    candidates_.insert(candidates_.end(), list.begin(), list.end());
+  }
+}
+
+int OrientationIndex::nearest(const Eigen::Quaterniond& rotation) const {
+  const Eigen::Vector4d q(rotation.w(), rotation.x(), rotation.y(), rotation.z());
+  const int cell = orientation_cell(q, n_);
+  int best = 0;
+  double best_dot = -1.0;
+  const int end = offsets_[static_cast<std::size_t>(cell) + 1];
+  for (int k = offsets_[static_cast<std::size_t>(cell)]; k < end; ++k) {
+    const int i = candidates_[static_cast<std::size_t>(k)];
+    const double d = std::abs(set_[static_cast<std::size_t>(i)].dot(q));
+    best = d > best_dot ? i : best;  // strictly greater: the lowest index wins ties
+    best_dot = std::max(best_dot, d);
+  }
+  return best;
+}
+
+double OrientationIndex::mean_candidates() const {
+  return offsets_.size() > 1
+             ? static_cast<double>(candidates_.size()) / static_cast<double>(offsets_.size() - 1)
+             : 0.0;
+}
+
 double comfort_index_fast(const core::Jacobian& jacobian, double characteristic_length) {
   if (jacobian.cols() < 6) return 0.0;
   core::Jacobian scaled = jacobian;
@@ -53,12 +145,38 @@ double comfort_index_fast(const core::Jacobian& jacobian, double characteristic_
 }
 
 std::size_t ComfortMap::index(const Eigen::Vector3i& node, int orientation) const {
-  const std::size_t cell =
-      (static_cast<std::size_t>(node.x()) * static_cast<std::size_t>(dims_.y()) +
-       static_cast<std::size_t>(node.y())) *
-          static_cast<std::size_t>(dims_.z()) +
-      static_cast<std::size_t>(node.z());
-  return cell * orientations_.size() + static_cast<std::size_t>(orientation);
+  return ((static_cast<std::size_t>(orientation) * static_cast<std::size_t>(dims_.x()) +
+           static_cast<std::size_t>(node.x())) *
+              static_cast<std::size_t>(dims_.y()) +
+          static_cast<std::size_t>(node.y())) *
+             static_cast<std::size_t>(dims_.z()) +
+         static_cast<std::size_t>(node.z());
+}
+
+namespace {
+
+// Node-major (database) index of bin (cell, o) <-> orientation-major (memory) index.
+template <typename Fn>
+void for_each_bin(const Eigen::Vector3i& dims, std::size_t orientations, Fn&& fn) {
+  const auto cells = static_cast<std::size_t>(dims.prod());
+  for (std::size_t cell = 0; cell < cells; ++cell) {
+    for (std::size_t o = 0; o < orientations; ++o) fn(cell * orientations + o, o * cells + cell);
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> ComfortMap::values() const {
+  std::vector<std::uint8_t> out(values_.size());
+  for_each_bin(dims_, orientations_.size(),
+               [&](std::size_t db, std::size_t mem) { out[db] = values_[mem]; });
+  return out;
+}
+
+long ComfortMap::filled_bins() const {
+  long n = 0;
+  for (const auto v : values_) n += v > 0 ? 1 : 0;
+  return n;
 }
 
 Eigen::Vector3i ComfortMap::nearest_node(const Eigen::Vector3d& position) const {
@@ -79,27 +197,27 @@ double ComfortMap::bin(const Eigen::Vector3i& node, int orientation) const {
 }
 
 double ComfortMap::lookup(const core::Pose& hand) const {
-  const int o = nearest_orientation(orientations_, Eigen::Quaterniond(hand.linear()));
+  const int o = orientation_index_.nearest(Eigen::Quaterniond(hand.linear()));
   const Eigen::Vector3d g = (hand.translation() - origin_) / spacing_;
   Eigen::Vector3i base;
   Eigen::Vector3d t;
   for (int k = 0; k < 3; ++k) {
-    if (g[k] < 0.0 || g[k] > dims_[k] - 1) return 0.0;  // outside the grid: out of reach
-    base[k] = std::min(static_cast<int>(std::floor(g[k])), dims_[k] - 2);
+    if (!(g[k] >= 0.0 && g[k] <= dims_[k] - 1)) return 0.0;  // outside the grid: out of reach
+    base[k] = std::min(static_cast<int>(g[k]), dims_[k] - 2);
     t[k] = g[k] - base[k];
   }
-  double value = 0.0;
-  for (int corner = 0; corner < 8; ++corner) {
-    double w = 1.0;
-    Eigen::Vector3i node = base;
-    for (int k = 0; k < 3; ++k) {
-      const bool upper = (corner >> k) & 1;
-      node[k] += upper ? 1 : 0;
-      w *= upper ? t[k] : 1.0 - t[k];
-    }
-    value += w * bin(node, o);
-  }
-  return value;
+  // Orientation-major layout: z neighbours adjacent, then y, then x.
+  const std::size_t sz = 1;
+  const auto sy = static_cast<std::size_t>(dims_.z());
+  const std::size_t sx = sy * static_cast<std::size_t>(dims_.y());
+  const std::uint8_t* p = values_.data() + index(base, o);
+  const double x0 = (1.0 - t.z()) * p[0] + t.z() * p[sz];
+  const double x1 = (1.0 - t.z()) * p[sy] + t.z() * p[sy + sz];
+  const double x2 = (1.0 - t.z()) * p[sx] + t.z() * p[sx + sz];
+  const double x3 = (1.0 - t.z()) * p[sx + sy] + t.z() * p[sx + sy + sz];
+  const double y0 = (1.0 - t.y()) * x0 + t.y() * x1;
+  const double y1 = (1.0 - t.y()) * x2 + t.y() * x3;
+  return ((1.0 - t.x()) * y0 + t.x() * y1) * (1.0 / 255.0);
 }
 
 ComfortMap ComfortMap::from_record(const db::ComfortMapRecord& record) {
@@ -108,7 +226,10 @@ ComfortMap ComfortMap::from_record(const db::ComfortMapRecord& record) {
   map.spacing_ = record.spacing;
   map.dims_ = record.dims;
   map.orientations_ = record.orientations;
-  map.values_ = record.values;
+  map.orientation_index_ = OrientationIndex(map.orientations_);
+  map.values_.assign(record.values.size(), 0);
+  for_each_bin(map.dims_, map.orientations_.size(),
+               [&](std::size_t db, std::size_t mem) { map.values_[mem] = record.values[db]; });
   map.coverage_ = record.coverage;
   return map;
 }
@@ -121,7 +242,7 @@ db::ComfortMapRecord ComfortMap::to_record(const std::string& arm,
   record.spacing = spacing_;
   record.dims = dims_;
   record.orientations = orientations_;
-  record.values = values_;
+  record.values = values();
   record.samples = settings.samples;
   record.seed = settings.seed;
   record.coverage = coverage_;
@@ -132,6 +253,7 @@ ComfortMap ComfortMap::build(const core::KinematicChain& arm, const ComfortMapSe
   ComfortMap map;
   map.spacing_ = settings.spacing;
   map.orientations_ = spread_orientations(settings.orientations);
+  map.orientation_index_ = OrientationIndex(map.orientations_);
   const double reach = characteristic_length(arm);
   const Eigen::Vector3d shoulder = arm.first_joint_position();
   const int half = static_cast<int>(std::ceil(reach / settings.spacing)) + 1;
@@ -148,7 +270,7 @@ ComfortMap ComfortMap::build(const core::KinematicChain& arm, const ComfortMapSe
     const double quality = comfort_index_fast(jac, reach);
     const auto value =
         static_cast<std::uint8_t>(std::lround(std::clamp(quality, 0.0, 1.0) * 255.0));
-    const int o = nearest_orientation(map.orientations_, Eigen::Quaterniond(tip.linear()));
+    const int o = map.orientation_index_.nearest(Eigen::Quaterniond(tip.linear()));
     std::uint8_t& slot = map.values_[map.index(map.nearest_node(tip.translation()), o)];
     slot = std::max(slot, value);
   }

@@ -297,65 +297,72 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   const double max_rotation = core::deg_to_rad(settings.max_rotation_deg);
   std::vector<HumanChoice> choices;
   double best_q = 0.0;
-  while (static_cast<int>(result.candidates.size()) < settings.candidates &&
-         stage.draws < settings.max_draws) {
-    ++stage.draws;
-    core::Pose pose = core::Pose::Identity();
-    pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
-    pose.translation() = target.translation() + random_in_ball(settings.max_offset, rng);
-    screen_data.set_body_pose(screen_board, pose);
-    if (core::in_collision(screen, screen_data, {screen_board})) continue;
-    db::HandoverCandidateRecord c;
-    c.sample = static_cast<int>(result.candidates.size());
-    c.board = pose;
-    c.distance = handover_distance(pose, target, settings.rotation_weight);
-    const HumanChoice h = choose_human(pose);
-    c.quality = h.quality;
-    best_q = std::max(best_q, h.quality);
-    c.status = "uncomfortable";
-    if (h.grasp >= 0) {
-      c.human_arm = comfort.arm_name(h.arm);
-      c.human_grasp_id = h.grasp;
-      c.human_quality = h.arm_quality;
-    } else {
-      c.human_grasp_id = -1;
+  auto sample_candidates = [&](int until) {
+    while (static_cast<int>(result.candidates.size()) < until && stage.draws < settings.max_draws) {
+      ++stage.draws;
+      core::Pose pose = core::Pose::Identity();
+      pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
+      pose.translation() = target.translation() + random_in_ball(settings.max_offset, rng);
+      screen_data.set_body_pose(screen_board, pose);
+      if (core::in_collision(screen, screen_data, {screen_board})) continue;
+      db::HandoverCandidateRecord c;
+      c.sample = static_cast<int>(result.candidates.size());
+      c.board = pose;
+      c.distance = handover_distance(pose, target, settings.rotation_weight);
+      const HumanChoice h = choose_human(pose);
+      c.quality = h.quality;
+      best_q = std::max(best_q, h.quality);
+      c.status = "uncomfortable";
+      if (h.grasp >= 0) {
+        c.human_arm = comfort.arm_name(h.arm);
+        c.human_grasp_id = h.grasp;
+        c.human_quality = h.arm_quality;
+      } else {
+        c.human_grasp_id = -1;
+      }
+      c.second_grasp_id = -1;
+      if (h.second_grasp >= 0) {
+        c.second_arm = comfort.arm_name(h.second_arm);
+        c.second_grasp_id = h.second_grasp;
+        c.second_quality = h.second_quality;
+      }
+      if (h.default_quality > settings.comfort_threshold) ++stage.comfortable_default_body;
+      if (h.quality > settings.comfort_threshold) {
+        ++stage.comfortable;
+        c.status = "no_shared_grasp";
+      }
+      result.candidates.push_back(c);
+      choices.push_back(h);
     }
-    c.second_grasp_id = -1;
-    if (h.second_grasp >= 0) {
-      c.second_arm = comfort.arm_name(h.second_arm);
-      c.second_grasp_id = h.second_grasp;
-      c.second_quality = h.second_quality;
-    }
-    if (h.default_quality > settings.comfort_threshold) ++stage.comfortable_default_body;
-    if (h.quality > settings.comfort_threshold) {
-      ++stage.comfortable;
-      c.status = "no_shared_grasp";
-    }
-    result.candidates.push_back(c);
-    choices.push_back(h);
-  }
-  screen_data.set_body_pose(screen_board, kParked);
-  stage.candidates = static_cast<int>(result.candidates.size());
+    screen_data.set_body_pose(screen_board, kParked);
+    stage.candidates = static_cast<int>(result.candidates.size());
+  };
   auto finish = [&](const std::string& failure) {
     stage.failure = failure;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
-  if (stage.candidates == 0) {
-    return finish("no pose within " + core::format_number(settings.max_rotation_deg) + " deg and " +
-                  core::format_number(settings.max_offset) +
-                  " m of the target is clear of the finished parts, the table and the human (" +
-                  std::to_string(stage.draws) + " draws)");
-  }
-  if (stage.comfortable == 0) {
-    if (best_q <= 0.0) {
-      return finish("the human reaches none of the " + std::to_string(stage.candidates) +
-                    " candidates around the target (is the target within reach of the stance?)");
+  auto no_candidate_reason = [&]() -> std::string {
+    if (stage.candidates == 0) {
+      return "no pose within " + core::format_number(settings.max_rotation_deg) + " deg and " +
+             core::format_number(settings.max_offset) +
+             " m of the target is clear of the finished parts, the table and the human (" +
+             std::to_string(stage.draws) + " draws)";
     }
-    return finish("no candidate is comfortable: the best human Q is " +
-                  core::format_number(best_q) + ", the threshold " +
-                  core::format_number(settings.comfort_threshold));
+    if (stage.comfortable == 0) {
+      if (best_q <= 0.0) {
+        return "the human reaches none of the " + std::to_string(stage.candidates) +
+               " candidates around the target (is the target within reach of the stance?)";
+      }
+      return "no candidate is comfortable: the best human Q is " + core::format_number(best_q) +
+             ", the threshold " + core::format_number(settings.comfort_threshold);
+    }
+    return "";
+  };
+  sample_candidates(settings.candidates);
+  if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates) {
+    return finish(no_candidate_reason());
   }
 
   // --- Robot grasp geometry: opening axis and lever direction in the part frame ---------------
@@ -507,15 +514,6 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   }
 
   // --- 𝕊: members of S sharing a grasp with a robot-robot pose, in Eq. 8 order -------------
-  std::vector<int> comfortable;
-  for (std::size_t i = 0; i < result.candidates.size(); ++i) {
-    if (result.candidates[i].status == "no_shared_grasp")
-      comfortable.push_back(static_cast<int>(i));
-  }
-  std::stable_sort(comfortable.begin(), comfortable.end(), [&](int a, int b) {
-    return result.candidates[static_cast<std::size_t>(a)].distance <
-           result.candidates[static_cast<std::size_t>(b)].distance;
-  });
   ComfortSettings ik_settings;
   ik_settings.ik_attempts = 12;
   ik_settings.seed = settings.seed;
@@ -532,74 +530,103 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // At the robot-human pose the receiving arm and the board it holds move against the rest.
   std::vector<int> rh_bodies = receiving_bodies;
   rh_bodies.push_back(scene.board);
-  for (const int ci : comfortable) {
-    auto& c = result.candidates[static_cast<std::size_t>(ci)];
-    const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
-    data.set_body_pose(scene.board, c.board);
-    const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
-    place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + 0.01);
-    if (h.second_grasp >= 0) {
-      const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-      place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + 0.01);
+  std::size_t searched = 0;  // candidates before this index have been searched
+  auto search_shared = [&] {
+    std::vector<int> comfortable;
+    for (std::size_t i = searched; i < result.candidates.size(); ++i) {
+      if (result.candidates[i].status == "no_shared_grasp")
+        comfortable.push_back(static_cast<int>(i));
     }
-    int shared = 0;
-    for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
-      const int rr = rr_of_grasp[static_cast<std::size_t>(g)];
-      if (rr < 0) continue;
-      Receiving at_rh;
-      if (!receive(c.board, g, rh_bodies, at_rh)) continue;
-      ++shared;
-      const auto& at_rr = rr_grasps[static_cast<std::size_t>(rr)];
-      const auto it = std::find_if(at_rr.begin(), at_rr.end(),
-                                   [&](const Receiving& r) { return r.grasp == g; });
-      db::SharedGraspRecord s;
-      s.candidate_id = ci;
-      s.robot_grasp_id = g;
-      s.robot_handover_id = rr;
-      s.arm = receiving_arm.spec.name;
-      s.joints_rr = it->joints;
-      s.joints_rh = at_rh.joints;
-      s.inclination_rr_deg = it->slip_deg;
-      s.inclination_rh_deg = at_rh.slip_deg;
-      result.shared.push_back(s);
-      if (shared >= settings.shared_stored) break;  // membership in 𝕊 is settled
-    }
-    restore_receiving();
-    reset_state();
-    if (shared == 0) continue;
-    // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
-    // are coarse, so a bin's Q may come from a neighbouring hand orientation.
-    if (verified < settings.human_ik_goals) {
-      const ComfortResult first = solve_human(c.board, h.arm, h.grasp);
-      ComfortResult second;
-      if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
-      const double q =
-          h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
-      if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) ||
-          q <= settings.comfort_threshold) {
-        // Not comfortable after all: out of S, and its shared grasps go.
-        c.status = "uncomfortable";
-        c.quality = q;
-        --stage.comfortable;
-        result.shared.erase(
-            std::remove_if(result.shared.begin(), result.shared.end(),
-                           [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; }),
-            result.shared.end());
-        continue;
-      }
-      ++verified;
-      c.human_joints = first.joints;
-      c.human_quality = first.quality;
+    searched = result.candidates.size();
+    std::stable_sort(comfortable.begin(), comfortable.end(), [&](int a, int b) {
+      return result.candidates[static_cast<std::size_t>(a)].distance <
+             result.candidates[static_cast<std::size_t>(b)].distance;
+    });
+    for (const int ci : comfortable) {
+      auto& c = result.candidates[static_cast<std::size_t>(ci)];
+      const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
+      data.set_body_pose(scene.board, c.board);
+      const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
+      place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + 0.01);
       if (h.second_grasp >= 0) {
-        c.second_joints = second.joints;
-        c.second_quality = second.quality;
+        const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+        place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + 0.01);
       }
+      int shared = 0;
+      for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+        const int rr = rr_of_grasp[static_cast<std::size_t>(g)];
+        if (rr < 0) continue;
+        Receiving at_rh;
+        if (!receive(c.board, g, rh_bodies, at_rh)) continue;
+        ++shared;
+        const auto& at_rr = rr_grasps[static_cast<std::size_t>(rr)];
+        const auto it = std::find_if(at_rr.begin(), at_rr.end(),
+                                     [&](const Receiving& r) { return r.grasp == g; });
+        db::SharedGraspRecord s;
+        s.candidate_id = ci;
+        s.robot_grasp_id = g;
+        s.robot_handover_id = rr;
+        s.arm = receiving_arm.spec.name;
+        s.joints_rr = it->joints;
+        s.joints_rh = at_rh.joints;
+        s.inclination_rr_deg = it->slip_deg;
+        s.inclination_rh_deg = at_rh.slip_deg;
+        result.shared.push_back(s);
+        if (shared >= settings.shared_stored) break;  // membership in 𝕊 is settled
+      }
+      restore_receiving();
+      reset_state();
+      if (shared == 0) continue;
+      // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
+      // are coarse, so a bin's Q may come from a neighbouring hand orientation.
+      if (verified < settings.human_ik_goals) {
+        const ComfortResult first = solve_human(c.board, h.arm, h.grasp);
+        ComfortResult second;
+        if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
+        const double q =
+            h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
+        if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) ||
+            q <= settings.comfort_threshold) {
+          // Not comfortable after all: out of S, and its shared grasps go.
+          c.status = "uncomfortable";
+          c.quality = q;
+          --stage.comfortable;
+          result.shared.erase(
+              std::remove_if(result.shared.begin(), result.shared.end(),
+                             [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; }),
+              result.shared.end());
+          continue;
+        }
+        ++verified;
+        c.human_joints = first.joints;
+        c.human_quality = first.quality;
+        if (h.second_grasp >= 0) {
+          c.second_joints = second.joints;
+          c.second_quality = second.quality;
+        }
+      }
+      c.status = "goal";
+      ++stage.goals;
     }
-    c.status = "goal";
-    c.rank = stage.goals++;
+    reset_state();
+  };
+  search_shared();
+  // Thin boards (few goals in the first batch) get more candidates, batch by batch.
+  while (stage.goals < settings.min_goals && stage.candidates < settings.max_candidates &&
+         stage.draws < settings.max_draws) {
+    sample_candidates(std::min(settings.max_candidates, stage.candidates + settings.candidates));
+    search_shared();
   }
-  reset_state();
+  // Eq. 8 ranks over every batch.
+  std::vector<db::HandoverCandidateRecord*> goals;
+  for (auto& c : result.candidates) {
+    if (c.status == "goal") goals.push_back(&c);
+  }
+  std::stable_sort(goals.begin(), goals.end(),
+                   [](const auto* a, const auto* b) { return a->distance < b->distance; });
+  for (std::size_t r = 0; r < goals.size(); ++r) goals[r]->rank = static_cast<int>(r);
 
+  if (!no_candidate_reason().empty()) return finish(no_candidate_reason());
   if (stage.goals == 0) {
     return finish(
         "no comfortable candidate shares a grasp with a robot-robot handover pose (|S| = " +

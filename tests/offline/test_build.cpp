@@ -26,6 +26,11 @@ offline::BuildSettings quick_settings(std::uint64_t seed = 7, int jobs = 1) {
   s.comfort.spacing = 0.06;
   s.comfort.orientations = 100;
   s.comfort.samples = 20000;
+  s.handover.candidates = 60;
+  s.handover.max_candidates = 60;
+  s.handover.rr_poses = 6;
+  s.handover.human_ik_goals = 2;
+  s.ergonomics.flexion_step_deg = 15.0;
   return s;
 }
 
@@ -87,6 +92,61 @@ TEST(Build, CabinetDatabaseHoldsEveryBoardWithGraspsOfEachKind) {
   EXPECT_EQ(database.comfort_map("right").values, direct.values());
   EXPECT_EQ(database.comfort_map("right").dims, direct.dims());
   EXPECT_EQ(files_in(dir), (std::vector<std::string>{"cabinet.hila"}));  // no temporary left
+}
+
+TEST(Build, HandoverStagesGoalsAndErgonomicsAreStoredForEveryBoard) {
+  const std::string dir = test::temp_dir("build_handover");
+  offline::BuildSettings settings = quick_settings();
+  settings.comfort.spacing = 0.03;
+  settings.comfort.orientations = 128;
+  settings.comfort.samples = 400000;
+  settings.human_bodies = {{1.60, core::Sex::Female}, {1.80, core::Sex::Male}};
+  const auto summary =
+      offline::build_database(test::product_path(), test::cell_path(), dir + "/c.hila", settings);
+  const auto database = db::Database::open(dir + "/c.hila");
+  EXPECT_EQ(database.meta().human_bodies, "1.6 female; 1.8 male");
+  int with_goals = 0;
+  for (std::size_t i = 0; i < database.parts().size(); ++i) {
+    const auto& part = database.parts()[i];
+    const db::HandoverStageRecord* stage = database.handover_stage(part.id);
+    ASSERT_NE(stage, nullptr) << part.name;
+    EXPECT_EQ(stage->finished_parts.size(), i) << part.name;  // the boards before it
+    EXPECT_EQ(stage->candidates, 60);
+    EXPECT_LE(stage->comfortable, stage->comfortable_default_body);  // every body vs the cell's
+    const auto candidates = database.handover_candidates(part.id);
+    EXPECT_EQ(static_cast<int>(candidates.size()), stage->candidates);
+    const auto goals = database.handover_goals(part.id);
+    EXPECT_EQ(static_cast<int>(goals.size()), stage->goals);
+    EXPECT_EQ(stage->failure.empty(), stage->goals > 0) << stage->failure;
+    EXPECT_EQ(summary.parts[i].handover_failure, stage->failure);
+    for (std::size_t r = 0; r < goals.size(); ++r) {
+      EXPECT_EQ(goals[r].rank, static_cast<int>(r));
+      EXPECT_FALSE(database.shared_grasps(goals[r].id).empty());
+    }
+    with_goals += stage->goals > 0 ? 1 : 0;
+    const auto ergonomics = database.ergonomics(part.id);
+    ASSERT_EQ(ergonomics.size(), stage->goals > 0 ? 3u : 2u);
+    EXPECT_EQ(ergonomics.back().method, "alone");
+  }
+  EXPECT_GT(with_goals, 0);
+  EXPECT_EQ(static_cast<int>(summary.failed_parts().size()), 7 - with_goals);
+}
+
+TEST(Build, AHumanStanceInsideTheTableIsRejectedBeforeAnyWork) {
+  const std::string dir = test::temp_dir("build_stance");
+  std::string cell = test::read_file(test::cell_path());
+  const std::string from = "stance: {xyz: [1.15, 0.0, 0.1]";
+  cell.replace(cell.find(from), from.size(), "stance: {xyz: [0.70, 0.0, 0.1]");
+  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
+    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
+  }
+  const std::string path = test::write_file(dir, "cell.yaml", cell);
+  test::expect_input_error(
+      [&] {
+        offline::build_database(test::product_path(), path, dir + "/x.hila", quick_settings());
+      },
+      {"human.stance", "table"});
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
 }
 
 TEST(Build, SameSeedSameDigestForAnyNumberOfJobs) {

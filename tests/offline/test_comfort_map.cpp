@@ -93,11 +93,13 @@ TEST(ComfortMap, EveryBinHoldsTheBestQOfTheSamplesThatLandedInIt) {
     slot = std::max<std::uint8_t>(slot, static_cast<std::uint8_t>(std::lround(quality * 255.0)));
   }
   std::size_t differing = 0;
-  for (std::size_t i = 0; i < expected.size(); ++i) differing += expected[i] != map.values()[i];
+  const auto values = map.values();
+  for (std::size_t i = 0; i < expected.size(); ++i) differing += expected[i] != values[i];
   // SVD vs eigenvalue rounding can move a value across a 1/255 step on rare ties.
   EXPECT_LE(differing, expected.size() / 10000);
-  EXPECT_GT(std::count_if(map.values().begin(), map.values().end(), [](auto v) { return v > 0; }),
-            1000);
+  EXPECT_GT(std::count_if(values.begin(), values.end(), [](auto v) { return v > 0; }), 1000);
+  EXPECT_EQ(map.filled_bins(),
+            std::count_if(values.begin(), values.end(), [](auto v) { return v > 0; }));
 }
 
 TEST(ComfortMap, LookupAtANodeIsItsBinAndOutsideTheGridIsZero) {
@@ -166,8 +168,9 @@ TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
   EXPECT_LE(error_sum / queries, 0.05);
 
   std::vector<std::size_t> filled;
-  for (std::size_t b = 0; b < map.values().size(); ++b) {
-    if (map.values()[b] > 0) filled.push_back(b);
+  const auto values = map.values();
+  for (std::size_t b = 0; b < values.size(); ++b) {
+    if (values[b] > 0) filled.push_back(b);
   }
   ASSERT_FALSE(filled.empty());
   const auto n_orient = map.orientations().size();
@@ -218,4 +221,25 @@ TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
   // the reachable set: measured 90 of 100 with this seed; 85 leaves room for the search, not for
   // a map that marks unreachable bins (a wrong frame or limit drops this far below).
   EXPECT_GE(confirmed, 85);
+}
+
+TEST(ComfortMap, OrientationIndexEqualsTheLinearScan) {
+  for (const int count : {100, 128, 300}) {
+    const auto set = offline::spread_orientations(count);
+    const offline::OrientationIndex index(set);
+    EXPECT_LT(index.mean_candidates(), 0.2 * count);  // the point of the index
+    std::mt19937_64 rng(static_cast<std::uint64_t>(count));
+    std::normal_distribution<double> n(0.0, 1.0);
+    for (int i = 0; i < 50000; ++i) {
+      Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
+      q.normalize();
+      ASSERT_EQ(index.nearest(q), offline::nearest_orientation(set, q)) << i;
+    }
+    // Exactly on the members, and at their negatives (the same rotations).
+    for (int i = 0; i < count; ++i) {
+      const auto& q = set[static_cast<std::size_t>(i)];
+      EXPECT_EQ(index.nearest(q), i);
+      EXPECT_EQ(index.nearest(Eigen::Quaterniond(-q.w(), -q.x(), -q.y(), -q.z())), i);
+    }
+  }
 }

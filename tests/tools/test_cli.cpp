@@ -172,7 +172,7 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
     const CommandRun handover = run("inspect " + out + " handover --part " + board + " --json");
     ASSERT_EQ(handover.status, 0) << handover.out;
     const auto h = nlohmann::json::parse(json_part(handover.out));
-    EXPECT_EQ(h["candidates"], 500);
+    EXPECT_GE(h["candidates"].get<int>(), 500);  // thin boards get further batches
     EXPECT_GT(h["goals"].get<int>(), 0) << board;
     EXPECT_EQ(h["ranked_goals"].size(), h["goals"].get<std::size_t>());
     EXPECT_EQ(h["failure"], "");

@@ -31,6 +31,24 @@ struct ComfortMapSettings {
 // hand pose binned to the nearest grid node and nearest orientation, each bin keeping the best Q
 // seen. Q is stored in 1/255 steps (one byte per bin). Lookups interpolate trilinearly between
 // the eight nodes around the position at the nearest orientation; bins never reached hold 0.
+// Exact nearest-orientation queries over a fixed set in a few dot products: the unit
+// quaternions (sign-folded) are split into the cells of a cube-face grid, each cell listing the
+// members that can be nearest to some rotation inside it (by the triangle inequality of the
+// rotation metric acos|<p, q>|). Same answers as nearest_orientation, ties included.
+class OrientationIndex {
+ public:
+  OrientationIndex() = default;
+  explicit OrientationIndex(const std::vector<Eigen::Quaterniond>& set, int cells_per_axis = 16);
+  int nearest(const Eigen::Quaterniond& rotation) const;
+  double mean_candidates() const;
+
+ private:
+  std::vector<Eigen::Vector4d> set_;  // (w, x, y, z)
+  int n_ = 0;
+  std::vector<int> offsets_;     // per cell, into candidates_ (one extra at the end)
+  std::vector<int> candidates_;  // ascending per cell
+};
+
 class ComfortMap {
  public:
   static ComfortMap build(const core::KinematicChain& arm, const ComfortMapSettings& settings);
@@ -40,6 +58,10 @@ class ComfortMap {
   db::ComfortMapRecord to_record(const std::string& arm, const ComfortMapSettings& settings) const;
 
   double lookup(const core::Pose& hand_in_base) const;
+  // Index of the map's orientation nearest to `rotation`.
+  int nearest_orientation(const Eigen::Quaterniond& rotation) const {
+    return orientation_index_.nearest(rotation);
+  }
   // The stored value of one bin (no interpolation).
   double bin(const Eigen::Vector3i& node, int orientation) const;
   // The grid node nearest to a position (clamped to the grid).
@@ -50,7 +72,9 @@ class ComfortMap {
   double coverage() const { return coverage_; }
   const Eigen::Vector3i& dims() const { return dims_; }
   const std::vector<Eigen::Quaterniond>& orientations() const { return orientations_; }
-  const std::vector<std::uint8_t>& values() const { return values_; }
+  // The bins in the database's order (a copy; see db::ComfortMapRecord::values).
+  std::vector<std::uint8_t> values() const;
+  long filled_bins() const;
   double spacing() const { return spacing_; }
   const Eigen::Vector3d& origin() const { return origin_; }
 
@@ -61,6 +85,9 @@ class ComfortMap {
   double spacing_ = 0.03;
   Eigen::Vector3i dims_ = Eigen::Vector3i::Zero();
   std::vector<Eigen::Quaterniond> orientations_;
+  OrientationIndex orientation_index_;
+  // Orientation-major in memory ((o * X + x) * Y + y) * Z + z, so the eight nodes a lookup
+  // interpolates share two to four cache lines; the database keeps node-major order.
   std::vector<std::uint8_t> values_;
   double coverage_ = 0.0;
 };

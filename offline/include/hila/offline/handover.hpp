@@ -14,7 +14,10 @@ namespace hila::offline {
 
 struct HandoverSettings {
   // Eq. 1: candidates around the target pose.
-  int candidates = 500;            // poses satisfying Eq. 1 kept per board
+  int candidates = 500;            // poses satisfying Eq. 1 per batch (the first batch always)
+  // Boards with fewer goals than min_goals get further batches, up to max_candidates.
+  int min_goals = 5;
+  int max_candidates = 3000;
   int max_draws = 100000;          // give up drawing after this many
   double max_rotation_deg = 45.0;  // from the target orientation
   double max_offset = 0.5;         // m from the target position
