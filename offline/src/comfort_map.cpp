@@ -104,8 +104,10 @@ OrientationIndex::OrientationIndex(const std::vector<Eigen::Quaterniond>& set, i
       }
     }
   }
+  unique_.assign(static_cast<std::size_t>(cells), -1);
   for (int cell = 0; cell < cells; ++cell) {
     const auto& list = lists[static_cast<std::size_t>(cell)];
+    if (list.size() == 1) unique_[static_cast<std::size_t>(cell)] = list.front();
     offsets_[static_cast<std::size_t>(cell) + 1] =
         offsets_[static_cast<std::size_t>(cell)] + static_cast<int>(list.size());
     candidates_.insert(candidates_.end(), list.begin(), list.end());
@@ -115,6 +117,8 @@ OrientationIndex::OrientationIndex(const std::vector<Eigen::Quaterniond>& set, i
 int OrientationIndex::nearest(const Eigen::Quaterniond& rotation) const {
   const Eigen::Vector4d q(rotation.w(), rotation.x(), rotation.y(), rotation.z());
   const int cell = orientation_cell(q, n_);
+  const int unique = unique_[static_cast<std::size_t>(cell)];
+  if (unique >= 0) return unique;  // most cells: one possible answer, no dot product
   int best = 0;
   double best_dot = -1.0;
   const int end = offsets_[static_cast<std::size_t>(cell) + 1];

@@ -47,6 +47,7 @@ class OrientationIndex {
   int n_ = 0;
   std::vector<int> offsets_;     // per cell, into candidates_ (one extra at the end)
   std::vector<int> candidates_;  // ascending per cell
+  std::vector<int> unique_;      // per cell: the only candidate, or -1
 };
 
 class ComfortMap {
