@@ -260,3 +260,19 @@ TEST(Handover, UnreachableTargetFailsWithAReason) {
   EXPECT_EQ(r.stage.goals, 0);
   EXPECT_NE(r.stage.failure.find("reaches none"), std::string::npos) << r.stage.failure;
 }
+
+TEST(Handover, NoRobotRobotPoseFailsWithAReason) {
+  // Robot-robot poses out of both arms' reach: S exists, 𝕊 cannot.
+  const auto cell = test::reference_cell();
+  offline::HandoverSettings settings;
+  settings.candidates = 60;
+  settings.max_candidates = 60;
+  settings.rr_positions = {{2.0, 0.0, 2.5}};
+  const auto r =
+      offline::plan_handover_goals(*cell, product(), 0, board_grasps(0), comfort(), settings);
+  EXPECT_EQ(r.stage.goals, 0);
+  EXPECT_EQ(r.stage.robot_handovers, 0);
+  EXPECT_NE(r.stage.failure.find("no robot-robot handover pose"), std::string::npos)
+      << r.stage.failure;
+  for (const auto& c : r.candidates) EXPECT_NE(c.status, "goal");
+}
