@@ -1,0 +1,280 @@
+#include "hila/offline/roadmap.hpp"
+
+#include <ompl/base/PlannerData.h>
+#include <ompl/base/PlannerTerminationCondition.h>
+#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/base/ValidStateSampler.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/datastructures/NearestNeighborsLinear.h>
+#include <ompl/geometric/planners/prm/PRM.h>
+#include <ompl/util/Console.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <set>
+
+#include "hila/core/collision.hpp"
+#include "hila/core/error.hpp"
+#include "hila/core/soft_finger.hpp"
+#include "hila/core/stage_scene.hpp"
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+namespace hila::offline {
+
+namespace {
+
+Eigen::VectorXd to_vector(const ob::State* s, int dof) {
+  const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+  Eigen::VectorXd q(dof);
+  for (int i = 0; i < dof; ++i) q[i] = v->values[i];
+  return q;
+}
+
+void from_vector(const Eigen::VectorXd& q, ob::State* s) {
+  auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+  for (Eigen::Index i = 0; i < q.size(); ++i) v->values[i] = q[i];
+}
+
+// The arm against the static cell (the other arm at home). One instance per thread.
+class ArmChecker {
+ public:
+  ArmChecker(const core::Cell& cell, const core::Arm& arm, int arm_index)
+      : cell_(cell),
+        arm_(arm),
+        scene_(core::build_cell_scene(cell)),
+        data_(scene_.model),
+        bodies_(scene_.arm_bodies[static_cast<std::size_t>(arm_index)]),
+        q_(cell.home_configuration()),
+        human_q_(cell.human_neutral()) {
+    core::set_cell_state(cell_, scene_, data_, q_, human_q_);
+  }
+  bool valid(const Eigen::VectorXd& arm_q) {
+    if (!arm_.chain.within_limits(arm_q, 1e-12)) return false;
+    cell_.set_arm(q_, arm_, arm_q);
+    core::set_cell_state(cell_, scene_, data_, q_, human_q_);
+    return !core::in_collision(scene_.model, data_, bodies_);
+  }
+
+ private:
+  const core::Cell& cell_;
+  const core::Arm& arm_;
+  core::CellScene scene_;
+  core::CollisionData data_;
+  std::vector<int> bodies_;
+  Eigen::VectorXd q_;
+  Eigen::VectorXd human_q_;
+};
+
+// Uniform joint-space samples mixed with IK samples of gripper poses whose opening axis is
+// near vertical (the slip-constrained region, thin in joint space).
+class SlipBiasedSampler : public ob::ValidStateSampler {
+ public:
+  SlipBiasedSampler(const ob::SpaceInformation* si, const core::Cell& cell, const core::Arm& arm,
+                    ArmChecker& checker, const RoadmapSettings& settings)
+      : ob::ValidStateSampler(si),
+        cell_(cell),
+        arm_(arm),
+        checker_(checker),
+        settings_(settings),
+        rng_(settings.seed),
+        base_(core::arm_base_in_world(cell, arm)) {
+    name_ = "slip_biased";
+    // Where the TCP goes: a box around the arm's base within its reach, above the table.
+    const double reach = 0.55;
+    lo_ = base_.translation() - Eigen::Vector3d::Constant(reach);
+    hi_ = base_.translation() + Eigen::Vector3d::Constant(reach);
+    double table_top = 0.0;
+    for (const auto& o : cell.spec().obstacles) {
+      table_top = std::max(table_top, o.pose.translation().z() + 0.5 * o.size.z());
+    }
+    lo_.z() = std::max(lo_.z(), table_top + 0.02);
+  }
+
+  bool sample(ob::State* state) override {
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      Eigen::VectorXd q;
+      if (uniform() < settings_.slip_bias) {
+        if (!vertical_axis_sample(q)) continue;
+      } else {
+        q = uniform_joints();
+      }
+      if (checker_.valid(q)) {
+        from_vector(q, state);
+        return true;
+      }
+    }
+    return false;
+  }
+  bool sampleNear(ob::State* state, const ob::State* near, double distance) override {
+    const Eigen::VectorXd centre = to_vector(near, arm_.chain.dof());
+    std::normal_distribution<double> n(0.0, distance / 2.0);
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      Eigen::VectorXd q = centre;
+      for (Eigen::Index i = 0; i < q.size(); ++i) q[i] += n(rng_);
+      if (checker_.valid(q)) {
+        from_vector(q, state);
+        return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  double uniform() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
+  Eigen::VectorXd uniform_joints() {
+    const auto& lo = arm_.chain.lower_limits();
+    const auto& hi = arm_.chain.upper_limits();
+    Eigen::VectorXd q(lo.size());
+    for (Eigen::Index i = 0; i < q.size(); ++i) q[i] = lo[i] + uniform() * (hi[i] - lo[i]);
+    return q;
+  }
+  bool vertical_axis_sample(Eigen::VectorXd& q) {
+    // Opening axis within the cone around +-z, any rotation about it, TCP in the box.
+    const double cone = core::deg_to_rad(settings_.vertical_cone_deg);
+    const double tilt = std::acos(1.0 - uniform() * (1.0 - std::cos(cone)));
+    const double azimuth = 2.0 * core::kPi * uniform();
+    Eigen::Vector3d axis(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth),
+                         std::cos(tilt));
+    if (uniform() < 0.5) axis = -axis;
+    const Eigen::Vector3d opening = cell_.spec().gripper.opening_axis.normalized();
+    const Eigen::Matrix3d align =
+        Eigen::Quaterniond::FromTwoVectors(opening, axis).toRotationMatrix();
+    core::Pose tcp = core::Pose::Identity();
+    tcp.linear() = Eigen::AngleAxisd(2.0 * core::kPi * uniform(), axis) * align;
+    for (int k = 0; k < 3; ++k) tcp.translation()[k] = lo_[k] + uniform() * (hi_[k] - lo_[k]);
+    core::UrIkSolutions solutions;
+    const int n = arm_.ur_ik->solve(base_.inverse() * tcp, arm_.spec.home, solutions);
+    if (n == 0) return false;
+    q = solutions.q[static_cast<std::size_t>(rng_() % static_cast<std::uint64_t>(n))];
+    return true;
+  }
+
+  const core::Cell& cell_;
+  const core::Arm& arm_;
+  ArmChecker& checker_;
+  RoadmapSettings settings_;
+  std::mt19937_64 rng_;
+  core::Pose base_;
+  Eigen::Vector3d lo_, hi_;
+};
+
+// PRM with OMPL's exact linear nearest-neighbour structure (deterministic: GNAT's pivots draw
+// from OMPL's global RNG). PRM::setup only wires the distance function into a structure it made
+// itself, so it is wired here.
+class LinearPrm : public og::PRM {
+ public:
+  explicit LinearPrm(const ob::SpaceInformationPtr& si) : og::PRM(si) {
+    setNearestNeighbors<ompl::NearestNeighborsLinear>();
+    nn_->setDistanceFunction(
+        [this](const Vertex a, const Vertex b) { return distanceFunction(a, b); });
+  }
+};
+
+}  // namespace
+
+std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                          double resolution) {
+  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
+  std::vector<Eigen::VectorXd> out;
+  for (int i = 1; i < steps; ++i) out.push_back(a + (b - a) * (static_cast<double>(i) / steps));
+  return out;
+}
+
+Eigen::Vector3d gravity_in_tcp(const core::Cell& cell, const core::Arm& arm,
+                               const Eigen::VectorXd& q) {
+  const Eigen::Matrix3d r = core::arm_base_in_world(cell, arm).linear() * arm.chain.fk(q).linear();
+  return r.transpose() * Eigen::Vector3d(0.0, 0.0, -1.0);
+}
+
+Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
+                      const RoadmapSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  const core::Arm& arm = cell.arm(arm_name);
+  if (!arm.ur_ik) {
+    throw core::InputError(cell.spec().file, "robot.arms." + arm_name + ".kinematics",
+                           "UR DH parameters (the roadmap's slip-biased sampler uses the "
+                           "analytic IK)",
+                           "none");
+  }
+  int arm_index = 0;
+  while (&cell.arms()[static_cast<std::size_t>(arm_index)] != &arm) ++arm_index;
+  const int dof = arm.chain.dof();
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+
+  auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
+  ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
+  for (int i = 0; i < dof; ++i) {
+    bounds.setLow(static_cast<unsigned>(i), arm.chain.lower_limits()[i]);
+    bounds.setHigh(static_cast<unsigned>(i), arm.chain.upper_limits()[i]);
+  }
+  space->setBounds(bounds);
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  ArmChecker checker(cell, arm, arm_index);
+  si->setStateValidityChecker([&](const ob::State* s) { return checker.valid(to_vector(s, dof)); });
+  si->setStateValidityCheckingResolution(settings.resolution / space->getMaximumExtent());
+  si->setValidStateSamplerAllocator([&](const ob::SpaceInformation* s) {
+    return std::make_shared<SlipBiasedSampler>(s, cell, arm, checker, settings);
+  });
+  si->setup();
+
+  LinearPrm prm(si);
+  prm.setMaxNearestNeighbors(static_cast<unsigned>(settings.neighbours));
+  prm.setProblemDefinition(std::make_shared<ob::ProblemDefinition>(si));
+  prm.setup();
+  prm.growRoadmap(ob::PlannerTerminationCondition(
+      [&] { return prm.milestoneCount() >= static_cast<unsigned long>(settings.nodes); }));
+
+  ob::PlannerData data(si);
+  prm.getPlannerData(data);
+  Roadmap map;
+  map.arm = arm_name;
+  map.dof = dof;
+  map.resolution = settings.resolution;
+  const Eigen::Vector3d opening = cell.spec().gripper.opening_axis.normalized();
+  for (unsigned v = 0; v < data.numVertices(); ++v) {
+    map.nodes.push_back(to_vector(data.getVertex(v).getState(), dof));
+    map.node_gravity.push_back(gravity_in_tcp(cell, arm, map.nodes.back()));
+    map.node_inclination_deg.push_back(
+        core::axis_inclination_deg(opening, map.node_gravity.back()));
+  }
+  std::set<std::pair<int, int>> seen;
+  for (unsigned v = 0; v < data.numVertices(); ++v) {
+    std::vector<unsigned> out;
+    data.getEdges(v, out);
+    for (const unsigned w : out) {
+      const std::pair<int, int> key{static_cast<int>(std::min(v, w)),
+                                    static_cast<int>(std::max(v, w))};
+      if (key.first == key.second || !seen.insert(key).second) continue;
+      const auto& a = map.nodes[static_cast<std::size_t>(key.first)];
+      const auto& b = map.nodes[static_cast<std::size_t>(key.second)];
+      // Re-checked and annotated at exactly the documented resolution.
+      const auto samples = edge_samples(a, b, settings.resolution);
+      bool free = true;
+      std::vector<Eigen::Vector3d> gravity;
+      double worst = std::max(map.node_inclination_deg[static_cast<std::size_t>(key.first)],
+                              map.node_inclination_deg[static_cast<std::size_t>(key.second)]);
+      for (const auto& q : samples) {
+        if (!checker.valid(q)) {
+          free = false;
+          break;
+        }
+        gravity.push_back(gravity_in_tcp(cell, arm, q));
+        worst = std::max(worst, core::axis_inclination_deg(opening, gravity.back()));
+      }
+      if (!free) continue;
+      map.edges.push_back(key);
+      map.edge_length.push_back((b - a).norm());
+      map.edge_max_inclination_deg.push_back(worst);
+      map.edge_gravity.push_back(std::move(gravity));
+    }
+  }
+  map.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return map;
+}
+
+}  // namespace hila::offline
