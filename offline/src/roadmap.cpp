@@ -185,6 +185,52 @@ std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen:
   return out;
 }
 
+std::vector<bool> slip_filter(const Roadmap& roadmap, const GraspSlip& grasp) {
+  // sin(slip) = |g . (axis x lever)|: one dot product per sample.
+  const Eigen::Vector3d normal = grasp.axis.cross(grasp.lever);
+  const double limit = std::sin(core::deg_to_rad(std::min(grasp.theta_c_deg, 90.0))) + 1e-12;
+  auto holds = [&](const Eigen::Vector3d& g) { return std::abs(g.dot(normal)) <= limit; };
+  std::vector<bool> node_ok(roadmap.nodes.size());
+  for (std::size_t i = 0; i < node_ok.size(); ++i) node_ok[i] = holds(roadmap.node_gravity[i]);
+  std::vector<bool> out(roadmap.edges.size(), false);
+  for (std::size_t e = 0; e < roadmap.edges.size(); ++e) {
+    const auto [a, b] = roadmap.edges[e];
+    bool ok = node_ok[static_cast<std::size_t>(a)] && node_ok[static_cast<std::size_t>(b)];
+    for (std::size_t k = 0; ok && k < roadmap.edge_gravity[e].size(); ++k) {
+      ok = holds(roadmap.edge_gravity[e][k]);
+    }
+    out[e] = ok;
+  }
+  return out;
+}
+
+std::vector<int> connected_components(const Roadmap& roadmap, const std::vector<bool>& edges) {
+  std::vector<int> parent(roadmap.nodes.size());
+  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  auto find = [&](int x) {
+    while (parent[static_cast<std::size_t>(x)] != x) {
+      parent[static_cast<std::size_t>(x)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+      x = parent[static_cast<std::size_t>(x)];
+    }
+    return x;
+  };
+  for (std::size_t e = 0; e < roadmap.edges.size(); ++e) {
+    if (!edges[e]) continue;
+    const int ra = find(roadmap.edges[e].first), rb = find(roadmap.edges[e].second);
+    if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+  }
+  std::vector<int> id(parent.size(), -1);
+  std::vector<int> root_id(parent.size(), -1);
+  int next = 0;
+  for (std::size_t i = 0; i < parent.size(); ++i) {
+    const auto r = static_cast<std::size_t>(find(static_cast<int>(i)));
+    if (root_id[r] < 0) root_id[r] = next++;
+    id[i] = root_id[r];
+  }
+  return id;
+}
+
 Eigen::Vector3d gravity_in_tcp(const core::Cell& cell, const core::Arm& arm,
                                const Eigen::VectorXd& q) {
   const Eigen::Matrix3d r = core::arm_base_in_world(cell, arm).linear() * arm.chain.fk(q).linear();

@@ -4,6 +4,7 @@
 
 #include "hila/core/collision.hpp"
 #include "hila/core/soft_finger.hpp"
+#include "hila/core/stage_scene.hpp"
 #include "hila/offline/roadmap.hpp"
 #include "util/test_util.hpp"
 
@@ -116,4 +117,76 @@ TEST(Roadmap, EdgeSamplesAreEvenAndInterior) {
   EXPECT_NEAR(s[0][0], 0.05, 1e-12);
   EXPECT_NEAR(s[2][0], 0.15, 1e-12);
   EXPECT_TRUE(offline::edge_samples(a, a, 0.05).empty());
+}
+
+// The filter against a recomputation from scratch: FK of every sample (not the stored gravity),
+// the gravity torque about the grasp axis against m g r sin(theta_c).
+TEST(Roadmap, SlipFilterEqualsRecomputationFromFk) {
+  const auto& map = small_roadmap();
+  const auto cell = test::reference_cell();
+  const core::Arm& arm = cell->arm("left");
+  const core::Pose base = core::arm_base_in_world(*cell, arm);
+  // Grasps of a board held at its edge: axis = TCP y, CoM straight ahead along the approach,
+  // and one with the CoM off to the side; a 1.8 kg lateral's 11 and 22 degrees.
+  const std::vector<offline::GraspSlip> grasps = {
+      {Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 11.0},
+      {Eigen::Vector3d::UnitY(), Eigen::Vector3d(1, 0, 1).normalized(), 22.0},
+      {Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX(), 90.0}};
+  const double lever = 0.25, weight = 1.8 * 9.81;
+  for (const auto& g : grasps) {
+    const auto filter = offline::slip_filter(map, g);
+    auto holds = [&](const Eigen::VectorXd& q) {
+      const core::Pose tcp = base * arm.chain.fk(q);
+      const Eigen::Vector3d axis = tcp.linear() * g.axis;
+      const Eigen::Vector3d r = tcp.linear() * g.lever * lever;  // contact centre -> CoM
+      const double torque = std::abs(axis.dot(r.cross(Eigen::Vector3d(0, 0, -weight))));
+      return torque <= weight * lever * std::sin(core::deg_to_rad(g.theta_c_deg)) + 1e-9;
+    };
+    int kept = 0;
+    for (std::size_t e = 0; e < map.edges.size(); ++e) {
+      const auto& a = map.nodes[static_cast<std::size_t>(map.edges[e].first)];
+      const auto& b = map.nodes[static_cast<std::size_t>(map.edges[e].second)];
+      bool ok = holds(a) && holds(b);
+      for (const auto& q : offline::edge_samples(a, b, map.resolution)) ok = ok && holds(q);
+      ASSERT_EQ(filter[e], ok) << "edge " << e << " theta_c " << g.theta_c_deg;
+      kept += ok ? 1 : 0;
+    }
+    if (g.theta_c_deg >= 90.0) {
+      EXPECT_EQ(kept, static_cast<int>(map.edges.size()));
+    } else {
+      EXPECT_GT(kept, 0);
+      EXPECT_LT(kept, static_cast<int>(map.edges.size()));
+    }
+  }
+}
+
+TEST(Roadmap, ComponentsAgreeWithBreadthFirstSearch) {
+  const auto& map = small_roadmap();
+  const auto filter =
+      offline::slip_filter(map, {Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 15.0});
+  const auto ids = offline::connected_components(map, filter);
+  std::vector<std::vector<int>> adjacent(map.nodes.size());
+  for (std::size_t e = 0; e < map.edges.size(); ++e) {
+    if (!filter[e]) continue;
+    adjacent[static_cast<std::size_t>(map.edges[e].first)].push_back(map.edges[e].second);
+    adjacent[static_cast<std::size_t>(map.edges[e].second)].push_back(map.edges[e].first);
+  }
+  std::vector<int> bfs(map.nodes.size(), -1);
+  int next = 0;
+  for (std::size_t s = 0; s < map.nodes.size(); ++s) {
+    if (bfs[s] >= 0) continue;
+    std::vector<int> queue{static_cast<int>(s)};
+    bfs[s] = next;
+    for (std::size_t k = 0; k < queue.size(); ++k) {
+      for (const int n : adjacent[static_cast<std::size_t>(queue[k])]) {
+        if (bfs[static_cast<std::size_t>(n)] < 0) {
+          bfs[static_cast<std::size_t>(n)] = next;
+          queue.push_back(n);
+        }
+      }
+    }
+    ++next;
+  }
+  EXPECT_EQ(ids, bfs);
+  EXPECT_GT(next, 1);  // a tight limit cuts the roadmap
 }

@@ -47,6 +47,22 @@ struct Roadmap {
 Roadmap build_roadmap(const core::Cell& cell, const std::string& arm,
                       const RoadmapSettings& settings);
 
+// What a held part needs of the roadmap: the grasp's opening axis and the unit lever from the
+// axis to the centre of mass, both in the TCP frame, and its relaxation limit.
+struct GraspSlip {
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d lever = Eigen::Vector3d::Zero();
+  double theta_c_deg = 90.0;
+};
+
+// The roadmap's edges a grasp may use: every sample (both ends and the interior samples) has a
+// slip angle (core::slip_angle_deg) within theta_c. One bit per edge.
+std::vector<bool> slip_filter(const Roadmap& roadmap, const GraspSlip& grasp);
+
+// Connected-component id per node over the edges whose bit is set (ids 0, 1, ... in order of
+// the lowest node of each component).
+std::vector<int> connected_components(const Roadmap& roadmap, const std::vector<bool>& edges);
+
 // The interior samples of the straight joint-space segment a -> b at `resolution` (what the
 // roadmap checks and annotates): ceil(|b - a| / resolution) - 1 points, evenly spaced.
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
