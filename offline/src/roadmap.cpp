@@ -150,7 +150,9 @@ class SlipBiasedSampler : public ob::ValidStateSampler {
     core::UrIkSolutions solutions;
     const int n = arm_.ur_ik->solve(base_.inverse() * tcp, arm_.spec.home, solutions);
     if (n == 0) return false;
-    q = solutions.q[static_cast<std::size_t>(rng_() % static_cast<std::uint64_t>(n))];
+    // Mostly the branch nearest home (dense within one branch, so near neighbours connect).
+    const auto pick = uniform() < 0.75 ? 0 : rng_() % static_cast<std::uint64_t>(n);
+    q = solutions.q[static_cast<std::size_t>(pick)];
     return true;
   }
 

@@ -12,10 +12,10 @@ namespace hila::offline {
 
 struct RoadmapSettings {
   int nodes = 3000;     // milestones
-  int neighbours = 10;  // PRM's k nearest neighbours tried per milestone
+  int neighbours = 15;  // PRM's k nearest neighbours tried per milestone
   // Share of samples drawn in the slip-constrained region: gripper poses whose opening axis lies
   // within `vertical_cone_deg` of vertical (by analytic IK), the rest uniform in joint space.
-  double slip_bias = 0.5;
+  double slip_bias = 0.8;
   double vertical_cone_deg = 10.0;
   // Edges are checked (collision) and annotated (inclination) at most this far apart in joint
   // space (rad, Euclidean over the six joints).
