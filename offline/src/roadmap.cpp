@@ -10,6 +10,7 @@
 #include <ompl/geometric/planners/prm/PRM.h>
 #include <ompl/util/Console.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -184,6 +185,37 @@ std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen:
   const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
   std::vector<Eigen::VectorXd> out;
   for (int i = 1; i < steps; ++i) out.push_back(a + (b - a) * (static_cast<double>(i) / steps));
+  return out;
+}
+
+std::vector<int> attach_configuration(const core::Cell& cell, const Roadmap& roadmap,
+                                      const GraspSlip& grasp, const Eigen::VectorXd& q, int k) {
+  const core::Arm& arm = cell.arm(roadmap.arm);
+  int arm_index = 0;
+  while (&cell.arms()[static_cast<std::size_t>(arm_index)] != &arm) ++arm_index;
+  ArmChecker checker(cell, arm, arm_index);
+  const Eigen::Vector3d normal = grasp.axis.cross(grasp.lever);
+  const double limit = std::sin(core::deg_to_rad(std::min(grasp.theta_c_deg, 90.0))) + 1e-12;
+  auto ok = [&](const Eigen::VectorXd& x) {
+    return checker.valid(x) && std::abs(gravity_in_tcp(cell, arm, x).dot(normal)) <= limit;
+  };
+  std::vector<int> out;
+  if (!ok(q)) return out;
+  std::vector<std::pair<double, int>> near;
+  for (std::size_t i = 0; i < roadmap.nodes.size(); ++i) {
+    near.emplace_back((roadmap.nodes[i] - q).norm(), static_cast<int>(i));
+  }
+  const auto take = std::min<std::size_t>(near.size(), static_cast<std::size_t>(k));
+  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(take), near.end());
+  for (std::size_t j = 0; j < take; ++j) {
+    const auto& node = roadmap.nodes[static_cast<std::size_t>(near[j].second)];
+    bool free = ok(node);
+    for (const auto& x : edge_samples(q, node, roadmap.resolution)) {
+      if (!free) break;
+      free = ok(x);
+    }
+    if (free) out.push_back(near[j].second);
+  }
   return out;
 }
 

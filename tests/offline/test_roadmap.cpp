@@ -190,3 +190,28 @@ TEST(Roadmap, ComponentsAgreeWithBreadthFirstSearch) {
   EXPECT_EQ(ids, bfs);
   EXPECT_GT(next, 1);  // a tight limit cuts the roadmap
 }
+
+TEST(Roadmap, AttachingAConfigurationRespectsTheSlipLimit) {
+  const auto& map = small_roadmap();
+  const auto cell = test::reference_cell();
+  const offline::GraspSlip loose{Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 90.0};
+  // A node attaches to itself (a zero-length edge) and to some neighbours.
+  const auto self = offline::attach_configuration(*cell, map, loose, map.nodes[0], 10);
+  ASSERT_FALSE(self.empty());
+  EXPECT_EQ(self.front(), 0);
+  // Under a 1-degree limit, a node that violates it attaches to nothing; every attachment of a
+  // node within it is a node within it.
+  const offline::GraspSlip tight{Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 1.0};
+  const Eigen::Vector3d normal = tight.axis.cross(tight.lever);
+  int checked = 0;
+  for (std::size_t i = 0; i < map.nodes.size() && checked < 8; ++i, ++checked) {
+    const bool within =
+        std::abs(map.node_gravity[i].dot(normal)) <= std::sin(core::deg_to_rad(1.0));
+    const auto attached = offline::attach_configuration(*cell, map, tight, map.nodes[i], 10);
+    if (!within) EXPECT_TRUE(attached.empty()) << i;
+    for (const int n : attached) {
+      EXPECT_LE(std::abs(map.node_gravity[static_cast<std::size_t>(n)].dot(normal)),
+                std::sin(core::deg_to_rad(1.0)) + 1e-12);
+    }
+  }
+}

@@ -63,6 +63,12 @@ std::vector<bool> slip_filter(const Roadmap& roadmap, const GraspSlip& grasp);
 // the lowest node of each component).
 std::vector<int> connected_components(const Roadmap& roadmap, const std::vector<bool>& edges);
 
+// Roadmap nodes among the `k` nearest (joint space) that a straight edge from `q` reaches
+// collision-free against the static cell and within the grasp's slip limit at the roadmap's
+// resolution; `q` itself must satisfy both, else none. (The held part is not checked yet.)
+std::vector<int> attach_configuration(const core::Cell& cell, const Roadmap& roadmap,
+                                      const GraspSlip& grasp, const Eigen::VectorXd& q, int k);
+
 // The interior samples of the straight joint-space segment a -> b at `resolution` (what the
 // roadmap checks and annotates): ceil(|b - a| / resolution) - 1 points, evenly spaced.
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
