@@ -208,7 +208,9 @@ TEST(Roadmap, AttachingAConfigurationRespectsTheSlipLimit) {
     const bool within =
         std::abs(map.node_gravity[i].dot(normal)) <= std::sin(core::deg_to_rad(1.0));
     const auto attached = offline::attach_configuration(*cell, map, tight, map.nodes[i], 10);
-    if (!within) EXPECT_TRUE(attached.empty()) << i;
+    if (!within) {
+      EXPECT_TRUE(attached.empty()) << i;
+    }
     for (const int n : attached) {
       EXPECT_LE(std::abs(map.node_gravity[static_cast<std::size_t>(n)].dot(normal)),
                 std::sin(core::deg_to_rad(1.0)) + 1e-12);
