@@ -349,11 +349,17 @@ CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options) {
   return scene;
 }
 
-void set_cell_state(const Cell& cell, const CellScene& scene, CollisionData& data,
-                    const Eigen::VectorXd& robot_q, const Eigen::VectorXd& human_q) {
-  std::vector<Pose> poses;
+void set_robot_state(const Cell& cell, const CellScene& scene, CollisionData& data,
+                     const Eigen::VectorXd& robot_q) {
+  thread_local std::vector<Pose> poses;
   cell.robot().link_poses(robot_q, poses);
   set_robot_pose(data, scene.robot, poses);
+}
+
+void set_cell_state(const Cell& cell, const CellScene& scene, CollisionData& data,
+                    const Eigen::VectorXd& robot_q, const Eigen::VectorXd& human_q) {
+  set_robot_state(cell, scene, data, robot_q);
+  std::vector<Pose> poses;
   cell.human().link_poses(human_q, poses);
   set_robot_pose(data, scene.human, poses, cell.spec().human_stance);
 }

@@ -64,21 +64,19 @@ StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
 
   std::vector<Pose> poses;
   tool.link_poses(tool.neutral_configuration(), poses);
-  const Pose handle_to_cup =
-      poses[static_cast<std::size_t>(tool.link_index(cell.spec().suction.handle_link))].inverse() *
-      poses[static_cast<std::size_t>(tool.link_index(cell.spec().suction.cup_link))];
-  scene.cup_in_tcp = cell.spec().suction.handle_in_tcp * handle_to_cup;
+  const Pose handle_inv =
+      poses[static_cast<std::size_t>(tool.link_index(cell.spec().suction.handle_link))].inverse();
+  for (const Pose& p : poses) scene.tool_links_in_handle.push_back(handle_inv * p);
+  scene.cup_in_tcp =
+      cell.spec().suction.handle_in_tcp * scene.tool_links_in_handle[static_cast<std::size_t>(
+                                              tool.link_index(cell.spec().suction.cup_link))];
   return scene;
 }
 
 void set_tool_held(const Cell& cell, const StageScene& scene, CollisionData& data,
                    const Pose& tcp) {
-  const RobotModel& tool = cell.suction_tool();
-  std::vector<Pose> poses;
-  tool.link_poses(tool.neutral_configuration(), poses);
-  const Pose root_in_handle =
-      poses[static_cast<std::size_t>(tool.link_index(cell.spec().suction.handle_link))].inverse();
-  set_robot_pose(data, scene.tool, poses, tcp * cell.spec().suction.handle_in_tcp * root_in_handle);
+  set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                 tcp * cell.spec().suction.handle_in_tcp);
 }
 
 }  // namespace hila::core

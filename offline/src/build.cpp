@@ -230,8 +230,8 @@ std::string settings_hash(const BuildSettings& s) {
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
-       << ' ' << e.bent_forward_deg << ' ' << e.candidates_per_step << ' ' << e.ik_attempts
-       << "\nbodies " << format_human_bodies(s.human_bodies) << '\n';
+       << ' ' << e.candidates_per_step << ' ' << e.ik_attempts << "\nbodies "
+       << format_human_bodies(s.human_bodies) << '\n';
   return db::sha256_hex(text.str());
 }
 
@@ -299,7 +299,10 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     ErgonomicsInputs in;
     in.target = r.record.target;
     in.initial = r.record.initial;
-    if (!r.placements.empty()) in.table_placement = r.placements.front().part_in_plane;
+    if (!r.placements.empty()) {
+      in.has_placement = true;
+      in.table_placement = r.placements.front().part_in_plane;
+    }
     in.human_grasps = &r.human;
     for (const auto& c : r.handover.candidates) {
       if (c.rank == 0) {

@@ -161,10 +161,12 @@ std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
                                         in.goal_arm, settings);
     out.push_back(record("hila", in.goal, p));
   }
-  const core::Pose table = table_drop_pose(cell, in.table_placement, settings);
-  out.push_back(
-      record("table", table,
-             receiving_posture(cell, comfort, stance, table, grasps, usable, -1, settings)));
+  if (in.has_placement) {
+    const core::Pose table = table_drop_pose(cell, in.table_placement, settings);
+    out.push_back(
+        record("table", table,
+               receiving_posture(cell, comfort, stance, table, grasps, usable, -1, settings)));
+  }
   // Alone, the human steps sideways to face the stack.
   core::Pose at_stack = stance;
   at_stack.translation().y() = in.initial.translation().y();

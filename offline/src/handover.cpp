@@ -18,6 +18,8 @@ namespace hila::offline {
 namespace {
 
 const core::Pose kParked = core::Pose(Eigen::Translation3d(100.0, 100.0, 100.0));
+// The human's fingers open this much wider than the grasp's aperture around the board.
+constexpr double kHandOpeningMargin = 0.01;
 const Eigen::Vector3d kDown(0.0, 0.0, -1.0);
 
 double uniform01(std::mt19937_64& rng) {
@@ -188,6 +190,13 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   core::CollisionData data(scene.cell.model);
   const core::Arm& suction_arm = cell.arms()[static_cast<std::size_t>(scene.suction_arm)];
   const core::Arm& receiving_arm = cell.arm(settings.receiving_arm);
+  for (const core::Arm* a : {&suction_arm, &receiving_arm}) {
+    if (!a->ur_ik) {
+      throw core::InputError(cell.spec().file, "robot.arms." + a->spec.name + ".kinematics",
+                             "UR DH parameters (handover goals search the arms' analytic IK)",
+                             "none");
+    }
+  }
   int receiving_index = 0;
   while (&cell.arms()[static_cast<std::size_t>(receiving_index)] != &receiving_arm)
     ++receiving_index;
@@ -225,7 +234,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   }
   auto human_hand_clear = [&](const core::Pose& board, int hand_slot, int grasp) {
     const auto& g = grasps.human[static_cast<std::size_t>(grasp)];
-    place_hand(screen_data, screen_hands[hand_slot], board * g.hand, g.aperture + 0.01);
+    place_hand(screen_data, screen_hands[hand_slot], board * g.hand,
+               g.aperture + kHandOpeningMargin);
     const bool clear = !core::in_collision(screen, screen_data, screen_hands[hand_slot].all());
     return clear;
   };
@@ -272,8 +282,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         if ((g0.hand.translation() - g1.hand.translation()).norm() < settings.two_hand_separation) {
           continue;
         }
-        place_hand(screen_data, screen_hands[0], board * g0.hand, g0.aperture + 0.01);
-        place_hand(screen_data, screen_hands[1], board * g1.hand, g1.aperture + 0.01);
+        place_hand(screen_data, screen_hands[0], board * g0.hand, g0.aperture + kHandOpeningMargin);
+        place_hand(screen_data, screen_hands[1], board * g1.hand, g1.aperture + kHandOpeningMargin);
         if (core::in_collision(screen, screen_data, screen_hands[0].all())) continue;
         best.default_quality = std::max(best.default_quality, q0);
         if (q > best.quality) {
@@ -393,7 +403,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                  std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + jaw_margin));
     for (int s = 0; s < n; ++s) {
       cell.set_arm(robot_q, receiving_arm, ik.q[static_cast<std::size_t>(s)]);
-      core::set_cell_state(cell, scene.cell, data, robot_q, human_q);
+      core::set_robot_state(cell, scene.cell, data, robot_q);
       if (!core::in_collision(scene.cell.model, data, bodies)) {
         out.grasp = g;
         out.joints = ik.q[static_cast<std::size_t>(s)];
@@ -470,7 +480,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     Eigen::VectorXd suction_q;
     for (int k = 0; k < n && !held; ++k) {
       cell.set_arm(robot_q, suction_arm, ik.q[static_cast<std::size_t>(k)]);
-      core::set_cell_state(cell, scene.cell, data, robot_q, human_q);
+      core::set_robot_state(cell, scene.cell, data, robot_q);
       if (!core::in_collision(scene.cell.model, data, suction_bodies)) {
         held = true;
         suction_q = ik.q[static_cast<std::size_t>(k)];
@@ -547,10 +557,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
       data.set_body_pose(scene.board, c.board);
       const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
-      place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + 0.01);
+      place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
       if (h.second_grasp >= 0) {
         const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-        place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + 0.01);
+        place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
       }
       int shared = 0;
       for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {

@@ -57,7 +57,7 @@ class ArmChecker {
   bool valid(const Eigen::VectorXd& arm_q) {
     if (!arm_.chain.within_limits(arm_q, 1e-12)) return false;
     cell_.set_arm(q_, arm_, arm_q);
-    core::set_cell_state(cell_, scene_, data_, q_, human_q_);
+    core::set_robot_state(cell_, scene_, data_, q_);
     return !core::in_collision(scene_.model, data_, bodies_);
   }
 
@@ -194,10 +194,11 @@ std::vector<int> attach_configuration(const core::Cell& cell, const Roadmap& roa
   int arm_index = 0;
   while (&cell.arms()[static_cast<std::size_t>(arm_index)] != &arm) ++arm_index;
   ArmChecker checker(cell, arm, arm_index);
+  const Eigen::Matrix3d base_rotation = core::arm_base_in_world(cell, arm).linear();
   const Eigen::Vector3d normal = grasp.axis.cross(grasp.lever);
   const double limit = std::sin(core::deg_to_rad(std::min(grasp.theta_c_deg, 90.0))) + 1e-12;
   auto ok = [&](const Eigen::VectorXd& x) {
-    return checker.valid(x) && std::abs(gravity_in_tcp(cell, arm, x).dot(normal)) <= limit;
+    return checker.valid(x) && std::abs(gravity_in_tcp(arm, base_rotation, x).dot(normal)) <= limit;
   };
   std::vector<int> out;
   if (!ok(q)) return out;
@@ -265,9 +266,9 @@ std::vector<int> connected_components(const Roadmap& roadmap, const std::vector<
   return id;
 }
 
-Eigen::Vector3d gravity_in_tcp(const core::Cell& cell, const core::Arm& arm,
+Eigen::Vector3d gravity_in_tcp(const core::Arm& arm, const Eigen::Matrix3d& base_rotation,
                                const Eigen::VectorXd& q) {
-  const Eigen::Matrix3d r = core::arm_base_in_world(cell, arm).linear() * arm.chain.fk(q).linear();
+  const Eigen::Matrix3d r = base_rotation * arm.chain.fk(q).linear();
   return r.transpose() * Eigen::Vector3d(0.0, 0.0, -1.0);
 }
 
@@ -284,6 +285,7 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
   int arm_index = 0;
   while (&cell.arms()[static_cast<std::size_t>(arm_index)] != &arm) ++arm_index;
   const int dof = arm.chain.dof();
+  const Eigen::Matrix3d base_rotation = core::arm_base_in_world(cell, arm).linear();
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 
   auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
@@ -318,7 +320,7 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
   const Eigen::Vector3d opening = cell.spec().gripper.opening_axis.normalized();
   for (unsigned v = 0; v < data.numVertices(); ++v) {
     map.nodes.push_back(to_vector(data.getVertex(v).getState(), dof));
-    map.node_gravity.push_back(gravity_in_tcp(cell, arm, map.nodes.back()));
+    map.node_gravity.push_back(gravity_in_tcp(arm, base_rotation, map.nodes.back()));
     map.node_inclination_deg.push_back(
         core::axis_inclination_deg(opening, map.node_gravity.back()));
   }
@@ -343,7 +345,7 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
           free = false;
           break;
         }
-        gravity.push_back(gravity_in_tcp(cell, arm, q));
+        gravity.push_back(gravity_in_tcp(arm, base_rotation, q));
         worst = std::max(worst, core::axis_inclination_deg(opening, gravity.back()));
       }
       if (!free) continue;

@@ -276,3 +276,25 @@ TEST(Handover, NoRobotRobotPoseFailsWithAReason) {
       << r.stage.failure;
   for (const auto& c : r.candidates) EXPECT_NE(c.status, "goal");
 }
+
+TEST(Handover, ACellWithoutAnalyticIkIsAClearError) {
+  // The same cell without the arms' UR kinematics: handover goals need the analytic IK.
+  const std::string dir = test::temp_dir("handover_no_ik");
+  std::string text = test::read_file(test::cell_path());
+  for (auto at = text.find("      kinematics: {"); at != std::string::npos;
+       at = text.find("      kinematics: {")) {
+    text.erase(at, text.find('\n', at) - at + 1);
+  }
+  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
+    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
+  }
+  const auto cell = core::Cell::load(test::write_file(dir, "cell.yaml", text));
+  offline::HandoverSettings settings;
+  settings.candidates = 10;
+  settings.max_candidates = 10;
+  test::expect_input_error(
+      [&] {
+        offline::plan_handover_goals(*cell, product(), 0, board_grasps(0), comfort(), settings);
+      },
+      {"cell.yaml", "kinematics", "UR DH parameters"});
+}

@@ -115,7 +115,7 @@ nlohmann::json ergonomics_json(const db::Database& database) {
 }
 
 std::string cell_text(const nlohmann::json& m) {
-  if (m.is_null()) return "no goal";
+  if (m.is_null()) return "-";  // not evaluated (no goal, no placement)
   if (!m["reachable"].get<bool>()) return "unreachable";
   std::ostringstream s;
   s << std::fixed << std::setprecision(0) << m["torso_flexion_deg"].get<double>() << "/"

@@ -173,6 +173,10 @@ CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options = {
 // intersects an obstacle (the table) or the robot at home: a stance inside the table.
 void check_human_stance(const Cell& cell);
 
+// Poses the robot's bodies only (the human unchanged): what a robot motion check needs.
+void set_robot_state(const Cell& cell, const CellScene& scene, CollisionData& data,
+                     const Eigen::VectorXd& robot_q);
+
 // Poses every robot and human body for the given configurations.
 void set_cell_state(const Cell& cell, const CellScene& scene, CollisionData& data,
                     const Eigen::VectorXd& robot_q, const Eigen::VectorXd& human_q);

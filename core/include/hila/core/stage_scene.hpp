@@ -28,6 +28,8 @@ struct StageScene {
   std::vector<int> tool_bodies;        // their bodies
   int suction_arm = -1;                // index into Cell::arms()
   Pose cup_in_tcp = Pose::Identity();  // the cup face in the suction arm's TCP while held
+  // The tool is rigid: its link poses relative to the handle, computed once.
+  std::vector<Pose> tool_links_in_handle;
 };
 
 StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,

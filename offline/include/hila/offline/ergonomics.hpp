@@ -14,9 +14,8 @@ struct ErgonomicsSettings {
   // of the human, beside the assembly, longest side across the human (world, m).
   double table_spot_x = 0.68;
   double table_spot_y = 0.55;
-  double flexion_step_deg = 5.0;   // torso flexion searched in these steps up to its limit
-  double bent_forward_deg = 20.0;  // EAWS (the paper's Table 2): bent forward from 20 degrees
-  int candidates_per_step = 3;     // best map-scored grasps confirmed by direct IK per step
+  double flexion_step_deg = 5.0;  // torso flexion searched in these steps up to its limit
+  int candidates_per_step = 3;    // best map-scored grasps confirmed by direct IK per step
   int ik_attempts = 12;
   std::uint64_t seed = 5;
 };
@@ -43,9 +42,12 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
                           const ErgonomicsSettings& settings);
 
 struct ErgonomicsInputs {
-  core::Pose target = core::Pose::Identity();           // world
-  core::Pose initial = core::Pose::Identity();          // on the stack, world
-  core::Pose table_placement = core::Pose::Identity();  // part in plane (z up), most stable
+  core::Pose target = core::Pose::Identity();   // world
+  core::Pose initial = core::Pose::Identity();  // on the stack, world
+  // The part's most stable placement (part in plane, z up); without one no table drop is
+  // evaluated (no "table" record).
+  bool has_placement = false;
+  core::Pose table_placement = core::Pose::Identity();
   const std::vector<db::HumanGraspRecord>* human_grasps = nullptr;
   // The first handover goal, if any: board pose, arm index and grasp index.
   bool has_goal = false;
@@ -54,7 +56,8 @@ struct ErgonomicsInputs {
   int goal_grasp = -1;
 };
 
-// The three ways of getting one board to the human (records in the order hila, table, alone):
+// The three ways of getting one board to the human (records in the order hila, table, alone;
+// "hila" only with a goal, "table" only with a placement):
 // hila's first goal with its human grasp; the board laid flat at the table spot; the human alone
 // stepping sideways to face the stack and taking the board from it. Board-specific inputs only;
 // part_id is left unset.

@@ -14,7 +14,7 @@ namespace hila::offline {
 
 struct HandoverSettings {
   // Eq. 1: candidates around the target pose.
-  int candidates = 500;            // poses satisfying Eq. 1 per batch (the first batch always)
+  int candidates = 500;  // poses satisfying Eq. 1 per batch (the first batch always)
   // Boards with fewer goals than min_goals get further batches, up to max_candidates.
   int min_goals = 5;
   int max_candidates = 3000;

@@ -74,8 +74,9 @@ std::vector<int> attach_configuration(const core::Cell& cell, const Roadmap& roa
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
                                           double resolution);
 
-// Gravity's direction in the TCP frame for arm joints q (world gravity -z).
-Eigen::Vector3d gravity_in_tcp(const core::Cell& cell, const core::Arm& arm,
+// Gravity's direction in the TCP frame for arm joints q (world gravity -z), the arm's base
+// rotated by `base_rotation` in the world (core::arm_base_in_world, computed once by callers).
+Eigen::Vector3d gravity_in_tcp(const core::Arm& arm, const Eigen::Matrix3d& base_rotation,
                                const Eigen::VectorXd& q);
 
 }  // namespace hila::offline
