@@ -208,6 +208,217 @@ std::vector<ComfortMapRecord> load_comfort_maps(detail::Connection& connection,
   return maps;
 }
 
+// A damaged version 4 row: DatabaseError "FILE: TABLE.COLUMN (ROW): expected X, got Y; FIX".
+class RowCheck {
+ public:
+  RowCheck(std::string path, std::string table, std::string fix)
+      : path_(std::move(path)), table_(std::move(table)), fix_(std::move(fix)) {}
+
+  void set_row(std::string row) { row_ = std::move(row); }
+
+  [[noreturn]] void fail(const std::string& column, const std::string& expected,
+                         const std::string& got) const {
+    throw DatabaseError(path_, table_ + "." + column + " (" + row_ + ")", expected, got, fix_);
+  }
+
+  // A count column: 0 <= value <= 2^31 - 1 (at least `minimum`).
+  int count(const std::string& column, std::int64_t value, int minimum = 0) const {
+    if (value < minimum || value > std::numeric_limits<int>::max()) {
+      fail(column, "an integer from " + std::to_string(minimum) + " to 2147483647",
+           std::to_string(value));
+    }
+    return static_cast<int>(value);
+  }
+
+  // A BLOB `decode` accepts for `count` elements of `element_bytes` bytes each ("N WHAT as
+  // little-endian TYPE (B bytes each) = T bytes").
+  template <typename Decode>
+  void blob(const std::string& column, const std::string& bytes, std::int64_t count,
+            std::int64_t element_bytes, const std::string& what, Decode&& decode) const {
+    if (!decode()) {
+      const std::int64_t total = detail::blob_bytes(count, element_bytes);
+      fail(column,
+           what + " (" + std::to_string(element_bytes) + " bytes each" +
+               (total >= 0 ? ", " + std::to_string(total) + " bytes" : std::string()) + ")",
+           std::to_string(bytes.size()) + " bytes");
+    }
+  }
+
+  // Every value finite; `label(i)` names the one that is not.
+  template <typename Values, typename Label>
+  void finite(const std::string& column, const Values& values, Label&& label) const {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (!finite_value(values[i])) {
+        fail(column, "finite values", "a value that is not finite (" + label(i) + ")");
+      }
+    }
+  }
+
+ private:
+  static bool finite_value(double v) { return std::isfinite(v); }
+  template <typename Derived>
+  static bool finite_value(const Eigen::MatrixBase<Derived>& v) {
+    return v.allFinite();
+  }
+
+  std::string path_;
+  std::string table_;
+  std::string fix_;
+  std::string row_;
+};
+
+std::string nth(const char* what, std::size_t i) {
+  return std::string(what) + " " + std::to_string(i);
+}
+
+// The roadmaps table. Every array's size is checked against the row's counts, and every value
+// (finite numbers, edges joining existing nodes in order) before anything is trusted.
+std::vector<RoadmapRecord> load_roadmaps(detail::Connection& connection, const std::string& path,
+                                         const std::string& fix) {
+  RowCheck check(path, "roadmaps", fix);
+  return load_rows<RoadmapRecord>(
+      connection, "roadmaps",
+      "arm, dof, resolution, node_count, edge_count, node_joints, node_gravity, "
+      "node_inclination_deg, edge_nodes, edge_length, edge_max_inclination_deg",
+      fix, [&](detail::Statement& s, std::int64_t id, RoadmapRecord& r) {
+        r.id = id;
+        r.arm = s.next_text();
+        check.set_row("arm '" + r.arm + "', id " + std::to_string(id));
+        r.dof = check.count("dof", s.next_int64(), 1);
+        r.resolution = s.next_double();
+        if (!(r.resolution > 0.0) || !std::isfinite(r.resolution)) {
+          check.fail("resolution", "a finite value > 0", std::to_string(r.resolution));
+        }
+        const int nodes = check.count("node_count", s.next_int64());
+        const int edges = check.count("edge_count", s.next_int64());
+        const std::string n = std::to_string(nodes);
+        const std::string e = std::to_string(edges);
+
+        const std::string joints = s.next_blob();
+        check.blob("node_joints", joints, nodes, detail::blob_bytes(r.dof, 8),
+                   "node_count * dof = " + n + " * " + std::to_string(r.dof) +
+                       " joint values as little-endian doubles, one node after the other",
+                   [&] { return detail::decode_vectors(joints, nodes, r.dof, r.nodes); });
+        check.finite("node_joints", r.nodes, [](std::size_t i) { return nth("node", i); });
+        const std::string gravity = s.next_blob();
+        check.blob("node_gravity", gravity, nodes, 24,
+                   "node_count = " + n + " directions as little-endian doubles x, y, z",
+                   [&] { return detail::decode_vectors(gravity, nodes, r.node_gravity); });
+        check.finite("node_gravity", r.node_gravity, [](std::size_t i) { return nth("node", i); });
+        const std::string inclination = s.next_blob();
+        check.blob("node_inclination_deg", inclination, nodes, 8,
+                   "node_count = " + n + " little-endian doubles", [&] {
+                     return detail::decode_double_list(inclination, nodes, r.node_inclination_deg);
+                   });
+        check.finite("node_inclination_deg", r.node_inclination_deg,
+                     [](std::size_t i) { return nth("node", i); });
+
+        const std::string pairs = s.next_blob();
+        check.blob("edge_nodes", pairs, edges, 8,
+                   "edge_count = " + e + " node pairs as little-endian int32s",
+                   [&] { return detail::decode_int32_pairs(pairs, edges, r.edges); });
+        for (std::size_t k = 0; k < r.edges.size(); ++k) {
+          const auto [first, second] = r.edges[k];
+          if (first < 0 || first >= second || second >= nodes) {
+            check.fail("edge_nodes", "node pairs with 0 <= first < second < node_count = " + n,
+                       "edge " + std::to_string(k) + " = (" + std::to_string(first) + ", " +
+                           std::to_string(second) + ")");
+          }
+        }
+        const std::string length = s.next_blob();
+        check.blob("edge_length", length, edges, 8, "edge_count = " + e + " little-endian doubles",
+                   [&] { return detail::decode_double_list(length, edges, r.edge_length); });
+        check.finite("edge_length", r.edge_length, [](std::size_t i) { return nth("edge", i); });
+        const std::string max_inclination = s.next_blob();
+        check.blob("edge_max_inclination_deg", max_inclination, edges, 8,
+                   "edge_count = " + e + " little-endian doubles", [&] {
+                     return detail::decode_double_list(max_inclination, edges,
+                                                       r.edge_max_inclination_deg);
+                   });
+        check.finite("edge_max_inclination_deg", r.edge_max_inclination_deg,
+                     [](std::size_t i) { return nth("edge", i); });
+      });
+}
+
+// The roadmap_filters table: the bits and component ids against their roadmap, the counts
+// against the bits and ids.
+std::vector<RoadmapFilterRecord> load_roadmap_filters(detail::Connection& connection,
+                                                      const std::string& path,
+                                                      const std::string& fix,
+                                                      const std::vector<RoadmapRecord>& roadmaps) {
+  RowCheck check(path, "roadmap_filters", fix);
+  std::map<std::int64_t, const RoadmapRecord*> by_id;
+  for (const auto& r : roadmaps) by_id[r.id] = &r;
+  return load_table<RoadmapFilterRecord>(
+      connection, "roadmap_filters",
+      "roadmap_id, grasp_kind, grasp_id, theta_c_deg, valid_edges, components, largest_component, "
+      "edge_bits, node_component",
+      fix, [&](detail::Statement& s, RoadmapFilterRecord& f) {
+        check.set_row("id " + std::to_string(f.id));
+        f.roadmap_id = s.next_int64();
+        f.grasp_kind = s.next_text();
+        f.grasp_id = s.next_int64();
+        f.theta_c_deg = s.next_double();
+        f.valid_edges = check.count("valid_edges", s.next_int64());
+        f.components = check.count("components", s.next_int64());
+        f.largest_component = check.count("largest_component", s.next_int64());
+        const auto roadmap = by_id.find(f.roadmap_id);
+        if (roadmap == by_id.end()) {
+          check.fail("roadmap_id", "the id of a roadmap in this file",
+                     std::to_string(f.roadmap_id));
+        }
+        const RoadmapRecord& r = *roadmap->second;
+        const auto edges = static_cast<std::int64_t>(r.edges.size());
+        const auto nodes = static_cast<std::int64_t>(r.nodes.size());
+        const std::string of_roadmap = " of roadmap id " + std::to_string(r.id);
+        const std::string bits = s.next_blob();
+        if (!detail::decode_bits(bits, edges, f.edges)) {
+          check.fail("edge_bits",
+                     "one bit per edge" + of_roadmap + ": " + std::to_string(edges) + " bits in " +
+                         std::to_string((edges + 7) / 8) + " bytes, the unused high bits 0",
+                     std::to_string(bits.size()) + " bytes" +
+                         (static_cast<std::int64_t>(bits.size()) == (edges + 7) / 8
+                              ? std::string(" with an unused bit set")
+                              : std::string()));
+        }
+        const std::string ids = s.next_blob();
+        check.blob("node_component", ids, nodes, 4,
+                   "one component id per node" + of_roadmap + " (" + std::to_string(nodes) +
+                       ") as little-endian int32s",
+                   [&] { return detail::decode_int32s(ids, nodes, f.component); });
+        std::map<int, int> sizes;
+        for (std::size_t n = 0; n < f.component.size(); ++n) {
+          if (f.component[n] < 0) {
+            check.fail("node_component", "component ids >= 0",
+                       nth("node", n) + ": " + std::to_string(f.component[n]));
+          }
+          ++sizes[f.component[n]];
+        }
+        for (std::size_t e = 0; e < f.edges.size(); ++e) {
+          const auto [a, b] = r.edges[e];
+          if (f.edges[e] && f.component[a] != f.component[b]) {
+            check.fail("node_component", "the same id at both ends of every set edge",
+                       "edge " + std::to_string(e) + " joining components " +
+                           std::to_string(f.component[a]) + " and " +
+                           std::to_string(f.component[b]));
+          }
+        }
+        int largest = 0;
+        for (const auto& entry : sizes) largest = std::max(largest, entry.second);
+        const auto count = [&](const char* column, int got, int want, const std::string& what) {
+          if (got != want)
+            check.fail(column, what + " = " + std::to_string(want), std::to_string(got));
+        };
+        count("valid_edges", f.valid_edges,
+              static_cast<int>(std::count(f.edges.begin(), f.edges.end(), true)),
+              "the set bits of edge_bits");
+        count("components", f.components, static_cast<int>(sizes.size()),
+              "the distinct ids of node_component");
+        count("largest_component", f.largest_component, largest,
+              "the nodes of the largest component");
+      });
+}
+
 template <typename Record>
 std::vector<Record> for_part(const std::vector<Record>& records, std::int64_t part_id) {
   std::vector<Record> selected;
@@ -388,6 +599,45 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.quality = s.next_double();
         r.arm = s.next_text();
       });
+
+  db.roadmaps_ = load_roadmaps(*connection, path, fix);
+  db.roadmap_filters_ = load_roadmap_filters(*connection, path, fix, db.roadmaps_);
+  db.regrasp_nodes_ = load_table<RegraspNodeRecord>(
+      *connection, "regrasp_nodes",
+      "kind, arm, grasp_kind, grasp_id, robot_handover_id, candidate_id, " + pose_columns("board") +
+          ", dof, solution_count, solutions",
+      fix, [&](detail::Statement& s, RegraspNodeRecord& r) {
+        RowCheck check(path, "regrasp_nodes", fix);
+        check.set_row("id " + std::to_string(r.id));
+        r.kind = s.next_text();
+        r.arm = s.next_text();
+        r.grasp_kind = s.next_text();
+        r.grasp_id = s.next_int64();
+        r.robot_handover_id = s.next_int64();  // NULL reads as 0
+        r.candidate_id = s.next_int64();
+        r.board = read_pose(s, path, "regrasp_nodes", "board", r.id, fix);
+        const int dof = check.count("dof", s.next_int64(), 1);
+        const int count = check.count("solution_count", s.next_int64(), 1);
+        const std::string bytes = s.next_blob();
+        check.blob("solutions", bytes, count, detail::blob_bytes(dof, 8),
+                   "solution_count * dof = " + std::to_string(count) + " * " + std::to_string(dof) +
+                       " joint values as little-endian doubles",
+                   [&] { return detail::decode_vectors(bytes, count, dof, r.solutions); });
+        check.finite("solutions", r.solutions, [](std::size_t i) { return nth("solution", i); });
+      });
+  db.regrasp_edges_ = load_table<RegraspEdgeRecord>(
+      *connection, "regrasp_edges",
+      "kind, arm, from_node, to_node, filter_id, connected, cost, path_nodes", fix,
+      [&](detail::Statement& s, RegraspEdgeRecord& r) {
+        r.kind = s.next_text();
+        r.arm = s.next_text();
+        r.from_node = s.next_int64();
+        r.to_node = s.next_int64();
+        r.filter_id = s.next_int64();  // NULL reads as 0
+        r.connected = s.next_int64() != 0;
+        r.cost = s.next_double();
+        r.path_nodes = static_cast<int>(s.next_int64());
+      });
   return db;
 }
 
@@ -466,6 +716,32 @@ std::vector<SharedGraspRecord> Database::shared_grasps(std::int64_t candidate_id
 
 std::vector<ErgonomicsRecord> Database::ergonomics(std::int64_t part_id) const {
   return for_part(ergonomics_, part_id);
+}
+
+const RoadmapRecord* Database::roadmap(const std::string& arm) const {
+  for (const auto& r : roadmaps_) {
+    if (r.arm == arm) return &r;
+  }
+  return nullptr;
+}
+
+std::vector<RoadmapFilterRecord> Database::roadmap_filters(std::int64_t part_id) const {
+  return for_part(roadmap_filters_, part_id);
+}
+
+const RoadmapFilterRecord* Database::roadmap_filter(std::int64_t id) const {
+  const auto it = std::lower_bound(
+      roadmap_filters_.begin(), roadmap_filters_.end(), id,
+      [](const RoadmapFilterRecord& f, std::int64_t value) { return f.id < value; });
+  return it != roadmap_filters_.end() && it->id == id ? &*it : nullptr;
+}
+
+std::vector<RegraspNodeRecord> Database::regrasp_nodes(std::int64_t part_id) const {
+  return for_part(regrasp_nodes_, part_id);
+}
+
+std::vector<RegraspEdgeRecord> Database::regrasp_edges(std::int64_t part_id) const {
+  return for_part(regrasp_edges_, part_id);
 }
 
 }  // namespace hila::db

@@ -7,7 +7,7 @@ namespace hila::db {
 
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 3;
+  return 4;
 }
 
 namespace detail {
@@ -137,11 +137,105 @@ std::string create_tables_v3() {
          kCreateHandoverCandidatesV3 + kCreateSharedGraspsV3 + kCreateErgonomicsV3;
 }
 
+// The roadmap and regrasp-graph tables as schema version 4 defines them, one constant per table
+// (with its indexes). Both the current schema and the 3 -> 4 migration step create them from this
+// text; like the constants above, a later change goes into schema_sql() and leaves these to the
+// step.
+//
+// Arrays are BLOBs, little-endian: roadmaps.node_joints node_count * dof doubles (node-major),
+// node_gravity node_count * 3 doubles (x, y, z), node_inclination_deg, edge_length and
+// edge_max_inclination_deg one double per node or edge, edge_nodes edge_count * 2 int32s (first,
+// second); roadmap_filters.edge_bits ceil(edge_count / 8) bytes (edge e: bit e % 8 of byte e / 8,
+// least significant first; unused bits 0), node_component node_count int32s;
+// regrasp_nodes.solutions solution_count * dof doubles (solution-major). The optional references
+// (regrasp_nodes.robot_handover_id and candidate_id, regrasp_edges.filter_id) are NULL when they
+// do not apply, so they can be foreign keys; the records hold 0 for NULL.
+constexpr const char* kCreateRoadmapsV4 = R"sql(
+CREATE TABLE roadmaps (
+  id INTEGER PRIMARY KEY,
+  arm TEXT UNIQUE NOT NULL,
+  dof INTEGER NOT NULL,
+  resolution REAL NOT NULL,
+  node_count INTEGER NOT NULL,
+  edge_count INTEGER NOT NULL,
+  node_joints BLOB NOT NULL,
+  node_gravity BLOB NOT NULL,
+  node_inclination_deg BLOB NOT NULL,
+  edge_nodes BLOB NOT NULL,
+  edge_length BLOB NOT NULL,
+  edge_max_inclination_deg BLOB NOT NULL
+);
+)sql";
+
+constexpr const char* kCreateRoadmapFiltersV4 = R"sql(
+CREATE TABLE roadmap_filters (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  roadmap_id INTEGER NOT NULL REFERENCES roadmaps(id),
+  grasp_kind TEXT NOT NULL CHECK (grasp_kind IN ('gripper', 'suction')),
+  grasp_id INTEGER NOT NULL,
+  theta_c_deg REAL NOT NULL,
+  valid_edges INTEGER NOT NULL,
+  components INTEGER NOT NULL,
+  largest_component INTEGER NOT NULL,
+  edge_bits BLOB NOT NULL,
+  node_component BLOB NOT NULL,
+  UNIQUE (part_id, roadmap_id, grasp_kind, grasp_id)
+);
+)sql";
+
+constexpr const char* kCreateRegraspNodesV4 = R"sql(
+CREATE TABLE regrasp_nodes (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  kind TEXT NOT NULL CHECK (kind IN ('home', 'pick', 'robot_handover', 'human_handover')),
+  arm TEXT NOT NULL,
+  grasp_kind TEXT NOT NULL CHECK (grasp_kind IN ('', 'gripper', 'suction')),
+  grasp_id INTEGER NOT NULL,
+  robot_handover_id INTEGER REFERENCES robot_handovers(id),
+  candidate_id INTEGER REFERENCES handover_candidates(id),
+  board_x REAL NOT NULL, board_y REAL NOT NULL, board_z REAL NOT NULL,
+  board_qw REAL NOT NULL, board_qx REAL NOT NULL, board_qy REAL NOT NULL, board_qz REAL NOT NULL,
+  dof INTEGER NOT NULL,
+  solution_count INTEGER NOT NULL,
+  solutions BLOB NOT NULL,
+  CHECK ((kind = 'home') = (grasp_kind = '')),
+  CHECK ((grasp_kind = '') = (grasp_id = 0)),
+  CHECK ((kind = 'robot_handover') = (robot_handover_id IS NOT NULL)),
+  CHECK ((kind = 'human_handover') = (candidate_id IS NOT NULL))
+);
+CREATE INDEX regrasp_nodes_part_id ON regrasp_nodes(part_id);
+)sql";
+
+constexpr const char* kCreateRegraspEdgesV4 = R"sql(
+CREATE TABLE regrasp_edges (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  kind TEXT NOT NULL CHECK (kind IN ('transit', 'transfer', 'handover')),
+  arm TEXT NOT NULL,
+  from_node INTEGER NOT NULL REFERENCES regrasp_nodes(id),
+  to_node INTEGER NOT NULL REFERENCES regrasp_nodes(id),
+  filter_id INTEGER REFERENCES roadmap_filters(id),
+  connected INTEGER NOT NULL CHECK (connected IN (0, 1)),
+  cost REAL NOT NULL,
+  path_nodes INTEGER NOT NULL,
+  CHECK ((kind = 'transfer') = (filter_id IS NOT NULL)),
+  CHECK (connected = 1 OR (cost = 0 AND path_nodes = 0))
+);
+CREATE INDEX regrasp_edges_part_id ON regrasp_edges(part_id);
+)sql";
+
+// Every table schema version 4 adds, in schema order.
+std::string create_tables_v4() {
+  return std::string(kCreateRoadmapsV4) + kCreateRoadmapFiltersV4 + kCreateRegraspNodesV4 +
+         kCreateRegraspEdgesV4;
+}
+
 }  // namespace
 
 // Written out in full (not generated) so this file is the readable reference of the schema (the
 // comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
-// kCreate...V3 constants).
+// kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
@@ -222,7 +316,7 @@ CREATE TABLE human_grasps (
 );
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql" + std::string(kCreateComfortMapsV2) +
-                                 create_tables_v3();
+                                 create_tables_v3() + create_tables_v4();
   return sql;
 }
 
@@ -237,6 +331,9 @@ const std::vector<MigrationStep>& migration_steps() {
       // rebuilt) and the meta key human_bodies (empty: the cell's human only).
       {2, create_tables_v3() +
               "INSERT OR IGNORE INTO meta (key, value) VALUES ('human_bodies', '');\n"},
+      // 3 -> 4: roadmaps, roadmap filters and the regrasp graph (new tables, empty in a migrated
+      // file until it is rebuilt; the old tables are unchanged).
+      {3, create_tables_v4()},
   };
   return steps;
 }

@@ -14,7 +14,7 @@ struct TableInfo {
   const char* name;
   int since_version;  // the schema version that added the table
 };
-inline constexpr std::array<TableInfo, 12> kTables = {{{"meta", 1},
+inline constexpr std::array<TableInfo, 16> kTables = {{{"meta", 1},
                                                        {"parts", 1},
                                                        {"placements", 1},
                                                        {"robot_grasps", 1},
@@ -25,7 +25,11 @@ inline constexpr std::array<TableInfo, 12> kTables = {{{"meta", 1},
                                                        {"robot_handovers", 3},
                                                        {"handover_candidates", 3},
                                                        {"shared_grasps", 3},
-                                                       {"ergonomics", 3}}};
+                                                       {"ergonomics", 3},
+                                                       {"roadmaps", 4},
+                                                       {"roadmap_filters", 4},
+                                                       {"regrasp_nodes", 4},
+                                                       {"regrasp_edges", 4}}};
 
 // The meta keys every database carries. Keys added later are optional when reading: the writer
 // always writes human_bodies (since version 3), the reader takes a missing one as "".

@@ -90,6 +90,10 @@ void Statement::bind_blob(const std::string& bytes) {
   }
 }
 
+void Statement::bind_null() {
+  if (sqlite3_bind_null(stmt_, bind_index_++) != SQLITE_OK) fail();
+}
+
 bool Statement::step() {
   read_column_ = 0;
   const int rc = sqlite3_step(stmt_);

@@ -54,6 +54,7 @@ class Statement {
   void bind_next(std::int64_t value);
   void bind_next(const std::string& value);
   void bind_blob(const std::string& bytes);  // a BLOB (bind_next binds a string as TEXT)
+  void bind_null();
 
   // Steps once: true if a row is available. Throws DatabaseError on failure.
   bool step();

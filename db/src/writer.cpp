@@ -1,6 +1,10 @@
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <initializer_list>
+#include <limits>
+#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -65,6 +69,9 @@ class FiniteCheck {
       value(column + "[" + std::to_string(i) + "]", joints[i]);
     }
   }
+  void vector(const std::string& column, const Eigen::Vector3d& v) const {
+    for (int i = 0; i < 3; ++i) value(column + "[" + std::to_string(i) + "]", v[i]);
+  }
 
  private:
   std::string call_;
@@ -75,6 +82,49 @@ class FiniteCheck {
 std::string record_label(std::size_t index, std::size_t count, const std::string& owner) {
   return "record " + std::to_string(index) + " of " + std::to_string(count) + ", " + owner;
 }
+
+// Refuses a record of the version 4 tables before anything of the call is written:
+// std::invalid_argument "DatabaseWriter::CALL: TABLE.COLUMN (RECORD): WHAT".
+[[noreturn]] void refuse(const std::string& call, const std::string& column,
+                         const std::string& record, const std::string& what) {
+  throw std::invalid_argument("DatabaseWriter::" + call + ": " + column + " (" + record +
+                              "): " + what);
+}
+
+std::string quoted(const std::string& text) {
+  return "'" + text + "'";
+}
+
+// "a, b or c" of quoted names.
+std::string one_of(std::initializer_list<const char*> names) {
+  std::string text;
+  std::size_t i = 0;
+  for (const char* name : names) {
+    if (i) text += i + 1 == names.size() ? " or " : ", ";
+    text += quoted(name);
+    ++i;
+  }
+  return text;
+}
+
+bool is_one_of(const std::string& value, std::initializer_list<const char*> names) {
+  return std::any_of(names.begin(), names.end(), [&](const char* name) { return value == name; });
+}
+
+// An optional reference of the version 4 tables: 0 in the record, NULL in the row.
+void bind_reference(detail::Statement& statement, std::int64_t id) {
+  if (id == 0) {
+    statement.bind_null();
+  } else {
+    statement.bind_next(id);
+  }
+}
+
+// What add_roadmap_filters needs to know of a roadmap this writer wrote.
+struct RoadmapShape {
+  std::size_t node_count = 0;
+  std::vector<std::pair<int, int>> edges;
+};
 
 // "INSERT INTO table (a, b) VALUES (?, ?)" for a comma-separated column list.
 std::string insert_sql(const std::string& table, const std::string& columns) {
@@ -94,7 +144,9 @@ struct DatabaseWriter::Impl {
   // Prepared once, reused for every row; destroyed before the connection closes.
   std::optional<detail::Statement> insert_meta, insert_part, insert_placement, insert_robot,
       insert_suction, insert_human, insert_comfort, insert_stage, insert_robot_handover,
-      insert_candidate, insert_shared, insert_ergonomics;
+      insert_candidate, insert_shared, insert_ergonomics, insert_roadmap, insert_filter,
+      insert_regrasp_node, insert_regrasp_edge, select_robot_grasp, select_suction_grasp;
+  std::map<std::int64_t, RoadmapShape> roadmaps;  // by id
   bool meta_written = false;
   bool committed = false;
   std::string failure;  // the first error: a writer that failed never commits
@@ -139,6 +191,32 @@ struct DatabaseWriter::Impl {
     insert_candidate.reset();
     insert_shared.reset();
     insert_ergonomics.reset();
+    insert_roadmap.reset();
+    insert_filter.reset();
+    insert_regrasp_node.reset();
+    insert_regrasp_edge.reset();
+    select_robot_grasp.reset();
+    select_suction_grasp.reset();
+  }
+
+  // Requires a written grasp of that kind ("gripper": robot_grasps, "suction": suction_grasps)
+  // with this id. grasp_id has no foreign key (the table depends on the kind), so the writer
+  // checks it: DatabaseError naming `column` and `record` otherwise.
+  void require_grasp(const std::string& column, const std::string& record, const std::string& kind,
+                     std::int64_t id) {
+    const bool gripper = kind == "gripper";
+    detail::Statement& s = gripper ? *select_robot_grasp : *select_suction_grasp;
+    s.set_context(context(column + " (" + record + ")"));
+    s.bind_next(id);
+    const bool found = s.step();
+    s.reset();
+    if (!found) {
+      throw DatabaseError(target, column + " (" + record + ")",
+                          std::string("the id of a written ") +
+                              (gripper ? "robot_grasps" : "suction_grasps") + " row (grasp_kind '" +
+                              kind + "')",
+                          std::to_string(id) + ", which names none");
+    }
   }
 
   std::int64_t last_id() const {
@@ -237,6 +315,34 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
                    "part_id, method, reachable, torso_flexion_deg, shoulder_elevated, reach, "
                    "reorientation_deg, quality, arm"),
         m.context("ergonomics"));
+    m.insert_roadmap.emplace(
+        *m.connection,
+        insert_sql("roadmaps",
+                   "arm, dof, resolution, node_count, edge_count, node_joints, node_gravity, "
+                   "node_inclination_deg, edge_nodes, edge_length, edge_max_inclination_deg"),
+        m.context("roadmaps"));
+    m.insert_filter.emplace(
+        *m.connection,
+        insert_sql("roadmap_filters",
+                   "part_id, roadmap_id, grasp_kind, grasp_id, theta_c_deg, valid_edges, "
+                   "components, largest_component, edge_bits, node_component"),
+        m.context("roadmap_filters"));
+    m.insert_regrasp_node.emplace(
+        *m.connection,
+        insert_sql("regrasp_nodes",
+                   "part_id, kind, arm, grasp_kind, grasp_id, robot_handover_id, candidate_id, " +
+                       pose_columns("board") + ", dof, solution_count, solutions"),
+        m.context("regrasp_nodes"));
+    m.insert_regrasp_edge.emplace(
+        *m.connection,
+        insert_sql("regrasp_edges",
+                   "part_id, kind, arm, from_node, to_node, filter_id, connected, cost, "
+                   "path_nodes"),
+        m.context("regrasp_edges"));
+    m.select_robot_grasp.emplace(*m.connection, "SELECT 1 FROM robot_grasps WHERE id = ?",
+                                 m.context("robot_grasps"));
+    m.select_suction_grasp.emplace(*m.connection, "SELECT 1 FROM suction_grasps WHERE id = ?",
+                                   m.context("suction_grasps"));
   } catch (...) {
     m.finalize_statements();
     m.connection.reset();
@@ -572,6 +678,336 @@ void DatabaseWriter::add_ergonomics(std::int64_t part_id,
       s.bind_next(e.arm);
       s.run();
     }
+  });
+}
+
+std::int64_t DatabaseWriter::add_roadmap(const RoadmapRecord& roadmap) {
+  Impl& m = *impl_;
+  return m.guarded("add_roadmap", [&] {
+    const RoadmapRecord& r = roadmap;
+    const std::string owner = "arm '" + r.arm + "'";
+    const auto bad = [&](const std::string& column, const std::string& what) {
+      refuse("add_roadmap", "roadmaps." + column, owner, what);
+    };
+    if (r.arm.empty()) bad("arm", "RoadmapRecord::arm is empty, expected an arm name");
+    if (r.dof <= 0) {
+      bad("dof", "RoadmapRecord::dof is " + std::to_string(r.dof) + ", expected > 0");
+    }
+    if (!(r.resolution > 0.0) || !std::isfinite(r.resolution)) {
+      bad("resolution", "RoadmapRecord::resolution is " + std::to_string(r.resolution) +
+                            ", expected a finite value > 0 (rad)");
+    }
+    const std::size_t nodes = r.nodes.size();
+    const std::size_t edges = r.edges.size();
+    if (nodes > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+      bad("node_count", std::to_string(nodes) + " nodes, expected at most 2^31 - 1");
+    }
+    const auto one_per = [&](const std::string& column, const std::string& field, std::size_t got,
+                             std::size_t want, const std::string& what) {
+      if (got != want) {
+        bad(column, "RoadmapRecord::" + field + " holds " + std::to_string(got) +
+                        " values, expected one per " + what + " (" + std::to_string(want) + ")");
+      }
+    };
+    one_per("node_gravity", "node_gravity", r.node_gravity.size(), nodes, "node");
+    one_per("node_inclination_deg", "node_inclination_deg", r.node_inclination_deg.size(), nodes,
+            "node");
+    one_per("edge_length", "edge_length", r.edge_length.size(), edges, "edge");
+    one_per("edge_max_inclination_deg", "edge_max_inclination_deg",
+            r.edge_max_inclination_deg.size(), edges, "edge");
+    FiniteCheck check("add_roadmap", "roadmaps");
+    for (std::size_t i = 0; i < nodes; ++i) {
+      if (r.nodes[i].size() != r.dof) {
+        bad("node_joints", "RoadmapRecord::nodes[" + std::to_string(i) + "] has " +
+                               std::to_string(r.nodes[i].size()) +
+                               " joint values, expected dof = " + std::to_string(r.dof));
+      }
+      check.set_record(owner + ", node " + std::to_string(i));
+      check.joints("node_joints", r.nodes[i]);
+      check.vector("node_gravity", r.node_gravity[i]);
+      check.value("node_inclination_deg", r.node_inclination_deg[i]);
+    }
+    for (std::size_t e = 0; e < edges; ++e) {
+      const auto [first, second] = r.edges[e];
+      if (first < 0 || first >= second || static_cast<std::size_t>(second) >= nodes) {
+        bad("edge_nodes", "RoadmapRecord::edges[" + std::to_string(e) + "] is (" +
+                              std::to_string(first) + ", " + std::to_string(second) +
+                              "), expected 0 <= first < second < " + std::to_string(nodes) +
+                              " (the node count)");
+      }
+      check.set_record(owner + ", edge " + std::to_string(e));
+      check.value("edge_length", r.edge_length[e]);
+      check.value("edge_max_inclination_deg", r.edge_max_inclination_deg[e]);
+    }
+
+    detail::Statement& s = *m.insert_roadmap;
+    s.set_context(m.context("roadmaps (" + owner + ")"));
+    s.bind_next(r.arm);
+    s.bind_next(static_cast<std::int64_t>(r.dof));
+    s.bind_next(r.resolution);
+    s.bind_next(static_cast<std::int64_t>(nodes));
+    s.bind_next(static_cast<std::int64_t>(edges));
+    s.bind_blob(detail::encode_vectors(r.nodes));
+    s.bind_blob(detail::encode_vectors(r.node_gravity));
+    s.bind_blob(detail::encode_double_list(r.node_inclination_deg));
+    s.bind_blob(detail::encode_int32_pairs(r.edges));
+    s.bind_blob(detail::encode_double_list(r.edge_length));
+    s.bind_blob(detail::encode_double_list(r.edge_max_inclination_deg));
+    s.run();
+    const std::int64_t id = m.last_id();
+    m.roadmaps[id] = RoadmapShape{nodes, r.edges};
+    return id;
+  });
+}
+
+std::vector<std::int64_t> DatabaseWriter::add_roadmap_filters(
+    const std::vector<RoadmapFilterRecord>& filters) {
+  Impl& m = *impl_;
+  return m.guarded("add_roadmap_filters", [&] {
+    FiniteCheck check("add_roadmap_filters", "roadmap_filters");
+    for (std::size_t i = 0; i < filters.size(); ++i) {
+      const RoadmapFilterRecord& f = filters[i];
+      const std::string record =
+          record_label(i, filters.size(), "part id " + std::to_string(f.part_id));
+      const auto bad = [&](const std::string& column, const std::string& what) {
+        refuse("add_roadmap_filters", "roadmap_filters." + column, record, what);
+      };
+      if (!is_one_of(f.grasp_kind, {"gripper", "suction"})) {
+        bad("grasp_kind", "RoadmapFilterRecord::grasp_kind is " + quoted(f.grasp_kind) +
+                              ", expected " + one_of({"gripper", "suction"}));
+      }
+      check.set_record(record);
+      check.value("theta_c_deg", f.theta_c_deg);
+
+      // The bits and ids against the roadmap (an unknown roadmap fails its foreign key below).
+      const auto shape = m.roadmaps.find(f.roadmap_id);
+      if (shape != m.roadmaps.end()) {
+        const std::string roadmap = "roadmap id " + std::to_string(f.roadmap_id);
+        if (f.edges.size() != shape->second.edges.size()) {
+          bad("edge_bits", "RoadmapFilterRecord::edges holds " + std::to_string(f.edges.size()) +
+                               " bits, expected one per edge of " + roadmap + " (" +
+                               std::to_string(shape->second.edges.size()) + ")");
+        }
+        if (f.component.size() != shape->second.node_count) {
+          bad("node_component", "RoadmapFilterRecord::component holds " +
+                                    std::to_string(f.component.size()) +
+                                    " ids, expected one per node of " + roadmap + " (" +
+                                    std::to_string(shape->second.node_count) + ")");
+        }
+        for (std::size_t e = 0; e < f.edges.size(); ++e) {
+          if (!f.edges[e]) continue;
+          const auto [a, b] = shape->second.edges[e];
+          if (f.component[a] != f.component[b]) {
+            bad("node_component", "edge " + std::to_string(e) + " (nodes " + std::to_string(a) +
+                                      ", " + std::to_string(b) + ") is set but joins components " +
+                                      std::to_string(f.component[a]) + " and " +
+                                      std::to_string(f.component[b]) +
+                                      ", expected the ids of connected nodes to be equal");
+          }
+        }
+      }
+      std::map<int, int> sizes;  // component id -> nodes
+      for (std::size_t n = 0; n < f.component.size(); ++n) {
+        if (f.component[n] < 0) {
+          bad("node_component", "RoadmapFilterRecord::component[" + std::to_string(n) + "] is " +
+                                    std::to_string(f.component[n]) + ", expected an id >= 0");
+        }
+        ++sizes[f.component[n]];
+      }
+      const auto set = static_cast<int>(std::count(f.edges.begin(), f.edges.end(), true));
+      int largest = 0;
+      for (const auto& entry : sizes) largest = std::max(largest, entry.second);
+      const auto count = [&](const std::string& column, int got, int want,
+                             const std::string& what) {
+        if (got != want) {
+          bad(column, "RoadmapFilterRecord::" + column + " is " + std::to_string(got) +
+                          ", expected " + what + " (" + std::to_string(want) + ")");
+        }
+      };
+      count("valid_edges", f.valid_edges, set, "the number of set edges");
+      count("components", f.components, static_cast<int>(sizes.size()),
+            "the number of distinct component ids");
+      count("largest_component", f.largest_component, largest, "the nodes of the largest");
+      m.require_grasp("roadmap_filters.grasp_id", record, f.grasp_kind, f.grasp_id);
+    }
+
+    detail::Statement& s = *m.insert_filter;
+    std::vector<std::int64_t> ids;
+    ids.reserve(filters.size());
+    for (const auto& f : filters) {
+      s.set_context(m.context("roadmap_filters (part id " + std::to_string(f.part_id) +
+                              ", roadmap id " + std::to_string(f.roadmap_id) + ", " + f.grasp_kind +
+                              " grasp id " + std::to_string(f.grasp_id) + ")"));
+      s.bind_next(f.part_id);
+      s.bind_next(f.roadmap_id);
+      s.bind_next(f.grasp_kind);
+      s.bind_next(f.grasp_id);
+      s.bind_next(f.theta_c_deg);
+      s.bind_next(static_cast<std::int64_t>(f.valid_edges));
+      s.bind_next(static_cast<std::int64_t>(f.components));
+      s.bind_next(static_cast<std::int64_t>(f.largest_component));
+      s.bind_blob(detail::encode_bits(f.edges));
+      s.bind_blob(detail::encode_int32s(f.component));
+      s.run();
+      ids.push_back(m.last_id());
+    }
+    return ids;
+  });
+}
+
+std::vector<std::int64_t> DatabaseWriter::add_regrasp_nodes(
+    const std::vector<RegraspNodeRecord>& nodes) {
+  Impl& m = *impl_;
+  return m.guarded("add_regrasp_nodes", [&] {
+    FiniteCheck check("add_regrasp_nodes", "regrasp_nodes");
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const RegraspNodeRecord& n = nodes[i];
+      const std::string record =
+          record_label(i, nodes.size(), "part id " + std::to_string(n.part_id));
+      const auto bad = [&](const std::string& column, const std::string& what) {
+        refuse("add_regrasp_nodes", "regrasp_nodes." + column, record, what);
+      };
+      if (!is_one_of(n.kind, {"home", "pick", "robot_handover", "human_handover"})) {
+        bad("kind", "RegraspNodeRecord::kind is " + quoted(n.kind) + ", expected " +
+                        one_of({"home", "pick", "robot_handover", "human_handover"}));
+      }
+      const std::string of_kind = " for a " + quoted(n.kind) + " node";
+      if (n.arm.empty()) bad("arm", "RegraspNodeRecord::arm is empty, expected an arm name");
+      if (n.kind == "home") {
+        if (!n.grasp_kind.empty()) {
+          bad("grasp_kind", "RegraspNodeRecord::grasp_kind is " + quoted(n.grasp_kind) + of_kind +
+                                ", expected ''");
+        }
+        if (n.grasp_id != 0) {
+          bad("grasp_id", "RegraspNodeRecord::grasp_id is " + std::to_string(n.grasp_id) + of_kind +
+                              ", expected 0");
+        }
+      } else if (!is_one_of(n.grasp_kind, {"gripper", "suction"})) {
+        bad("grasp_kind", "RegraspNodeRecord::grasp_kind is " + quoted(n.grasp_kind) + of_kind +
+                              ", expected " + one_of({"gripper", "suction"}));
+      }
+      const auto reference = [&](const std::string& column, std::int64_t id,
+                                 const std::string& applies_to) {
+        if ((n.kind == applies_to) != (id != 0)) {
+          bad(column,
+              "RegraspNodeRecord::" + column + " is " + std::to_string(id) + of_kind +
+                  (id == 0 ? ", expected the id it refers to"
+                           : ", expected 0 (it applies to " + quoted(applies_to) + " nodes only)"));
+        }
+      };
+      reference("robot_handover_id", n.robot_handover_id, "robot_handover");
+      reference("candidate_id", n.candidate_id, "human_handover");
+      if (n.solutions.empty()) {
+        bad("solutions", "RegraspNodeRecord::solutions is empty, expected at least one");
+      }
+      for (std::size_t j = 0; j < n.solutions.size(); ++j) {
+        if (n.solutions[j].size() == 0 || n.solutions[j].size() != n.solutions[0].size()) {
+          bad("solutions", "RegraspNodeRecord::solutions[" + std::to_string(j) + "] has " +
+                               std::to_string(n.solutions[j].size()) + " joint values, expected " +
+                               (j == 0 ? std::string("at least one")
+                                       : "as many as solutions[0] (" +
+                                             std::to_string(n.solutions[0].size()) + ")"));
+        }
+      }
+      check.set_record(record);
+      check.pose("board", n.board);
+      for (std::size_t j = 0; j < n.solutions.size(); ++j) {
+        check.set_record(record + ", solution " + std::to_string(j));
+        check.joints("solutions", n.solutions[j]);
+      }
+      if (n.kind != "home")
+        m.require_grasp("regrasp_nodes.grasp_id", record, n.grasp_kind, n.grasp_id);
+    }
+
+    detail::Statement& s = *m.insert_regrasp_node;
+    std::vector<std::int64_t> ids;
+    ids.reserve(nodes.size());
+    for (const auto& n : nodes) {
+      s.set_context(m.context("regrasp_nodes (part id " + std::to_string(n.part_id) + ", " +
+                              n.kind + " node of arm '" + n.arm + "')"));
+      s.bind_next(n.part_id);
+      s.bind_next(n.kind);
+      s.bind_next(n.arm);
+      s.bind_next(n.grasp_kind);
+      s.bind_next(n.grasp_id);
+      bind_reference(s, n.robot_handover_id);
+      bind_reference(s, n.candidate_id);
+      bind_pose(s, n.board);
+      s.bind_next(static_cast<std::int64_t>(n.solutions[0].size()));
+      s.bind_next(static_cast<std::int64_t>(n.solutions.size()));
+      s.bind_blob(detail::encode_vectors(n.solutions));
+      s.run();
+      ids.push_back(m.last_id());
+    }
+    return ids;
+  });
+}
+
+std::vector<std::int64_t> DatabaseWriter::add_regrasp_edges(
+    const std::vector<RegraspEdgeRecord>& edges) {
+  Impl& m = *impl_;
+  return m.guarded("add_regrasp_edges", [&] {
+    FiniteCheck check("add_regrasp_edges", "regrasp_edges");
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      const RegraspEdgeRecord& e = edges[i];
+      const std::string record =
+          record_label(i, edges.size(), "part id " + std::to_string(e.part_id));
+      const auto bad = [&](const std::string& column, const std::string& what) {
+        refuse("add_regrasp_edges", "regrasp_edges." + column, record, what);
+      };
+      if (!is_one_of(e.kind, {"transit", "transfer", "handover"})) {
+        bad("kind", "RegraspEdgeRecord::kind is " + quoted(e.kind) + ", expected " +
+                        one_of({"transit", "transfer", "handover"}));
+      }
+      const std::string of_kind = " for a " + quoted(e.kind) + " edge";
+      if (e.arm.empty()) bad("arm", "RegraspEdgeRecord::arm is empty, expected an arm name");
+      if ((e.kind == "transfer") != (e.filter_id != 0)) {
+        bad("filter_id", "RegraspEdgeRecord::filter_id is " + std::to_string(e.filter_id) +
+                             of_kind +
+                             (e.filter_id == 0 ? ", expected the roadmap filter used"
+                                               : ", expected 0 (only 'transfer' edges use one)"));
+      }
+      check.set_record(record);
+      check.value("cost", e.cost);
+      if (e.cost < 0.0) {
+        bad("cost", "RegraspEdgeRecord::cost is " + std::to_string(e.cost) +
+                        ", expected a path length >= 0");
+      }
+      if (e.path_nodes < 0) {
+        bad("path_nodes",
+            "RegraspEdgeRecord::path_nodes is " + std::to_string(e.path_nodes) + ", expected >= 0");
+      }
+      if (!e.connected && (e.cost != 0.0 || e.path_nodes != 0)) {
+        bad(e.cost != 0.0 ? "cost" : "path_nodes",
+            "RegraspEdgeRecord::cost is " + std::to_string(e.cost) + " and path_nodes " +
+                std::to_string(e.path_nodes) + " for an edge that is not connected, expected 0");
+      }
+      if (e.kind == "handover" && e.cost != 0.0) {
+        bad("cost",
+            "RegraspEdgeRecord::cost is " + std::to_string(e.cost) + of_kind + ", expected 0");
+      }
+    }
+
+    detail::Statement& s = *m.insert_regrasp_edge;
+    std::vector<std::int64_t> ids;
+    ids.reserve(edges.size());
+    for (const auto& e : edges) {
+      s.set_context(m.context("regrasp_edges (part id " + std::to_string(e.part_id) + ", " +
+                              e.kind + " edge " + std::to_string(e.from_node) + " -> " +
+                              std::to_string(e.to_node) + ")"));
+      s.bind_next(e.part_id);
+      s.bind_next(e.kind);
+      s.bind_next(e.arm);
+      s.bind_next(e.from_node);
+      s.bind_next(e.to_node);
+      bind_reference(s, e.filter_id);
+      s.bind_next(static_cast<std::int64_t>(e.connected ? 1 : 0));
+      s.bind_next(e.cost);
+      s.bind_next(static_cast<std::int64_t>(e.path_nodes));
+      s.run();
+      ids.push_back(m.last_id());
+    }
+    return ids;
   });
 }
 

@@ -3,13 +3,16 @@
 // Shared fixtures for the hila::db tests: records with awkward values and a helper that writes
 // them, so every test file builds databases the same way.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hila/db/database.hpp"
@@ -30,12 +33,19 @@ struct SamplePart {
   std::vector<HandoverCandidateRecord> handover_candidates;
   std::vector<SharedGraspRecord> shared_grasps;  // of this part's candidates
   std::vector<ErgonomicsRecord> ergonomics;
+  // Schema version 4. The ids in these records (id, roadmap_id, grasp_id, robot_handover_id,
+  // candidate_id, from_node, to_node, filter_id) are likewise the ones write_sample's writer
+  // assigns; part_id is the part's.
+  std::vector<RoadmapFilterRecord> roadmap_filters;
+  std::vector<RegraspNodeRecord> regrasp_nodes;
+  std::vector<RegraspEdgeRecord> regrasp_edges;
 };
 
 struct Sample {
   Meta meta;
   std::vector<SamplePart> parts;
   std::vector<ComfortMapRecord> comfort_maps;
+  std::vector<RoadmapRecord> roadmaps;  // ids 1, 2, ... in order
 };
 
 inline Eigen::Vector3d random_vector(std::mt19937_64& rng, double scale) {
@@ -192,9 +202,218 @@ inline void add_handover_records(Sample& s, std::mt19937_64& rng) {
   }
 }
 
+// Component ids per node over the set edges: 0, 1, ... in order of each component's lowest node
+// (as hila::offline::connected_components numbers them).
+inline std::vector<int> components_of(std::size_t node_count,
+                                      const std::vector<std::pair<int, int>>& edges,
+                                      const std::vector<bool>& bits) {
+  std::vector<int> parent(node_count);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int n) {
+    while (parent[n] != n) n = parent[n] = parent[parent[n]];
+    return n;
+  };
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    if (bits[e]) parent[root(edges[e].second)] = root(edges[e].first);
+  }
+  std::vector<int> component(node_count, -1);
+  std::map<int, int> ids;  // root -> id
+  for (std::size_t n = 0; n < node_count; ++n) {
+    const int r = root(static_cast<int>(n));
+    const auto it = ids.try_emplace(r, static_cast<int>(ids.size())).first;
+    component[n] = it->second;
+  }
+  return component;
+}
+
+// Sets the filter's components from its bits and the counts from both.
+inline void complete_filter(RoadmapFilterRecord& f, const RoadmapRecord& roadmap) {
+  f.component = components_of(roadmap.nodes.size(), roadmap.edges, f.edges);
+  f.valid_edges = static_cast<int>(std::count(f.edges.begin(), f.edges.end(), true));
+  std::map<int, int> sizes;
+  for (int c : f.component) ++sizes[c];
+  f.components = static_cast<int>(sizes.size());
+  f.largest_component = 0;
+  for (const auto& entry : sizes) f.largest_component = std::max(f.largest_component, entry.second);
+}
+
+// A roadmap of `node_count` random configurations and `edge_count` distinct random edges (at most
+// node_count * (node_count - 1) / 2), with awkward values: -0.0 and a subnormal in node 0,
+// inclinations of exactly 0 and 90 degrees.
+inline RoadmapRecord make_roadmap(const std::string& arm, std::uint64_t seed, int dof,
+                                  int node_count, int edge_count) {
+  std::mt19937_64 rng(seed);
+  RoadmapRecord r;
+  r.arm = arm;
+  r.dof = dof;
+  r.resolution = 0.05 + 1e-17;
+  std::uniform_real_distribution<double> angle(0.0, 90.0);
+  for (int n = 0; n < node_count; ++n) {
+    r.nodes.push_back(random_joints(rng, dof));
+    r.node_gravity.push_back(random_vector(rng, 1.0).normalized());
+    r.node_inclination_deg.push_back(n == 1 ? 90.0 : n == 2 ? 0.0 : angle(rng));
+  }
+  if (node_count > 0) {
+    r.nodes[0][1] = -0.0;
+    r.nodes[0][dof - 1] = std::numeric_limits<double>::denorm_min();
+    r.node_gravity[0] = Eigen::Vector3d(-0.0, 0.0, -1.0);
+  }
+  // A random spanning tree first (so the roadmap is connected when edge_count >= node_count - 1),
+  // then other pairs by a partial Fisher-Yates shuffle (the same on every platform).
+  std::vector<std::pair<int, int>> pairs;
+  for (int b = 1; b < node_count; ++b) {
+    r.edges.emplace_back(static_cast<int>(rng() % static_cast<std::uint64_t>(b)), b);
+  }
+  if (static_cast<int>(r.edges.size()) > edge_count)
+    r.edges.resize(static_cast<std::size_t>(edge_count));
+  for (int a = 0; a < node_count; ++a) {
+    for (int b = a + 1; b < node_count; ++b) {
+      if (std::find(r.edges.begin(), r.edges.end(), std::make_pair(a, b)) == r.edges.end()) {
+        pairs.emplace_back(a, b);
+      }
+    }
+  }
+  for (std::size_t e = 0; r.edges.size() < static_cast<std::size_t>(edge_count); ++e) {
+    std::swap(pairs[e], pairs[e + rng() % (pairs.size() - e)]);
+    r.edges.push_back(pairs[e]);
+  }
+  for (const auto& [a, b] : r.edges) {
+    r.edge_length.push_back((r.nodes[b] - r.nodes[a]).norm());
+    r.edge_max_inclination_deg.push_back(
+        std::max(r.node_inclination_deg[a], r.node_inclination_deg[b]) + 1e-13);
+  }
+  return r;
+}
+
+// A filter of `roadmap` with each edge set with probability `share`, its components and counts.
+inline RoadmapFilterRecord make_filter(const RoadmapRecord& roadmap, std::int64_t roadmap_id,
+                                       std::mt19937_64& rng, const std::string& grasp_kind,
+                                       std::int64_t grasp_id, double theta_c_deg, double share) {
+  RoadmapFilterRecord f;
+  f.roadmap_id = roadmap_id;
+  f.grasp_kind = grasp_kind;
+  f.grasp_id = grasp_id;
+  f.theta_c_deg = theta_c_deg;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (std::size_t e = 0; e < roadmap.edges.size(); ++e) f.edges.push_back(u(rng) < share);
+  complete_filter(f, roadmap);
+  return f;
+}
+
+inline std::vector<Eigen::VectorXd> random_solutions(std::mt19937_64& rng, int count, int dof) {
+  std::vector<Eigen::VectorXd> solutions;
+  for (int i = 0; i < count; ++i) solutions.push_back(random_joints(rng, dof));
+  return solutions;
+}
+
+// Roadmaps and the regrasp graph: the left (gripper) arm's roadmap has 11 nodes and 13 edges (bit
+// lists that are not a whole number of bytes), the right (suction) arm's 5 nodes, 7 joints and 8
+// edges (exactly one byte). Part 1 has four filters, seven regrasp nodes of every kind and six
+// edges of every kind (one not connected); part 2 two filters, three nodes and two edges. Written
+// after the handover records (the nodes refer to robot handovers and candidates).
+inline void add_roadmap_records(Sample& s, std::mt19937_64& rng) {
+  s.roadmaps.push_back(make_roadmap("left", rng(), 6, 11, 13));
+  s.roadmaps.push_back(make_roadmap("right", rng(), 7, 5, 8));
+  for (std::size_t i = 0; i < s.roadmaps.size(); ++i) {
+    s.roadmaps[i].id = static_cast<std::int64_t>(i + 1);
+  }
+  const RoadmapRecord& left = s.roadmaps[0];
+  const RoadmapRecord& right = s.roadmaps[1];
+  const int left_dof = left.dof;
+  const int right_dof = right.dof;
+
+  SamplePart& a = s.parts[0];
+  a.roadmap_filters = {make_filter(left, 1, rng, "gripper", 1, 22.0, 0.6),
+                       make_filter(left, 1, rng, "gripper", 3, 90.0, 1.0),
+                       make_filter(right, 2, rng, "suction", 1, 90.0, 0.5),
+                       make_filter(right, 2, rng, "suction", 2, 90.0, 0.0)};
+  SamplePart& b = s.parts[1];
+  b.roadmap_filters = {make_filter(left, 1, rng, "gripper", 6, 11.5, 0.7),
+                       make_filter(left, 1, rng, "gripper", 9, 1e-300, 0.3)};
+  std::int64_t filter_id = 0;
+  for (std::size_t k = 0; k < s.parts.size(); ++k) {
+    for (auto& f : s.parts[k].roadmap_filters) {
+      f.id = ++filter_id;
+      f.part_id = static_cast<std::int64_t>(k + 1);
+    }
+  }
+
+  const auto node = [&](std::int64_t part_id, const std::string& kind, const std::string& arm,
+                        const std::string& grasp_kind, std::int64_t grasp_id,
+                        const core::Pose& board, int solutions, int dof) {
+    RegraspNodeRecord n;
+    n.part_id = part_id;
+    n.kind = kind;
+    n.arm = arm;
+    n.grasp_kind = grasp_kind;
+    n.grasp_id = grasp_id;
+    n.board = board;
+    n.solutions = random_solutions(rng, solutions, dof);
+    return n;
+  };
+  const core::Pose home = core::Pose::Identity();
+  a.regrasp_nodes = {
+      node(1, "home", "left", "", 0, home, 1, left_dof),
+      node(1, "home", "right", "", 0, home, 1, right_dof),
+      node(1, "pick", "left", "gripper", 1, a.part.initial, 3, left_dof),
+      node(1, "pick", "right", "suction", 1, a.part.initial, 2, right_dof),
+      node(1, "robot_handover", "right", "suction", 1, a.robot_handovers[0].board, 1, right_dof),
+      node(1, "robot_handover", "left", "gripper", 3, a.robot_handovers[0].board, 2, left_dof),
+      node(1, "human_handover", "left", "gripper", 1, a.handover_candidates[1].board, 4, left_dof),
+  };
+  a.regrasp_nodes[4].robot_handover_id = a.robot_handovers[0].id;
+  a.regrasp_nodes[5].robot_handover_id = a.robot_handovers[0].id;
+  a.regrasp_nodes[6].candidate_id = a.handover_candidates[1].id;
+  a.regrasp_nodes[2].solutions[1][0] = -0.0;
+  a.regrasp_nodes[2].solutions[2][5] = std::numeric_limits<double>::denorm_min();
+  b.regrasp_nodes = {
+      node(2, "home", "left", "", 0, home, 1, left_dof),
+      node(2, "pick", "left", "gripper", 6, b.part.initial, 2, left_dof),
+      node(2, "human_handover", "left", "gripper", 6, b.handover_candidates[0].board, 1, left_dof),
+  };
+  b.regrasp_nodes[2].candidate_id = b.handover_candidates[0].id;
+  std::int64_t node_id = 0;
+  for (auto& p : s.parts) {
+    for (auto& n : p.regrasp_nodes) n.id = ++node_id;
+  }
+
+  const auto edge = [](std::int64_t part_id, const std::string& kind, const std::string& arm,
+                       std::int64_t from, std::int64_t to, std::int64_t filter, bool connected,
+                       double cost, int path_nodes) {
+    RegraspEdgeRecord e;
+    e.part_id = part_id;
+    e.kind = kind;
+    e.arm = arm;
+    e.from_node = from;
+    e.to_node = to;
+    e.filter_id = filter;
+    e.connected = connected;
+    e.cost = cost;
+    e.path_nodes = path_nodes;
+    return e;
+  };
+  a.regrasp_edges = {
+      edge(1, "transit", "left", 1, 3, 0, true, 1.25, 4),
+      edge(1, "transfer", "left", 3, 7, 1, true, 2.5 + 1e-15, 9),
+      edge(1, "transit", "right", 2, 4, 0, true, 0.75, 2),
+      edge(1, "transfer", "right", 4, 5, 3, false, 0.0, 0),
+      edge(1, "handover", "right", 5, 6, 0, true, 0.0, 0),
+      edge(1, "transfer", "left", 6, 7, 2, true, 1e300, 2147483647),
+  };
+  b.regrasp_edges = {
+      edge(2, "transit", "left", 8, 9, 0, false, 0.0, 0),
+      edge(2, "transfer", "left", 9, 10, 5, true, std::numeric_limits<double>::denorm_min(), 2),
+  };
+  std::int64_t edge_id = 0;
+  for (auto& p : s.parts) {
+    for (auto& e : p.regrasp_edges) e.id = ++edge_id;
+  }
+}
+
 // Two parts with different record counts (part 2 has no suction grasps), values that are
 // negative, tiny, huge, subnormal and infinite, a non-ASCII part name, handover records (see
-// add_handover_records), and two comfort maps.
+// add_handover_records), two comfort maps, and roadmaps with the regrasp graph (see
+// add_roadmap_records).
 inline Sample make_sample(std::uint64_t seed = 7) {
   std::mt19937_64 rng(seed);
   Sample s;
@@ -274,14 +493,16 @@ inline Sample make_sample(std::uint64_t seed = 7) {
   // Two small comfort maps of different shapes (the values' size is what the writer checks).
   s.comfort_maps.push_back(make_comfort_map("right", seed + 1, {4, 3, 2}, 10));
   s.comfort_maps.push_back(make_comfort_map("left", seed + 2, {2, 5, 3}, 7, 0.5));
+  add_roadmap_records(s, rng);
   return s;
 }
 
 // Writes `sample` to `path` through DatabaseWriter and returns the part ids in order: first each
 // part with its placements and grasps, then each part's handover and ergonomics records (so they
-// may refer to grasps of any part), then the comfort maps. The candidate and robot handover ids
-// the shared grasps refer to are translated from the sample's ids to the ones the writer returns
-// (the same unless a test reorders the sample's parts).
+// may refer to grasps of any part), then the comfort maps, the roadmaps and each part's roadmap
+// filters, regrasp nodes and regrasp edges. The candidate, robot handover, roadmap, filter and
+// node ids the records refer to are translated from the sample's ids to the ones the writer
+// returns (the same unless a test reorders the sample's parts); grasp ids are written as given.
 inline std::vector<std::int64_t> write_sample(const std::string& path, const Sample& sample) {
   DatabaseWriter writer(path);
   writer.write_meta(sample.meta);
@@ -324,6 +545,34 @@ inline std::vector<std::int64_t> write_sample(const std::string& path, const Sam
     writer.add_ergonomics(ids[k], p.ergonomics);
   }
   for (const auto& map : sample.comfort_maps) writer.add_comfort_map(map);
+  std::map<std::int64_t, std::int64_t> roadmap_ids;
+  for (const auto& roadmap : sample.roadmaps) roadmap_ids[roadmap.id] = writer.add_roadmap(roadmap);
+  std::map<std::int64_t, std::int64_t> filter_ids;
+  std::map<std::int64_t, std::int64_t> node_ids;
+  for (std::size_t k = 0; k < sample.parts.size(); ++k) {
+    const SamplePart& p = sample.parts[k];
+    std::vector<RoadmapFilterRecord> filters = p.roadmap_filters;
+    for (auto& f : filters) {
+      f.part_id = ids[k];
+      f.roadmap_id = translate(roadmap_ids, f.roadmap_id);
+    }
+    remember(filter_ids, p.roadmap_filters, writer.add_roadmap_filters(filters));
+    std::vector<RegraspNodeRecord> nodes = p.regrasp_nodes;
+    for (auto& n : nodes) {
+      n.part_id = ids[k];
+      n.robot_handover_id = translate(handover_ids, n.robot_handover_id);
+      n.candidate_id = translate(candidate_ids, n.candidate_id);
+    }
+    remember(node_ids, p.regrasp_nodes, writer.add_regrasp_nodes(nodes));
+    std::vector<RegraspEdgeRecord> edges = p.regrasp_edges;
+    for (auto& e : edges) {
+      e.part_id = ids[k];
+      e.from_node = translate(node_ids, e.from_node);
+      e.to_node = translate(node_ids, e.to_node);
+      e.filter_id = translate(filter_ids, e.filter_id);
+    }
+    writer.add_regrasp_edges(edges);
+  }
   writer.commit();
   return ids;
 }

@@ -127,6 +127,54 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
   add("ergonomics order",
       [](Sample& s) { std::swap(s.parts[0].ergonomics[0], s.parts[0].ergonomics[1]); });
   add("ergonomics arm", [](Sample& s) { s.parts[1].ergonomics[1].arm = "left ✋"; });
+  // Schema version 4: roadmaps, their filters and the regrasp graph.
+  add("roadmap node joint ulp", [](Sample& s) {
+    double& q = s.roadmaps[0].nodes[7][3];
+    q = std::nextafter(q, 10.0);
+  });
+  add("roadmap node joint -0.0 to +0.0", [](Sample& s) { s.roadmaps[0].nodes[0][1] = 0.0; });
+  add("roadmap gravity ulp", [](Sample& s) {
+    double& g = s.roadmaps[1].node_gravity[4].z();
+    g = std::nextafter(g, 10.0);
+  });
+  add("roadmap edge max inclination ulp", [](Sample& s) {
+    double& a = s.roadmaps[1].edge_max_inclination_deg[7];
+    a = std::nextafter(a, 0.0);
+  });
+  add("roadmap edge length ulp", [](Sample& s) {
+    double& l = s.roadmaps[0].edge_length[12];
+    l = std::nextafter(l, 0.0);
+  });
+  add("roadmap resolution", [](Sample& s) { s.roadmaps[1].resolution = 0.025; });
+  add("roadmaps swapped", [](Sample& s) { std::swap(s.roadmaps[0].arm, s.roadmaps[1].arm); });
+  add("filter theta_c ulp", [](Sample& s) {
+    double& t = s.parts[1].roadmap_filters[1].theta_c_deg;
+    t = std::nextafter(t, 1.0);
+  });
+  add("filter grasp", [](Sample& s) { s.parts[0].roadmap_filters[0].grasp_id = 2; });
+  add("filter order", [](Sample& s) {
+    auto& filters = s.parts[0].roadmap_filters;
+    std::swap(filters[0], filters[1]);
+  });
+  add("regrasp node solution ulp", [](Sample& s) {
+    double& q = s.parts[0].regrasp_nodes[6].solutions[3][2];
+    q = std::nextafter(q, 10.0);
+  });
+  add("regrasp node solution -0.0 to +0.0",
+      [](Sample& s) { s.parts[0].regrasp_nodes[2].solutions[1][0] = 0.0; });
+  add("regrasp node a solution less",
+      [](Sample& s) { s.parts[0].regrasp_nodes[2].solutions.pop_back(); });
+  add("regrasp node arm", [](Sample& s) { s.parts[1].regrasp_nodes[0].arm = "right"; });
+  add("regrasp edge cost ulp", [](Sample& s) {
+    double& c = s.parts[0].regrasp_edges[1].cost;
+    c = std::nextafter(c, 10.0);
+  });
+  add("regrasp edge path nodes", [](Sample& s) { s.parts[0].regrasp_edges[0].path_nodes += 1; });
+  add("regrasp edge reversed", [](Sample& s) {
+    auto& e = s.parts[0].regrasp_edges[2];
+    std::swap(e.from_node, e.to_node);
+  });
+  add("regrasp edge filter", [](Sample& s) { s.parts[0].regrasp_edges[1].filter_id = 2; });
   for (const auto& [name, sample] : variants) {
     const std::string path = dir + "/variant.db";
     write_sample(path, sample);
@@ -153,6 +201,26 @@ TEST(Digest, OneComfortValueByteChangesIt) {
   EXPECT_NE(content_digest(dir + "/a.db"), content_digest(dir + "/c.db"));
   write_sample(dir + "/d.db", make_sample());
   EXPECT_EQ(content_digest(dir + "/a.db"), content_digest(dir + "/d.db"));
+}
+
+TEST(Digest, OneRoadmapFilterBitChangesIt) {
+  const std::string dir = temp_dir("db_digest_filter_bit");
+  write_sample(dir + "/a.db", make_sample());
+  const std::string reference = content_digest(dir + "/a.db");
+  // Edge 12 of 13 (the last, alone in its byte) and edge 3 (in a full byte), each flipped with
+  // the components and counts that go with it (the writer refuses anything else).
+  for (const std::size_t edge : {std::size_t{12}, std::size_t{3}}) {
+    SCOPED_TRACE(edge);
+    Sample b = make_sample();
+    RoadmapFilterRecord& f = b.parts[0].roadmap_filters[0];
+    ASSERT_EQ(f.edges.size(), 13u);
+    f.edges[edge] = !f.edges[edge];
+    complete_filter(f, b.roadmaps[0]);
+    write_sample(dir + "/b.db", b);
+    EXPECT_NE(content_digest(dir + "/b.db"), reference);
+  }
+  write_sample(dir + "/c.db", make_sample());
+  EXPECT_EQ(content_digest(dir + "/c.db"), reference) << "and the same sample gives the same";
 }
 
 TEST(Digest, IndependentOfTheFileName) {

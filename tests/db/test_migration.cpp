@@ -17,11 +17,16 @@ namespace fs = std::filesystem;
 namespace {
 
 // A "version 0" database: what schema 1 would look like if robot_grasps had no theta_c_deg yet
-// (and, as in schema 1, there were no comfort maps, handover or ergonomics tables).
+// (and, as in schema 1, there were no comfort maps, handover, ergonomics, roadmap or regrasp
+// tables).
 std::string write_v0(const std::string& dir) {
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
   execute_script(path,
+                 "DROP TABLE regrasp_edges;"
+                 "DROP TABLE regrasp_nodes;"
+                 "DROP TABLE roadmap_filters;"
+                 "DROP TABLE roadmaps;"
                  "DROP TABLE comfort_maps;"
                  "DROP TABLE shared_grasps;"
                  "DROP TABLE handover_candidates;"
@@ -152,6 +157,84 @@ CREATE TABLE comfort_maps (
 );
 )sql";
 
+// What schema version 3 added to version 2, exactly as hila (schema 3) wrote it, frozen here like
+// kSchemaV1.
+const char* const kSchemaV3Additions = R"sql(
+CREATE TABLE handover_stages (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL UNIQUE REFERENCES parts(id),
+  finished_parts TEXT NOT NULL,
+  draws INTEGER NOT NULL,
+  candidates INTEGER NOT NULL,
+  comfortable INTEGER NOT NULL,
+  comfortable_default_body INTEGER NOT NULL,
+  goals INTEGER NOT NULL,
+  robot_handovers INTEGER NOT NULL,
+  two_hands INTEGER NOT NULL CHECK (two_hands IN (0, 1)),
+  failure TEXT NOT NULL
+);
+
+CREATE TABLE robot_handovers (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  board_x REAL NOT NULL, board_y REAL NOT NULL, board_z REAL NOT NULL,
+  board_qw REAL NOT NULL, board_qx REAL NOT NULL, board_qy REAL NOT NULL, board_qz REAL NOT NULL,
+  suction_grasp_id INTEGER NOT NULL REFERENCES suction_grasps(id),
+  arm TEXT NOT NULL,
+  joints BLOB NOT NULL
+);
+CREATE INDEX robot_handovers_part_id ON robot_handovers(part_id);
+
+CREATE TABLE handover_candidates (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  sample INTEGER NOT NULL,
+  board_x REAL NOT NULL, board_y REAL NOT NULL, board_z REAL NOT NULL,
+  board_qw REAL NOT NULL, board_qx REAL NOT NULL, board_qy REAL NOT NULL, board_qz REAL NOT NULL,
+  distance REAL NOT NULL,
+  quality REAL NOT NULL,
+  status TEXT NOT NULL CHECK (status IN ('uncomfortable', 'no_shared_grasp', 'goal')),
+  rank INTEGER NOT NULL,
+  human_arm TEXT NOT NULL,
+  human_grasp_id INTEGER NOT NULL,
+  human_quality REAL NOT NULL,
+  second_arm TEXT NOT NULL,
+  second_grasp_id INTEGER NOT NULL,
+  second_quality REAL NOT NULL,
+  human_joints BLOB NOT NULL,
+  second_joints BLOB NOT NULL,
+  CHECK ((status = 'goal' AND rank >= 0) OR (status <> 'goal' AND rank = -1))
+);
+CREATE INDEX handover_candidates_part_id ON handover_candidates(part_id);
+
+CREATE TABLE shared_grasps (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  robot_handover_id INTEGER NOT NULL REFERENCES robot_handovers(id),
+  arm TEXT NOT NULL,
+  joints_rr BLOB NOT NULL,
+  joints_rh BLOB NOT NULL,
+  inclination_rr_deg REAL NOT NULL,
+  inclination_rh_deg REAL NOT NULL
+);
+CREATE INDEX shared_grasps_candidate_id ON shared_grasps(candidate_id);
+
+CREATE TABLE ergonomics (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  method TEXT NOT NULL CHECK (method IN ('hila', 'table', 'alone')),
+  reachable INTEGER NOT NULL CHECK (reachable IN (0, 1)),
+  torso_flexion_deg REAL NOT NULL,
+  shoulder_elevated INTEGER NOT NULL CHECK (shoulder_elevated IN (0, 1)),
+  reach REAL NOT NULL,
+  reorientation_deg REAL NOT NULL,
+  quality REAL NOT NULL,
+  arm TEXT NOT NULL,
+  UNIQUE (part_id, method)
+);
+)sql";
+
 // Meta and one part with a placement and one grasp of each kind, as rows of the version 1 tables
 // (meta without schema_version). Values are exact in binary so the writer would store the same
 // bits.
@@ -192,9 +275,35 @@ INSERT INTO comfort_maps VALUES (1, 'right', 0.25, -0.5, 1.0, 0.03125, 1, 1, 1, 
   return path;
 }
 
+// The comfort map of write_v2 and one record of every version 3 table, as rows. Joint vectors are
+// (0.5, 1.0) = x'000000000000e03f000000000000f03f' and (-2.0) = x'00000000000000c0'.
+const char* const kV3Rows = R"sql(
+INSERT INTO meta (key, value) VALUES ('schema_version', '3'), ('human_bodies', '1.75 male');
+INSERT INTO comfort_maps VALUES (1, 'right', 0.25, -0.5, 1.0, 0.03125, 1, 1, 1, 0, x'', 0,
+  x'789c030000000001', 2000000, -1, 0.375);
+INSERT INTO handover_stages VALUES (1, 1, '', 812, 6, 5, 6, 1, 1, 0, '');
+INSERT INTO robot_handovers VALUES (1, 1, 0.5, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1, 'right',
+  x'000000000000e03f000000000000f03f');
+INSERT INTO handover_candidates VALUES (1, 1, 3, 0.25, 0.5, 1.0, 1.0, 0.0, 0.0, 0.0, 0.125, 0.75,
+  'goal', 0, 'right', 1, 0.875, '', 0, 0.0, x'00000000000000c0', x'');
+INSERT INTO shared_grasps VALUES (1, 1, 1, 1, 'left', x'000000000000e03f000000000000f03f',
+  x'00000000000000c0', 12.5, 45.0);
+INSERT INTO ergonomics VALUES (1, 1, 'hila', 1, 17.25, 0, 0.625, 0.0, 0.5, 'right');
+)sql";
+
+// A version 3 file made by hand: kV1Rows and kV3Rows.
+std::string write_v3(const std::string& dir) {
+  const std::string path = dir + "/v3.db";
+  execute_script(
+      path, std::string(kSchemaV1) + kSchemaV2Additions + kSchemaV3Additions + kV1Rows + kV3Rows);
+  return path;
+}
+
 // The same content written by this hila's DatabaseWriter (no handover or ergonomics records, an
-// empty meta.human_bodies), with the comfort map of write_v2 when `with_comfort_map`.
-void write_reference_content(const std::string& path, bool with_comfort_map) {
+// empty meta.human_bodies), with the comfort map of write_v2 when `with_comfort_map`, and with the
+// version 3 records (and meta.human_bodies) of write_v3 when `with_handover_records`.
+void write_reference_content(const std::string& path, bool with_comfort_map,
+                             bool with_handover_records = false) {
   Meta meta;
   meta.hila_version = "0.1.0";
   meta.product_name = "cabinet";
@@ -253,6 +362,8 @@ void write_reference_content(const std::string& path, bool with_comfort_map) {
   map.seed = 18446744073709551615ull;  // stored as -1
   map.coverage = 0.375;
 
+  if (with_handover_records) meta.human_bodies = "1.75 male";
+
   DatabaseWriter writer(path);
   writer.write_meta(meta);
   const auto id = writer.add_part(part);
@@ -261,6 +372,53 @@ void write_reference_content(const std::string& path, bool with_comfort_map) {
   writer.add_suction_grasps(id, {suction});
   writer.add_human_grasps(id, {human});
   if (with_comfort_map) writer.add_comfort_map(map);
+  if (with_handover_records) {
+    HandoverStageRecord stage;
+    stage.part_id = id;
+    stage.draws = 812;
+    stage.candidates = 6;
+    stage.comfortable = 5;
+    stage.comfortable_default_body = 6;
+    stage.goals = 1;
+    stage.robot_handovers = 1;
+    writer.add_handover_stage(stage);
+    RobotHandoverRecord handover;
+    handover.board.translation() = Eigen::Vector3d(0.5, 0.0, 1.0);
+    handover.suction_grasp_id = 1;
+    handover.arm = "right";
+    handover.joints = Eigen::Vector2d(0.5, 1.0);
+    writer.add_robot_handovers(id, {handover});
+    HandoverCandidateRecord candidate;
+    candidate.sample = 3;
+    candidate.board.translation() = Eigen::Vector3d(0.25, 0.5, 1.0);
+    candidate.distance = 0.125;
+    candidate.quality = 0.75;
+    candidate.status = "goal";
+    candidate.rank = 0;
+    candidate.human_arm = "right";
+    candidate.human_grasp_id = 1;
+    candidate.human_quality = 0.875;
+    candidate.human_joints = Eigen::VectorXd::Constant(1, -2.0);
+    writer.add_handover_candidates(id, {candidate});
+    SharedGraspRecord shared;
+    shared.candidate_id = 1;
+    shared.robot_grasp_id = 1;
+    shared.robot_handover_id = 1;
+    shared.arm = "left";
+    shared.joints_rr = Eigen::Vector2d(0.5, 1.0);
+    shared.joints_rh = Eigen::VectorXd::Constant(1, -2.0);
+    shared.inclination_rr_deg = 12.5;
+    shared.inclination_rh_deg = 45.0;
+    writer.add_shared_grasps({shared});
+    ErgonomicsRecord ergonomics;
+    ergonomics.method = "hila";
+    ergonomics.reachable = true;
+    ergonomics.torso_flexion_deg = 17.25;
+    ergonomics.reach = 0.625;
+    ergonomics.quality = 0.5;
+    ergonomics.arm = "right";
+    writer.add_ergonomics(id, {ergonomics});
+  }
   writer.commit();
 }
 
@@ -294,6 +452,16 @@ void expect_no_handover_records(const Database& db) {
   EXPECT_TRUE(db.ergonomics(1).empty());
 }
 
+// A migrated file has the version 4 tables, empty.
+void expect_no_roadmap_records(const Database& db) {
+  EXPECT_TRUE(db.roadmaps().empty());
+  EXPECT_EQ(db.roadmap("left"), nullptr);
+  EXPECT_TRUE(db.roadmap_filters(1).empty());
+  EXPECT_EQ(db.roadmap_filter(1), nullptr);
+  EXPECT_TRUE(db.regrasp_nodes(1).empty());
+  EXPECT_TRUE(db.regrasp_edges(1).empty());
+}
+
 }  // namespace
 
 TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
@@ -305,10 +473,10 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v1 = content_digest(path);  // an old file still has a digest
 
-  migrate_in_place(path);  // 1 -> 2 -> 3
+  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 3);
+  EXPECT_EQ(db.meta().schema_version, 4);
   EXPECT_EQ(db.meta().product_name, "cabinet");
   EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
@@ -317,6 +485,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
   expect_input_error([&] { db.comfort_map("right"); },
                      {path + ": comfort_maps", "a comfort map for arm 'right' (arms: none)"});
   expect_no_handover_records(db);
+  expect_no_roadmap_records(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v1.db"}) << "no temporary copy left";
 
   // The migrated file holds exactly what this hila writes for the same records: same tables,
@@ -332,23 +501,23 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(read_file(path), after);
 }
 
-TEST(Migration, Version2FileIsUpgradedToVersion3) {
+TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   const std::string dir = temp_dir("db_migration_v2");
   const std::string path = write_v2(dir);
   // Unmigrated, the file is refused as outdated, with the way out.
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 3), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 4), got one "
        "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_THROW(Database::open(path), DatabaseError);
   const std::string digest_v2 = content_digest(path);
 
-  migrate_in_place(path);
+  migrate_in_place(path);  // 2 -> 3 -> 4
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 3);
+  EXPECT_EQ(db.meta().schema_version, 4);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   expect_v1_records(db);
   ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
@@ -356,6 +525,7 @@ TEST(Migration, Version2FileIsUpgradedToVersion3) {
   EXPECT_EQ(db.comfort_map("right").seed, 18446744073709551615ull);
   EXPECT_TRUE(db.comfort_map("right").values.empty());
   expect_no_handover_records(db);
+  expect_no_roadmap_records(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v2.db"}) << "no temporary copy left";
 
   // Same content as this hila writes: the new tables (empty) and meta.human_bodies ("") included.
@@ -367,6 +537,85 @@ TEST(Migration, Version2FileIsUpgradedToVersion3) {
   const std::string after = read_file(path);
   migrate_in_place(path);
   EXPECT_EQ(read_file(path), after);
+}
+
+TEST(Migration, Version3FileIsUpgradedToVersion4) {
+  const std::string dir = temp_dir("db_migration_v3");
+  const std::string path = write_v3(dir);
+  // Unmigrated, the file is refused as outdated, with the way out.
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 4), got one "
+       "written by schema version 3 (an older hila); rebuild with: hila build product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  const std::string digest_v3 = content_digest(path);
+
+  migrate_in_place(path);  // 3 -> 4 only
+
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 4);
+  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+  EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
+  expect_v1_records(db);
+  ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
+  EXPECT_EQ(db.comfort_map("right").coverage, 0.375);
+  // Every version 3 record is kept.
+  ASSERT_NE(db.handover_stage(1), nullptr);
+  EXPECT_EQ(db.handover_stage(1)->draws, 812);
+  EXPECT_EQ(db.handover_stage(1)->goals, 1);
+  ASSERT_EQ(db.robot_handovers(1).size(), 1u);
+  EXPECT_EQ(db.robot_handovers(1)[0].joints, Eigen::Vector2d(0.5, 1.0));
+  EXPECT_EQ(db.robot_handovers(1)[0].board.translation(), Eigen::Vector3d(0.5, 0.0, 1.0));
+  const auto goals = db.handover_goals(1);
+  ASSERT_EQ(goals.size(), 1u);
+  EXPECT_EQ(goals[0].human_quality, 0.875);
+  EXPECT_EQ(goals[0].human_joints, Eigen::VectorXd::Constant(1, -2.0));
+  ASSERT_EQ(db.shared_grasps(1).size(), 1u);
+  EXPECT_EQ(db.shared_grasps(1)[0].inclination_rh_deg, 45.0);
+  ASSERT_EQ(db.ergonomics(1).size(), 1u);
+  EXPECT_EQ(db.ergonomics(1)[0].torso_flexion_deg, 17.25);
+  // The version 4 tables exist, empty.
+  expect_no_roadmap_records(db);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"v3.db"}) << "no temporary copy left";
+
+  // Same content as this hila writes for the same records: the new tables (empty) included.
+  const std::string fresh = dir + "/fresh.db";
+  write_reference_content(fresh, true, true);
+  EXPECT_EQ(content_digest(path), content_digest(fresh));
+  EXPECT_NE(content_digest(path), digest_v3);
+
+  // The migrated file takes version 4 records like a fresh one (the tables and their constraints
+  // are there): a roadmap row by SQL, then a filter of it that breaks its foreign key.
+  execute_script(path,
+                 "INSERT INTO roadmaps VALUES (1, 'left', 6, 0.05, 0, 0, x'', x'', x'', x'', x'', "
+                 "x'');");
+  EXPECT_EQ(Database::open(path).roadmaps().size(), 1u);
+  expect_input_error(
+      [&] {
+        execute_script(path,
+                       "INSERT INTO roadmap_filters VALUES (1, 1, 2, 'gripper', 1, 90.0, 0, 0, 0, "
+                       "x'', x'');");
+      },
+      {"FOREIGN KEY constraint failed"});
+
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after) << "migrating a current file is a no-op";
+}
+
+TEST(Migration, Version3FileThatAlreadyHasTheNewTablesFailsCleanly) {
+  // Version 4 content with the version number set back: the 3 -> 4 step's CREATE TABLE fails and
+  // the file is left as it was.
+  const std::string dir = temp_dir("db_migration_v3_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '3' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 3 -> 4", "table roadmaps already exists"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
 TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
@@ -400,7 +649,7 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   migrate_with_steps(path, steps_from_v0(), current_schema_version());
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 3);
+  EXPECT_EQ(db.meta().schema_version, 4);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -412,30 +661,33 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   }
   EXPECT_TRUE(db.comfort_maps().empty());
   expect_no_handover_records(db);
+  expect_no_roadmap_records(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"}) << "no temporary copy left";
 }
 
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 3 -> 4 needs the table step 0 -> 1 creates and the ones steps 1 -> 2 and 2 -> 3 create;
-  // listed first to prove ordering.
-  std::vector<MigrationStep> steps = {{3,
-                                       "INSERT INTO notes (text) VALUES ('from step 3');"
+  // Step 4 -> 5 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3 and 3 -> 4
+  // create; listed first to prove ordering.
+  std::vector<MigrationStep> steps = {{4,
+                                       "INSERT INTO notes (text) VALUES ('from step 4');"
                                        "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
-                                       "INSERT INTO notes (text) SELECT arm FROM ergonomics;"}};
+                                       "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
+                                       "INSERT INTO notes (text) SELECT arm FROM roadmaps;"}};
   steps.push_back(migration_steps().at(1));
+  steps.push_back(migration_steps().at(2));
   steps.push_back(migration_steps().at(0));
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 4));
-  migrate_with_steps(path, steps, 4);
-  // The file is now version 4: this hila (3) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 4"});
-  // Migrating to 4 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 5));
+  migrate_with_steps(path, steps, 5);
+  // The file is now version 5: this hila (4) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 5"});
+  // Migrating to 5 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 4);
+  migrate_with_steps(path, steps, 5);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -460,6 +712,8 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
   EXPECT_FALSE(can_migrate({}, 0, 1));
   EXPECT_FALSE(can_migrate(kSteps, 0, 2));
   EXPECT_FALSE(can_migrate({migration_steps().at(0)}, 1, 3)) << "1 -> 2 alone does not reach 3";
+  EXPECT_FALSE(can_migrate({migration_steps().at(0), migration_steps().at(1)}, 1, 4))
+      << "1 -> 2 -> 3 does not reach 4";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },

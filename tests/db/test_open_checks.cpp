@@ -123,7 +123,7 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   const std::string path = write_small(temp_dir("db_open_older"));
   detail::execute_script(path, "UPDATE meta SET value = '0' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "this hila reads (schema version 3)",
+                     {path + ": meta.schema_version", "this hila reads (schema version 4)",
                       "written by schema version 0 (an older hila)",
                       "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
   // There is no step from version 0, so the message must not offer one.
@@ -134,15 +134,22 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   }
 }
 
+// SQL that drops the tables schema version 4 added (regrasp_edges first: it refers to the others).
+const char* const kDropVersion4Tables =
+    "DROP TABLE regrasp_edges; DROP TABLE regrasp_nodes; DROP TABLE roadmap_filters;"
+    "DROP TABLE roadmaps;";
+
 TEST(OpenChecks, Version1OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v1"));
-  detail::execute_script(path,
-                         "DROP TABLE comfort_maps;"
-                         "UPDATE meta SET value = '1' WHERE key = 'schema_version'");
+  detail::execute_script(path, std::string(kDropVersion4Tables) +
+                                   "DROP TABLE shared_grasps; DROP TABLE handover_candidates;"
+                                   "DROP TABLE robot_handovers; DROP TABLE handover_stages;"
+                                   "DROP TABLE ergonomics; DROP TABLE comfort_maps;"
+                                   "UPDATE meta SET value = '1' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 3), "
+       ": meta.schema_version: expected a database this hila reads (schema version 4), "
        "got one written by schema version 1 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -151,14 +158,15 @@ TEST(OpenChecks, Version1OffersMigration) {
 TEST(OpenChecks, Version2OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v2"));
   detail::execute_script(path,
-                         "DROP TABLE shared_grasps; DROP TABLE handover_candidates;"
-                         "DROP TABLE robot_handovers; DROP TABLE handover_stages;"
-                         "DROP TABLE ergonomics; DELETE FROM meta WHERE key = 'human_bodies';"
-                         "UPDATE meta SET value = '2' WHERE key = 'schema_version'");
+                         std::string(kDropVersion4Tables) +
+                             "DROP TABLE shared_grasps; DROP TABLE handover_candidates;"
+                             "DROP TABLE robot_handovers; DROP TABLE handover_stages;"
+                             "DROP TABLE ergonomics; DELETE FROM meta WHERE key = 'human_bodies';"
+                             "UPDATE meta SET value = '2' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 3), "
+       ": meta.schema_version: expected a database this hila reads (schema version 4), "
        "got one written by schema version 2 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -166,11 +174,29 @@ TEST(OpenChecks, Version2OffersMigration) {
   EXPECT_EQ(content_digest(path).size(), 64u);
 }
 
+TEST(OpenChecks, Version3OffersMigration) {
+  const std::string path = write_small(temp_dir("db_open_v3"));
+  const std::string digest_v4 = content_digest(path);
+  detail::execute_script(path, std::string(kDropVersion4Tables) +
+                                   "UPDATE meta SET value = '3' WHERE key = 'schema_version'");
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 4), "
+       "got one written by schema version 3 (an older hila); rebuild with: hila build "
+       "meshes/cabinet/product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  // The digest still reads it (a version 3 file has no version 4 tables to hash), and differs.
+  const std::string digest_v3 = content_digest(path);
+  EXPECT_EQ(digest_v3.size(), 64u);
+  EXPECT_NE(digest_v3, digest_v4);
+}
+
 TEST(OpenChecks, NewerSchemaVersion) {
   const std::string path = write_small(temp_dir("db_open_newer"));
-  detail::execute_script(path, "UPDATE meta SET value = '4' WHERE key = 'schema_version'");
+  detail::execute_script(path, "UPDATE meta SET value = '5' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "written by schema version 4 (a newer hila)",
+                     {path + ": meta.schema_version", "written by schema version 5 (a newer hila)",
                       "upgrade hila, or rebuild with: hila build"});
 }
 
@@ -178,7 +204,7 @@ TEST(OpenChecks, OlderVersionWithAMigrationPathSaysSo) {
   expect_input_error([] { detail::check_schema_version("p.db", 0, 1, true, "rebuild with: X"); },
                      {"p.db: meta.schema_version",
                       "rebuild with: X (or migrate it in place with hila::db::migrate_in_place)"});
-  EXPECT_NO_THROW(detail::check_schema_version("p.db", 3, 3, false, ""));
+  EXPECT_NO_THROW(detail::check_schema_version("p.db", 4, 4, false, ""));
 }
 
 TEST(OpenChecks, BadMetaValues) {

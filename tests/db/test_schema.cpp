@@ -33,13 +33,15 @@ std::vector<std::string> create_statements(const std::string& sql) {
 
 }  // namespace
 
-TEST(Schema, VersionIsThreeWithStepsFromOneAndTwo) {
-  EXPECT_EQ(current_schema_version(), 3);
-  ASSERT_EQ(migration_steps().size(), 2u);
+TEST(Schema, VersionIsFourWithStepsFromOneTwoAndThree) {
+  EXPECT_EQ(current_schema_version(), 4);
+  ASSERT_EQ(migration_steps().size(), 3u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
   EXPECT_EQ(migration_steps()[1].from_version, 2);
+  EXPECT_EQ(migration_steps()[2].from_version, 3);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 3, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
   // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
@@ -57,6 +59,18 @@ TEST(Schema, VersionIsThreeWithStepsFromOneAndTwo) {
   EXPECT_NE(migration_steps()[1].sql.find(
                 "INSERT OR IGNORE INTO meta (key, value) VALUES ('human_bodies', '');"),
             std::string::npos);
+  // 3 -> 4: the roadmap and regrasp-graph tables, as a fresh database has them, and nothing else.
+  const auto created_v4 = create_statements(migration_steps()[2].sql);
+  ASSERT_EQ(created_v4.size(), 6u) << "4 tables, 2 indexes";
+  for (const std::string table :
+       {"roadmaps", "roadmap_filters", "regrasp_nodes", "regrasp_edges"}) {
+    EXPECT_NE(migration_steps()[2].sql.find("CREATE TABLE " + table + " ("), std::string::npos)
+        << table;
+  }
+  for (const auto& statement : created_v4) {
+    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  EXPECT_EQ(migration_steps()[2].sql.find("INSERT"), std::string::npos);
 }
 
 TEST(Schema, ColumnListHelpers) {
@@ -65,7 +79,7 @@ TEST(Schema, ColumnListHelpers) {
 }
 
 TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
-  ASSERT_EQ(kTables.size(), 12u);
+  ASSERT_EQ(kTables.size(), 16u);
   EXPECT_STREQ(kTables[0].name, "meta");
   EXPECT_STREQ(kTables[1].name, "parts");
   EXPECT_STREQ(kTables[6].name, "comfort_maps");
@@ -75,7 +89,12 @@ TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
   EXPECT_STREQ(kTables[9].name, "handover_candidates");
   EXPECT_STREQ(kTables[10].name, "shared_grasps");
   EXPECT_STREQ(kTables[11].name, "ergonomics");
-  for (std::size_t i = 7; i < kTables.size(); ++i) EXPECT_EQ(kTables[i].since_version, 3);
+  for (std::size_t i = 7; i < 12; ++i) EXPECT_EQ(kTables[i].since_version, 3);
+  EXPECT_STREQ(kTables[12].name, "roadmaps");
+  EXPECT_STREQ(kTables[13].name, "roadmap_filters");
+  EXPECT_STREQ(kTables[14].name, "regrasp_nodes");
+  EXPECT_STREQ(kTables[15].name, "regrasp_edges");
+  for (std::size_t i = 12; i < kTables.size(); ++i) EXPECT_EQ(kTables[i].since_version, 4);
   for (const auto& table : kTables) {
     EXPECT_NE(schema_sql().find(std::string("CREATE TABLE ") + table.name + " ("),
               std::string::npos)
@@ -127,6 +146,55 @@ TEST(Schema, HandoverAndErgonomicsColumnsAreDeclared) {
   }
 }
 
+TEST(Schema, RoadmapAndRegraspColumnsAreDeclared) {
+  const std::string& sql = schema_sql();
+  for (const std::string column : {
+           "arm TEXT UNIQUE NOT NULL",
+           "dof INTEGER NOT NULL",
+           "resolution REAL NOT NULL",
+           "node_count INTEGER NOT NULL",
+           "edge_count INTEGER NOT NULL",
+           "node_joints BLOB NOT NULL",
+           "node_gravity BLOB NOT NULL",
+           "node_inclination_deg BLOB NOT NULL",
+           "edge_nodes BLOB NOT NULL",
+           "edge_length BLOB NOT NULL",
+           "edge_max_inclination_deg BLOB NOT NULL",
+           "roadmap_id INTEGER NOT NULL REFERENCES roadmaps(id)",
+           "grasp_kind TEXT NOT NULL CHECK (grasp_kind IN ('gripper', 'suction'))",
+           "grasp_id INTEGER NOT NULL",
+           "theta_c_deg REAL NOT NULL",
+           "valid_edges INTEGER NOT NULL",
+           "components INTEGER NOT NULL",
+           "largest_component INTEGER NOT NULL",
+           "edge_bits BLOB NOT NULL",
+           "node_component BLOB NOT NULL",
+           "UNIQUE (part_id, roadmap_id, grasp_kind, grasp_id)",
+           "kind TEXT NOT NULL CHECK (kind IN ('home', 'pick', 'robot_handover', "
+           "'human_handover'))",
+           "grasp_kind TEXT NOT NULL CHECK (grasp_kind IN ('', 'gripper', 'suction'))",
+           "robot_handover_id INTEGER REFERENCES robot_handovers(id),",
+           "candidate_id INTEGER REFERENCES handover_candidates(id),",
+           "solution_count INTEGER NOT NULL",
+           "solutions BLOB NOT NULL",
+           "CHECK ((kind = 'home') = (grasp_kind = ''))",
+           "CHECK ((grasp_kind = '') = (grasp_id = 0))",
+           "CHECK ((kind = 'robot_handover') = (robot_handover_id IS NOT NULL))",
+           "CHECK ((kind = 'human_handover') = (candidate_id IS NOT NULL))",
+           "kind TEXT NOT NULL CHECK (kind IN ('transit', 'transfer', 'handover'))",
+           "from_node INTEGER NOT NULL REFERENCES regrasp_nodes(id)",
+           "to_node INTEGER NOT NULL REFERENCES regrasp_nodes(id)",
+           "filter_id INTEGER REFERENCES roadmap_filters(id),",
+           "connected INTEGER NOT NULL CHECK (connected IN (0, 1))",
+           "cost REAL NOT NULL",
+           "path_nodes INTEGER NOT NULL",
+           "CHECK ((kind = 'transfer') = (filter_id IS NOT NULL))",
+           "CHECK (connected = 1 OR (cost = 0 AND path_nodes = 0))",
+       }) {
+    EXPECT_NE(sql.find(column), std::string::npos) << column;
+  }
+}
+
 TEST(Schema, ComfortMapColumnsAreDeclaredNotNull) {
   const std::string& sql = schema_sql();
   for (const std::string column :
@@ -160,8 +228,9 @@ TEST(Schema, SqlRunsOnAnEmptyFileAndCreatesThePartIdIndexes) {
   const std::string path = schema_only_database("db_schema_indexes");
   // Creating an index that already exists fails: that is how the test sees the index without SQL
   // access of its own.
-  for (const std::string table : {"placements", "robot_grasps", "suction_grasps", "human_grasps",
-                                  "robot_handovers", "handover_candidates"}) {
+  for (const std::string table :
+       {"placements", "robot_grasps", "suction_grasps", "human_grasps", "robot_handovers",
+        "handover_candidates", "regrasp_nodes", "regrasp_edges"}) {
     expect_input_error(
         [&] {
           execute_script(path, "CREATE INDEX " + table + "_part_id ON " + table + "(part_id)");

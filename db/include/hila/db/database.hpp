@@ -81,6 +81,38 @@ class DatabaseWriter {
   // orientations.size() or an orientation that is not a unit quaternion (to 1e-9), and
   // DatabaseError for an arm that already has a map.
   void add_comfort_map(const ComfortMapRecord& map);
+
+  // Roadmaps and the regrasp graph (schema version 4). As for version 3, every double (joint
+  // values, gravity directions, poses, costs) must be finite, and the records are checked before
+  // anything of the call is written: a mistake is std::invalid_argument naming the call,
+  // table.column, the record and what was expected, e.g. "DatabaseWriter::add_roadmap:
+  // roadmaps.node_gravity (arm 'left'): RoadmapRecord::node_gravity holds 9 values, expected
+  // one per node (10)".
+  //
+  // One roadmap per arm (DatabaseError: UNIQUE constraint failed: roadmaps.arm); returns its id.
+  // Refused: an empty arm name, dof <= 0, resolution not > 0, a node of another size than dof,
+  // node_gravity or node_inclination_deg not one per node, edge_length or
+  // edge_max_inclination_deg not one per edge, an edge not 0 <= first < second < nodes.size().
+  std::int64_t add_roadmap(const RoadmapRecord& roadmap);
+  // part_id, roadmap_id and grasp_id are taken from each record. roadmap_id must name a roadmap
+  // of this writer (FOREIGN KEY constraint failed otherwise); edges must hold one bit per edge of
+  // that roadmap and component one id >= 0 per node, the ids equal at both ends of every set
+  // edge; valid_edges, components and largest_component must be the counts of those. grasp_kind
+  // must be "gripper" or "suction" and grasp_id a written robot_grasps or suction_grasps id
+  // respectively (DatabaseError otherwise); at most one filter per part, roadmap and grasp
+  // (UNIQUE constraint failed). Returns the ids in record order.
+  std::vector<std::int64_t> add_roadmap_filters(const std::vector<RoadmapFilterRecord>& filters);
+  // part_id and the ids are taken from each record. kind must be "home", "pick",
+  // "robot_handover" or "human_handover"; grasp_kind "" exactly for "home" (with grasp_id 0),
+  // else "gripper" or "suction" with grasp_id a written grasp of that kind; robot_handover_id
+  // non-zero exactly for "robot_handover" and candidate_id exactly for "human_handover" (both
+  // must name written records); at least one solution, all of one size > 0. Returns the ids.
+  std::vector<std::int64_t> add_regrasp_nodes(const std::vector<RegraspNodeRecord>& nodes);
+  // part_id and the ids are taken from each record. kind must be "transit", "transfer" or
+  // "handover"; filter_id non-zero exactly for "transfer" (a written roadmap filter); from_node
+  // and to_node written regrasp nodes; cost finite and >= 0, path_nodes >= 0, both 0 when not
+  // connected, cost 0 for a handover. Returns the ids.
+  std::vector<std::int64_t> add_regrasp_edges(const std::vector<RegraspEdgeRecord>& edges);
   void commit();
 
   const std::string& temporary_path() const;
@@ -98,7 +130,7 @@ struct OpenOptions {
 };
 
 // A read-only, fully loaded product database (small, except the comfort maps: about 13 MB per arm
-// in memory). Const after open: safe to share.
+// in memory, and the roadmaps and their filters: a few MB). Const after open: safe to share.
 class Database {
  public:
   // Throws DatabaseError for a missing, truncated, corrupt or foreign file (not SQLite, or SQLite
@@ -128,6 +160,15 @@ class Database {
   std::vector<SharedGraspRecord> shared_grasps(std::int64_t candidate_id) const;  // id order
   std::vector<ErgonomicsRecord> ergonomics(std::int64_t part_id) const;  // id (write) order
 
+  // Roadmaps and the regrasp graph (schema version 4). The arm's roadmap, or nullptr when the
+  // database has none for it (valid as long as this Database); all roadmaps in id order.
+  const RoadmapRecord* roadmap(const std::string& arm) const;
+  const std::vector<RoadmapRecord>& roadmaps() const { return roadmaps_; }
+  std::vector<RoadmapFilterRecord> roadmap_filters(std::int64_t part_id) const;  // id order
+  const RoadmapFilterRecord* roadmap_filter(std::int64_t id) const;          // nullptr when none
+  std::vector<RegraspNodeRecord> regrasp_nodes(std::int64_t part_id) const;  // id order
+  std::vector<RegraspEdgeRecord> regrasp_edges(std::int64_t part_id) const;  // id order
+
  private:
   std::string path_;
   Meta meta_;
@@ -142,6 +183,10 @@ class Database {
   std::vector<HandoverCandidateRecord> handover_candidates_;
   std::vector<SharedGraspRecord> shared_grasps_;
   std::vector<ErgonomicsRecord> ergonomics_;
+  std::vector<RoadmapRecord> roadmaps_;
+  std::vector<RoadmapFilterRecord> roadmap_filters_;  // id order: roadmap_filter() bisects
+  std::vector<RegraspNodeRecord> regrasp_nodes_;
+  std::vector<RegraspEdgeRecord> regrasp_edges_;
 };
 
 // Upgrades a database written by an older schema version to current_schema_version(): copies it

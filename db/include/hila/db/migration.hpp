@@ -13,7 +13,7 @@ struct MigrationStep {
 };
 
 // The steps this build of hila knows, in order (1 -> 2 adds comfort_maps, 2 -> 3 the handover and
-// ergonomics tables and meta.human_bodies).
+// ergonomics tables and meta.human_bodies, 3 -> 4 the roadmap and regrasp-graph tables).
 const std::vector<MigrationStep>& migration_steps();
 
 // True if `steps` hold one step for every version from `from_version` up to `to_version` - 1.

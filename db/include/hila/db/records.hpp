@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hila/core/pose.hpp"
@@ -165,6 +166,71 @@ struct ErgonomicsRecord {
   double reorientation_deg = 0.0;  // rotation left to bring the board to its target
   double quality = 0.0;            // comfort Q of the posture
   std::string arm;                 // the human arm used
+};
+
+// One arm's joint-space roadmap over the static cell (schema v4). Node i's configuration is
+// nodes[i]; edge e joins edges[e].first < edges[e].second.
+struct RoadmapRecord {
+  std::int64_t id = 0;
+  std::string arm;  // unique per database
+  int dof = 0;
+  double resolution = 0.0;             // joint-space spacing (rad) at which edges were checked
+  std::vector<Eigen::VectorXd> nodes;  // each of size dof, rad
+  std::vector<Eigen::Vector3d> node_gravity;  // gravity's unit direction in the TCP frame
+  std::vector<double> node_inclination_deg;   // gripper opening axis vs gravity, [0, 90]
+  std::vector<std::pair<int, int>> edges;
+  std::vector<double> edge_length;  // rad
+  std::vector<double> edge_max_inclination_deg;
+};
+
+// The edges of one arm's roadmap that a held board may use (slip within the grasp's limit and
+// the held board clear of the static cell), with connected components over them.
+struct RoadmapFilterRecord {
+  std::int64_t id = 0;
+  std::int64_t part_id = 0;
+  std::int64_t roadmap_id = 0;
+  std::string grasp_kind;  // "gripper" (robot_grasps.id) or "suction" (suction_grasps.id)
+  std::int64_t grasp_id = 0;
+  double theta_c_deg = 90.0;
+  std::vector<bool> edges;     // one per roadmap edge
+  std::vector<int> component;  // one per roadmap node: component id >= 0 over the set edges
+  int valid_edges = 0;         // number of set bits
+  int components = 0;          // number of distinct ids
+  int largest_component = 0;   // nodes in the largest
+};
+
+// A regrasp-graph node: the board at one pose held (or about to be held) by one arm with one
+// grasp, with the arm's collision-free IK solutions. kind: "home" (arm at home, grasp_kind "",
+// grasp_id 0), "pick" (board at its initial pose), "robot_handover" (robot_handover_id set),
+// "human_handover" (candidate_id set).
+struct RegraspNodeRecord {
+  std::int64_t id = 0;
+  std::int64_t part_id = 0;
+  std::string kind;
+  std::string arm;
+  std::string grasp_kind;  // "", "gripper" or "suction"
+  std::int64_t grasp_id = 0;
+  std::int64_t robot_handover_id = 0;         // 0 unless kind == "robot_handover"
+  std::int64_t candidate_id = 0;              // 0 unless kind == "human_handover"
+  core::Pose board = core::Pose::Identity();  // world; identity for "home"
+  std::vector<Eigen::VectorXd> solutions;     // at least one, each of the arm's dof, rad
+};
+
+// A regrasp-graph edge. kind: "transit" (arm moves empty), "transfer" (arm moves holding the
+// board; filter_id names the roadmap filter used), "handover" (suction arm -> gripper arm at a
+// robot-robot pose; cost 0). cost: joint-space length (rad) of the roadmap path found, when
+// connected; 0 and connected=false otherwise.
+struct RegraspEdgeRecord {
+  std::int64_t id = 0;
+  std::int64_t part_id = 0;
+  std::string kind;
+  std::string arm;
+  std::int64_t from_node = 0;  // regrasp_nodes.id
+  std::int64_t to_node = 0;
+  std::int64_t filter_id = 0;  // 0 for transit and handover
+  bool connected = false;
+  double cost = 0.0;
+  int path_nodes = 0;  // roadmap nodes on the path (0 when not connected)
 };
 
 // Self-description of a database (the `meta` table, one key per field).
