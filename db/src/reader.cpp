@@ -627,8 +627,11 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       });
   db.regrasp_edges_ = load_table<RegraspEdgeRecord>(
       *connection, "regrasp_edges",
-      "kind, arm, from_node, to_node, filter_id, connected, cost, path_nodes", fix,
-      [&](detail::Statement& s, RegraspEdgeRecord& r) {
+      "kind, arm, from_node, to_node, filter_id, connected, cost, path_nodes, via, path_dof, "
+      "path_waypoints, path",
+      fix, [&](detail::Statement& s, RegraspEdgeRecord& r) {
+        RowCheck check(path, "regrasp_edges", fix);
+        check.set_row("id " + std::to_string(r.id));
         r.kind = s.next_text();
         r.arm = s.next_text();
         r.from_node = s.next_int64();
@@ -637,6 +640,23 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.connected = s.next_int64() != 0;
         r.cost = s.next_double();
         r.path_nodes = static_cast<int>(s.next_int64());
+        r.via = s.next_text();
+        // No path: both counts 0. A path: at least 2 waypoints of at least one joint.
+        const std::int64_t stored_dof = s.next_int64();
+        const int waypoints = check.count("path_waypoints", s.next_int64());
+        if (waypoints == 1) {
+          check.fail("path_waypoints", "0 (no path) or an integer from 2 to 2147483647", "1");
+        }
+        const int dof = check.count("path_dof", stored_dof, waypoints > 0 ? 1 : 0);
+        if (waypoints == 0 && dof != 0) {
+          check.fail("path_dof", "0 when path_waypoints is 0", std::to_string(dof));
+        }
+        const std::string bytes = s.next_blob();
+        check.blob("path", bytes, waypoints, detail::blob_bytes(dof, 8),
+                   "path_waypoints * path_dof = " + std::to_string(waypoints) + " * " +
+                       std::to_string(dof) + " joint values as little-endian doubles",
+                   [&] { return detail::decode_vectors(bytes, waypoints, dof, r.path); });
+        check.finite("path", r.path, [](std::size_t i) { return nth("waypoint", i); });
       });
   return db;
 }

@@ -147,7 +147,9 @@ std::string create_tables_v3() {
 // edge_max_inclination_deg one double per node or edge, edge_nodes edge_count * 2 int32s (first,
 // second); roadmap_filters.edge_bits ceil(edge_count / 8) bytes (edge e: bit e % 8 of byte e / 8,
 // least significant first; unused bits 0), node_component node_count int32s;
-// regrasp_nodes.solutions solution_count * dof doubles (solution-major). The optional references
+// regrasp_nodes.solutions solution_count * dof doubles (solution-major), regrasp_edges.path
+// path_waypoints * path_dof doubles (waypoint-major; empty, with both counts 0, for an edge without
+// a path: not connected, or a handover). The optional references
 // (regrasp_nodes.robot_handover_id and candidate_id, regrasp_edges.filter_id) are NULL when they
 // do not apply, so they can be foreign keys; the records hold 0 for NULL.
 constexpr const char* kCreateRoadmapsV4 = R"sql(
@@ -219,8 +221,14 @@ CREATE TABLE regrasp_edges (
   connected INTEGER NOT NULL CHECK (connected IN (0, 1)),
   cost REAL NOT NULL,
   path_nodes INTEGER NOT NULL,
+  via TEXT NOT NULL CHECK (via IN ('', 'roadmap', 'bridge')),
+  path_dof INTEGER NOT NULL,
+  path_waypoints INTEGER NOT NULL,
+  path BLOB NOT NULL,
   CHECK ((kind = 'transfer') = (filter_id IS NOT NULL)),
-  CHECK (connected = 1 OR (cost = 0 AND path_nodes = 0))
+  CHECK (connected = 1 OR (cost = 0 AND path_nodes = 0)),
+  CHECK ((connected = 1 AND kind IN ('transit', 'transfer')) = (via <> '')),
+  CHECK ((via = '') = (path_waypoints = 0))
 );
 CREATE INDEX regrasp_edges_part_id ON regrasp_edges(part_id);
 )sql";

@@ -337,7 +337,7 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
         *m.connection,
         insert_sql("regrasp_edges",
                    "part_id, kind, arm, from_node, to_node, filter_id, connected, cost, "
-                   "path_nodes"),
+                   "path_nodes, via, path_dof, path_waypoints, path"),
         m.context("regrasp_edges"));
     m.select_robot_grasp.emplace(*m.connection, "SELECT 1 FROM robot_grasps WHERE id = ?",
                                  m.context("robot_grasps"));
@@ -986,6 +986,46 @@ std::vector<std::int64_t> DatabaseWriter::add_regrasp_edges(
         bad("cost",
             "RegraspEdgeRecord::cost is " + std::to_string(e.cost) + of_kind + ", expected 0");
       }
+      // A connected transit or transfer edge says how it was connected and holds its path; the
+      // others hold neither.
+      const bool has_path = e.connected && e.kind != "handover";
+      const std::string without_path =
+          e.kind == "handover" ? of_kind : std::string(" for an edge that is not connected");
+      if (!is_one_of(e.via, {"", "roadmap", "bridge"})) {
+        bad("via", "RegraspEdgeRecord::via is " + quoted(e.via) + ", expected " +
+                       one_of({"roadmap", "bridge"}) + " (or '' without a path)");
+      }
+      if (has_path && e.via.empty()) {
+        bad("via", "RegraspEdgeRecord::via is '' for a connected " + quoted(e.kind) +
+                       " edge, expected " + one_of({"roadmap", "bridge"}));
+      }
+      if (!has_path && !e.via.empty()) {
+        bad("via", "RegraspEdgeRecord::via is " + quoted(e.via) + without_path + ", expected ''");
+      }
+      const auto waypoints = [](std::size_t n) {
+        return std::to_string(n) + (n == 1 ? " waypoint" : " waypoints");
+      };
+      if (has_path && e.path.size() < 2) {
+        bad("path", "RegraspEdgeRecord::path has " + waypoints(e.path.size()) +
+                        " for a connected " + quoted(e.kind) + " edge, expected at least 2");
+      }
+      if (!has_path && !e.path.empty()) {
+        bad("path", "RegraspEdgeRecord::path has " + waypoints(e.path.size()) + without_path +
+                        ", expected none");
+      }
+      for (std::size_t j = 0; j < e.path.size(); ++j) {
+        if (e.path[j].size() == 0 || e.path[j].size() != e.path[0].size()) {
+          bad("path",
+              "RegraspEdgeRecord::path[" + std::to_string(j) + "] has " +
+                  std::to_string(e.path[j].size()) + " joint values, expected " +
+                  (j == 0 ? std::string("at least one")
+                          : "as many as path[0] (" + std::to_string(e.path[0].size()) + ")"));
+        }
+      }
+      for (std::size_t j = 0; j < e.path.size(); ++j) {
+        check.set_record(record + ", waypoint " + std::to_string(j));
+        check.joints("path", e.path[j]);
+      }
     }
 
     detail::Statement& s = *m.insert_regrasp_edge;
@@ -1004,6 +1044,10 @@ std::vector<std::int64_t> DatabaseWriter::add_regrasp_edges(
       s.bind_next(static_cast<std::int64_t>(e.connected ? 1 : 0));
       s.bind_next(e.cost);
       s.bind_next(static_cast<std::int64_t>(e.path_nodes));
+      s.bind_next(e.via);
+      s.bind_next(static_cast<std::int64_t>(e.path.empty() ? 0 : e.path[0].size()));
+      s.bind_next(static_cast<std::int64_t>(e.path.size()));
+      s.bind_blob(detail::encode_vectors(e.path));
       s.run();
       ids.push_back(m.last_id());
     }

@@ -309,8 +309,9 @@ inline std::vector<Eigen::VectorXd> random_solutions(std::mt19937_64& rng, int c
 // Roadmaps and the regrasp graph: the left (gripper) arm's roadmap has 11 nodes and 13 edges (bit
 // lists that are not a whole number of bytes), the right (suction) arm's 5 nodes, 7 joints and 8
 // edges (exactly one byte). Part 1 has four filters, seven regrasp nodes of every kind and six
-// edges of every kind (one not connected); part 2 two filters, three nodes and two edges. Written
-// after the handover records (the nodes refer to robot handovers and candidates).
+// edges of every kind (one not connected; the connected transit and transfer edges with paths via
+// the roadmap and via a bridge); part 2 two filters, three nodes and two edges. Written after the
+// handover records (the nodes refer to robot handovers and candidates).
 inline void add_roadmap_records(Sample& s, std::mt19937_64& rng) {
   s.roadmaps.push_back(make_roadmap("left", rng(), 6, 11, 13));
   s.roadmaps.push_back(make_roadmap("right", rng(), 7, 5, 8));
@@ -404,6 +405,34 @@ inline void add_roadmap_records(Sample& s, std::mt19937_64& rng) {
       edge(2, "transit", "left", 8, 9, 0, false, 0.0, 0),
       edge(2, "transfer", "left", 9, 10, 5, true, std::numeric_limits<double>::denorm_min(), 2),
   };
+  // The connected transit and transfer edges' paths: from the from-node's first solution through
+  // `between` random waypoints to the to-node's first solution.
+  const auto connect = [&](SamplePart& p, std::size_t index, const std::string& via, int between) {
+    RegraspEdgeRecord& e = p.regrasp_edges[index];
+    const auto first_solution = [&](std::int64_t id) {
+      for (const auto& q : s.parts) {
+        for (const auto& n : q.regrasp_nodes) {
+          if (n.id == id) return n.solutions[0];
+        }
+      }
+      return Eigen::VectorXd();
+    };
+    const Eigen::VectorXd from = first_solution(e.from_node);
+    e.via = via;
+    e.path = {from};
+    for (int i = 0; i < between; ++i) {
+      e.path.push_back(random_joints(rng, static_cast<int>(from.size())));
+    }
+    e.path.push_back(first_solution(e.to_node));
+  };
+  connect(a, 0, "roadmap", 4);
+  connect(a, 1, "bridge", 1);
+  connect(a, 2, "roadmap", 2);
+  connect(a, 5, "roadmap", 0);  // the least: two waypoints
+  connect(b, 1, "bridge", 3);
+  a.regrasp_edges[1].path[1][0] = -0.0;
+  a.regrasp_edges[1].path[1][4] = std::numeric_limits<double>::denorm_min();
+  b.regrasp_edges[1].path[2][1] = 1e300;
   std::int64_t edge_id = 0;
   for (auto& p : s.parts) {
     for (auto& e : p.regrasp_edges) e.id = ++edge_id;

@@ -175,6 +175,21 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
     std::swap(e.from_node, e.to_node);
   });
   add("regrasp edge filter", [](Sample& s) { s.parts[0].regrasp_edges[1].filter_id = 2; });
+  add("regrasp edge via", [](Sample& s) { s.parts[0].regrasp_edges[0].via = "bridge"; });
+  add("regrasp edge path waypoint ulp", [](Sample& s) {
+    double& q = s.parts[1].regrasp_edges[1].path[2][3];
+    q = std::nextafter(q, 10.0);
+  });
+  add("regrasp edge path -0.0 to +0.0",
+      [](Sample& s) { s.parts[0].regrasp_edges[1].path[1][0] = 0.0; });
+  add("regrasp edge path a waypoint less", [](Sample& s) {
+    auto& path = s.parts[0].regrasp_edges[0].path;
+    path.erase(path.begin() + 2);
+  });
+  add("regrasp edge path waypoints swapped", [](Sample& s) {
+    auto& path = s.parts[0].regrasp_edges[0].path;
+    std::swap(path[1], path[2]);
+  });
   for (const auto& [name, sample] : variants) {
     const std::string path = dir + "/variant.db";
     write_sample(path, sample);
@@ -219,6 +234,23 @@ TEST(Digest, OneRoadmapFilterBitChangesIt) {
     write_sample(dir + "/b.db", b);
     EXPECT_NE(content_digest(dir + "/b.db"), reference);
   }
+  write_sample(dir + "/c.db", make_sample());
+  EXPECT_EQ(content_digest(dir + "/c.db"), reference) << "and the same sample gives the same";
+}
+
+TEST(Digest, OneRegraspPathValueChangesIt) {
+  const std::string dir = temp_dir("db_digest_regrasp_path");
+  write_sample(dir + "/a.db", make_sample());
+  const std::string reference = content_digest(dir + "/a.db");
+  // One joint value of one waypoint of part 1's first edge (a path via the roadmap), by one ulp.
+  Sample b = make_sample();
+  ASSERT_EQ(b.parts[0].regrasp_edges[0].via, "roadmap");
+  double& q = b.parts[0].regrasp_edges[0].path[3][4];
+  const double before = q;
+  q = std::nextafter(q, 10.0);
+  ASSERT_NE(q, before);
+  write_sample(dir + "/b.db", b);
+  EXPECT_NE(content_digest(dir + "/b.db"), reference);
   write_sample(dir + "/c.db", make_sample());
   EXPECT_EQ(content_digest(dir + "/c.db"), reference) << "and the same sample gives the same";
 }

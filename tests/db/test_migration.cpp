@@ -591,6 +591,10 @@ TEST(Migration, Version3FileIsUpgradedToVersion4) {
                  "INSERT INTO roadmaps VALUES (1, 'left', 6, 0.05, 0, 0, x'', x'', x'', x'', x'', "
                  "x'');");
   EXPECT_EQ(Database::open(path).roadmaps().size(), 1u);
+  // The regrasp edges as a fresh file has them: how each was connected and its path.
+  execute_script(path,
+                 "CREATE TEMP TABLE probe AS SELECT via, path_dof, path_waypoints, path "
+                 "FROM regrasp_edges;");
   expect_input_error(
       [&] {
         execute_script(path,

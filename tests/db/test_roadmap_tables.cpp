@@ -103,6 +103,12 @@ void expect_same(const RegraspEdgeRecord& got, const RegraspEdgeRecord& want) {
   EXPECT_EQ(got.connected, want.connected);
   EXPECT_EQ(got.cost, want.cost);
   EXPECT_EQ(got.path_nodes, want.path_nodes);
+  EXPECT_EQ(got.via, want.via);
+  ASSERT_EQ(got.path.size(), want.path.size());
+  for (std::size_t i = 0; i < want.path.size(); ++i) {
+    SCOPED_TRACE("waypoint " + std::to_string(i));
+    expect_same_values(got.path[i], want.path[i]);
+  }
 }
 
 // A writer at `path` with the sample's meta, parts with their grasps, robot handovers and
@@ -286,6 +292,63 @@ TEST_F(RoadmapRoundTrip, RegraspEdgesOfEveryKind) {
   EXPECT_EQ(edges[5].path_nodes, 2147483647);
   EXPECT_EQ(db.regrasp_edges(ids_[1])[1].cost, std::numeric_limits<double>::denorm_min());
   EXPECT_TRUE(db.regrasp_edges(5).empty());
+}
+
+TEST_F(RoadmapRoundTrip, RegraspEdgePathsAndHowTheyWereConnected) {
+  const Database db = Database::open(path_);
+  const auto edges = db.regrasp_edges(ids_[0]);
+  const auto nodes = db.regrasp_nodes(ids_[0]);
+  ASSERT_EQ(edges.size(), 6u);
+  EXPECT_EQ(edges[0].via, "roadmap");
+  EXPECT_EQ(edges[1].via, "bridge");
+  EXPECT_EQ(edges[3].via, "") << "not connected";
+  EXPECT_TRUE(edges[3].path.empty());
+  EXPECT_EQ(edges[4].via, "") << "a handover";
+  EXPECT_TRUE(edges[4].path.empty());
+  ASSERT_EQ(edges[0].path.size(), 6u);
+  EXPECT_EQ(edges[0].path.front(), nodes[0].solutions[0]) << "from the from-node's first solution";
+  EXPECT_EQ(edges[0].path.back(), nodes[2].solutions[0]) << "to the to-node's first solution";
+  ASSERT_EQ(edges[2].path.size(), 4u);
+  EXPECT_EQ(edges[2].path[0].size(), 7) << "the right arm's dof";
+  ASSERT_EQ(edges[5].path.size(), 2u) << "the least a path has";
+  ASSERT_EQ(edges[1].path.size(), 3u);
+  EXPECT_TRUE(std::signbit(edges[1].path[1][0]));
+  EXPECT_EQ(edges[1].path[1][4], std::numeric_limits<double>::denorm_min());
+  const auto other = db.regrasp_edges(ids_[1]);
+  EXPECT_TRUE(other[0].path.empty());
+  ASSERT_EQ(other[1].path.size(), 5u);
+  EXPECT_EQ(other[1].path[2][1], 1e300);
+}
+
+TEST_F(RoadmapRoundTrip, RegraspEdgePathColumnsInTheFile) {
+  // As in ReferencesThatDoNotApplyAreNullInTheFile: a TEMP probe table whose CHECK fails unless
+  // the count is as expected.
+  const auto probe = [&](const std::string& count_sql, int expected) {
+    detail::execute_script(
+        path_, "CREATE TEMP TABLE probe (n INTEGER CHECK (n = " + std::to_string(expected) +
+                   ")); INSERT INTO probe " + count_sql);
+  };
+  // Five edges with a path (6, 3, 4, 2 and 5 waypoints), three without (0, 0, x'').
+  probe("SELECT count(*) FROM regrasp_edges WHERE length(path) = 8 * path_waypoints * path_dof", 8);
+  probe(
+      "SELECT count(*) FROM regrasp_edges WHERE via = '' AND path_dof = 0 AND "
+      "path_waypoints = 0 AND typeof(path) = 'blob' AND length(path) = 0",
+      3);
+  probe("SELECT sum(path_waypoints) FROM regrasp_edges", 20);
+  probe("SELECT count(*) FROM regrasp_edges WHERE via = 'bridge'", 2);
+  // The file's CHECKs keep via, connected, kind and the path together for rows made by hand.
+  for (const std::string sql : {
+           "UPDATE regrasp_edges SET via = 'rrt' WHERE id = 1",
+           "UPDATE regrasp_edges SET via = 'bridge' WHERE id = 4",   // not connected
+           "UPDATE regrasp_edges SET via = 'roadmap' WHERE id = 5",  // a handover
+           "UPDATE regrasp_edges SET via = '', path_dof = 0, path_waypoints = 0, path = x'' "
+           "WHERE id = 1",                                              // connected without via
+           "UPDATE regrasp_edges SET path_waypoints = 0 WHERE id = 2",  // via without a path
+           "UPDATE regrasp_edges SET path_waypoints = 2 WHERE id = 4",  // a path without via
+       }) {
+    SCOPED_TRACE(sql);
+    expect_input_error([&] { detail::execute_script(path_, sql); }, {"CHECK constraint failed"});
+  }
 }
 
 TEST_F(RoadmapRoundTrip, ReferencesThatDoNotApplyAreNullInTheFile) {
@@ -686,6 +749,45 @@ TEST(RoadmapWriter, RegraspEdgeMistakesAreRefused) {
           {"regrasp_edges.cost (record 4 of 6", "for a 'handover' edge, expected 0"});
   refused("no arm", 4, [](RegraspEdgeRecord& e) { e.arm = ""; },
           {"regrasp_edges.arm (record 4 of 6, part id 1): RegraspEdgeRecord::arm is empty"});
+  // How an edge was connected and its path.
+  refused("unknown via", 0, [](RegraspEdgeRecord& e) { e.via = "rrt"; },
+          {"regrasp_edges.via (record 0 of 6, part id 1): RegraspEdgeRecord::via is 'rrt', "
+           "expected 'roadmap' or 'bridge' (or '' without a path)"});
+  refused("connected without via", 2, [](RegraspEdgeRecord& e) { e.via = ""; },
+          {"regrasp_edges.via (record 2 of 6, part id 1): RegraspEdgeRecord::via is '' for a "
+           "connected 'transit' edge, expected 'roadmap' or 'bridge'"});
+  refused("bridge on an unconnected edge", 3, [](RegraspEdgeRecord& e) { e.via = "bridge"; },
+          {"regrasp_edges.via (record 3 of 6, part id 1): RegraspEdgeRecord::via is 'bridge' for "
+           "an edge that is not connected, expected ''"});
+  refused("via on a handover", 4, [](RegraspEdgeRecord& e) { e.via = "roadmap"; },
+          {"regrasp_edges.via (record 4 of 6", "is 'roadmap' for a 'handover' edge, expected ''"});
+  refused("connected with one waypoint", 1, [](RegraspEdgeRecord& e) { e.path.resize(1); },
+          {"regrasp_edges.path (record 1 of 6, part id 1): RegraspEdgeRecord::path has 1 "
+           "waypoint for a connected 'transfer' edge, expected at least 2"});
+  refused("connected without a path", 5, [](RegraspEdgeRecord& e) { e.path.clear(); },
+          {"regrasp_edges.path (record 5 of 6", "has 0 waypoints", "expected at least 2"});
+  refused("handover with a path", 4,
+          [](RegraspEdgeRecord& e) { e.path.assign(2, Eigen::VectorXd::Zero(7)); },
+          {"regrasp_edges.path (record 4 of 6, part id 1): RegraspEdgeRecord::path has 2 "
+           "waypoints for a 'handover' edge, expected none"});
+  refused("unconnected with a path", 3,
+          [](RegraspEdgeRecord& e) { e.path.assign(2, Eigen::VectorXd::Zero(7)); },
+          {"regrasp_edges.path (record 3 of 6",
+           "has 2 waypoints for an edge that is not connected, expected none"});
+  refused("waypoints of different sizes", 0,
+          [](RegraspEdgeRecord& e) { e.path[3].conservativeResize(5); },
+          {"regrasp_edges.path (record 0 of 6, part id 1): RegraspEdgeRecord::path[3] has 5 "
+           "joint values, expected as many as path[0] (6)"});
+  refused(
+      "waypoints without joints", 5,
+      [](RegraspEdgeRecord& e) { e.path.assign(2, Eigen::VectorXd()); },
+      {"regrasp_edges.path (record 5 of 6", "path[0] has 0 joint values, expected at least one"});
+  refused("NaN waypoint", 2, [](RegraspEdgeRecord& e) { e.path[1][4] = std::nan(""); },
+          {"regrasp_edges.path[4] (record 2 of 6, part id 1, waypoint 1) must be finite, got nan"});
+  refused(
+      "infinite waypoint", 0,
+      [](RegraspEdgeRecord& e) { e.path.back()[0] = -std::numeric_limits<double>::infinity(); },
+      {"regrasp_edges.path[0] (record 0 of 6, part id 1, waypoint 5) must be finite, got -inf"});
 
   expect_database_error(
       dir, "unknown node", write_with(5, [](RegraspEdgeRecord& e) { e.to_node = 8; }),
@@ -784,6 +886,29 @@ TEST(RoadmapReader, DamagedRowsAreDatabaseErrors) {
           {"regrasp_nodes.solutions (id 7)", "got a value that is not finite (solution 0)"});
   damaged("board quaternion", "UPDATE regrasp_nodes SET board_qw = 2.0 WHERE id = 5",
           {"regrasp_nodes.board (id 5)", "a unit quaternion"});
+  // Edge 2 (part 1's transfer via a bridge) has 3 waypoints of 6 joints.
+  damaged("path truncated", "UPDATE regrasp_edges SET path = substr(path, 2) WHERE id = 2",
+          {path + ": regrasp_edges.path (id 2)",
+           "expected path_waypoints * path_dof = 3 * 6 joint values as little-endian doubles (48 "
+           "bytes each, 144 bytes)",
+           "got 143 bytes"});
+  damaged("path of another dof", "UPDATE regrasp_edges SET path_dof = 7 WHERE id = 2",
+          {"regrasp_edges.path (id 2)", "3 * 7 joint values", "got 144 bytes"});
+  damaged("NaN waypoint (little-endian 0x7ff8000000000000)",
+          "UPDATE regrasp_edges SET path = CAST(substr(path, 1, 48) || x'000000000000f87f' || "
+          "substr(path, 57) AS BLOB) WHERE id = 2",
+          {path + ": regrasp_edges.path (id 2)", "expected finite values",
+           "got a value that is not finite (waypoint 1)"});
+  damaged("one waypoint",
+          "UPDATE regrasp_edges SET path_waypoints = 1, path = substr(path, 1, 48) WHERE id = 2",
+          {"regrasp_edges.path_waypoints (id 2)", "expected 0 (no path) or an integer from 2",
+           "got 1"});
+  damaged("negative waypoints", "UPDATE regrasp_edges SET path_waypoints = -2 WHERE id = 2",
+          {"regrasp_edges.path_waypoints (id 2)", "got -2"});
+  damaged("no joints", "UPDATE regrasp_edges SET path_dof = 0, path = x'' WHERE id = 2",
+          {"regrasp_edges.path_dof (id 2)", "an integer from 1 to 2147483647", "got 0"});
+  damaged("joints without waypoints", "UPDATE regrasp_edges SET path_dof = 6 WHERE id = 4",
+          {"regrasp_edges.path_dof (id 4)", "expected 0 when path_waypoints is 0", "got 6"});
 }
 
 TEST(RoadmapReader, EmptyTablesOpen) {

@@ -190,6 +190,12 @@ TEST(Schema, RoadmapAndRegraspColumnsAreDeclared) {
            "path_nodes INTEGER NOT NULL",
            "CHECK ((kind = 'transfer') = (filter_id IS NOT NULL))",
            "CHECK (connected = 1 OR (cost = 0 AND path_nodes = 0))",
+           "via TEXT NOT NULL CHECK (via IN ('', 'roadmap', 'bridge'))",
+           "path_dof INTEGER NOT NULL",
+           "path_waypoints INTEGER NOT NULL",
+           "path BLOB NOT NULL",
+           "CHECK ((connected = 1 AND kind IN ('transit', 'transfer')) = (via <> ''))",
+           "CHECK ((via = '') = (path_waypoints = 0))",
        }) {
     EXPECT_NE(sql.find(column), std::string::npos) << column;
   }

@@ -111,7 +111,9 @@ class DatabaseWriter {
   // part_id and the ids are taken from each record. kind must be "transit", "transfer" or
   // "handover"; filter_id non-zero exactly for "transfer" (a written roadmap filter); from_node
   // and to_node written regrasp nodes; cost finite and >= 0, path_nodes >= 0, both 0 when not
-  // connected, cost 0 for a handover. Returns the ids.
+  // connected, cost 0 for a handover. A connected "transit" or "transfer" edge has via "roadmap"
+  // or "bridge" and a path of at least 2 waypoints, all of one size > 0 (finite); an edge that is
+  // not connected and a "handover" edge have via "" and no path. Returns the ids.
   std::vector<std::int64_t> add_regrasp_edges(const std::vector<RegraspEdgeRecord>& edges);
   void commit();
 

@@ -218,8 +218,8 @@ struct RegraspNodeRecord {
 
 // A regrasp-graph edge. kind: "transit" (arm moves empty), "transfer" (arm moves holding the
 // board; filter_id names the roadmap filter used), "handover" (suction arm -> gripper arm at a
-// robot-robot pose; cost 0). cost: joint-space length (rad) of the roadmap path found, when
-// connected; 0 and connected=false otherwise.
+// robot-robot pose; cost 0). cost: joint-space length (rad) of the path found, when connected; 0
+// and connected=false otherwise.
 struct RegraspEdgeRecord {
   std::int64_t id = 0;
   std::int64_t part_id = 0;
@@ -231,6 +231,14 @@ struct RegraspEdgeRecord {
   bool connected = false;
   double cost = 0.0;
   int path_nodes = 0;  // roadmap nodes on the path (0 when not connected)
+  // How the edge was connected: "roadmap" (a shortest path through the filtered roadmap, both
+  // ends attached by straight edges), "bridge" (a path planned around a cut in the roadmap by
+  // RRT-Connect under the same checks), "" when not connected or for a handover.
+  std::string via;
+  // The joint-space path from the from-node's first solution to the to-node's first solution,
+  // waypoints joined by straight segments (empty when not connected and for a handover; at
+  // least 2 waypoints of equal size otherwise).
+  std::vector<Eigen::VectorXd> path;
 };
 
 // Self-description of a database (the `meta` table, one key per field).
