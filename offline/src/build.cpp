@@ -65,6 +65,7 @@ std::string utc_now() {
 
 struct PartResult {
   HandoverResult handover;
+  RegraspResult regrasp;
   std::vector<db::ErgonomicsRecord> ergonomics;
   db::PartRecord record;
   std::vector<db::PlacementRecord> placements;
@@ -150,14 +151,20 @@ void run_tasks(int jobs, std::size_t count, const std::function<void(std::size_t
   }
 }
 
+struct HandoverIds {
+  std::vector<std::int64_t> robot_handovers;
+  std::vector<std::int64_t> candidates;
+};
+
+std::int64_t id_of(const std::vector<std::int64_t>& ids, std::int64_t index) {
+  return index < 0 ? 0 : ids[static_cast<std::size_t>(index)];
+}
+
 // Turns the result's 0-based indices into database ids and writes it.
-void write_handover(db::DatabaseWriter& writer, std::int64_t part_id, const HandoverResult& h,
-                    const std::vector<std::int64_t>& robot_ids,
-                    const std::vector<std::int64_t>& suction_ids,
-                    const std::vector<std::int64_t>& human_ids) {
-  auto id_of = [](const std::vector<std::int64_t>& ids, std::int64_t index) -> std::int64_t {
-    return index < 0 ? 0 : ids[static_cast<std::size_t>(index)];
-  };
+HandoverIds write_handover(db::DatabaseWriter& writer, std::int64_t part_id,
+                           const HandoverResult& h, const std::vector<std::int64_t>& robot_ids,
+                           const std::vector<std::int64_t>& suction_ids,
+                           const std::vector<std::int64_t>& human_ids) {
   db::HandoverStageRecord stage = h.stage;
   stage.part_id = part_id;
   writer.add_handover_stage(stage);
@@ -177,6 +184,40 @@ void write_handover(db::DatabaseWriter& writer, std::int64_t part_id, const Hand
     s.robot_handover_id = id_of(rr_ids, s.robot_handover_id);
   }
   writer.add_shared_grasps(shared);
+  return {rr_ids, candidate_ids};
+}
+
+// The same for the regrasp graph (filters, nodes, edges).
+void write_regrasp(db::DatabaseWriter& writer, std::int64_t part_id, const RegraspResult& r,
+                   const std::vector<std::int64_t>& roadmap_ids,
+                   const std::vector<std::int64_t>& robot_ids,
+                   const std::vector<std::int64_t>& suction_ids, const HandoverIds& handover) {
+  auto grasp_id = [&](const std::string& kind, std::int64_t index) {
+    return id_of(kind == "suction" ? suction_ids : robot_ids, index);
+  };
+  std::vector<db::RoadmapFilterRecord> filters = r.filters;
+  for (auto& f : filters) {
+    f.part_id = part_id;
+    f.roadmap_id = roadmap_ids[static_cast<std::size_t>(f.roadmap_id)];
+    f.grasp_id = grasp_id(f.grasp_kind, f.grasp_id);
+  }
+  const auto filter_ids = writer.add_roadmap_filters(filters);
+  std::vector<db::RegraspNodeRecord> nodes = r.nodes;
+  for (auto& n : nodes) {
+    n.part_id = part_id;
+    n.grasp_id = grasp_id(n.grasp_kind, n.grasp_id);
+    n.robot_handover_id = id_of(handover.robot_handovers, n.robot_handover_id);
+    n.candidate_id = id_of(handover.candidates, n.candidate_id);
+  }
+  const auto node_ids = writer.add_regrasp_nodes(nodes);
+  std::vector<db::RegraspEdgeRecord> edges = r.edges;
+  for (auto& e : edges) {
+    e.part_id = part_id;
+    e.from_node = id_of(node_ids, e.from_node);
+    e.to_node = id_of(node_ids, e.to_node);
+    e.filter_id = id_of(filter_ids, e.filter_id);
+  }
+  writer.add_regrasp_edges(edges);
 }
 
 }  // namespace
@@ -184,7 +225,7 @@ void write_handover(db::DatabaseWriter& writer, std::int64_t part_id, const Hand
 std::vector<std::string> BuildSummary::failed_parts() const {
   std::vector<std::string> out;
   for (const auto& p : parts) {
-    if (!p.handover_failure.empty()) out.push_back(p.name);
+    if (!p.handover_failure.empty() || !p.regrasp_failure.empty()) out.push_back(p.name);
   }
   return out;
 }
@@ -226,12 +267,18 @@ std::string settings_hash(const BuildSettings& s) {
        << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.two_hand_separation << ' '
        << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
        << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' '
-       << h.human_ik_goals;
+       << h.human_ik_goals << ' ' << h.pick_lift << ' ' << h.pick_resolution;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
        << ' ' << e.candidates_per_step << ' ' << e.ik_attempts << "\nbodies "
        << format_human_bodies(s.human_bodies) << '\n';
+  const auto& m = s.roadmap;
+  text << "roadmap " << m.nodes << ' ' << m.neighbours << ' ' << m.slip_bias << ' '
+       << m.vertical_cone_deg << ' ' << m.resolution << ' ' << m.joint_range << '\n';
+  const auto& g = s.regrasp;
+  text << "regrasp " << g.goals << ' ' << g.served_goals << ' ' << g.attach_neighbours << ' '
+       << g.bridge.max_checks << '\n';
   return db::sha256_hex(text.str());
 }
 
@@ -254,10 +301,14 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   // go to fixed slots, so the content does not depend on which thread ran what.
   const std::size_t n = product.parts.size();
   const std::size_t arms = cell->human_arms().size();
-  const int total = static_cast<int>(arms + 2 * n);
+  const std::vector<std::string> robot_arms{settings.handover.suction_arm,
+                                            settings.handover.receiving_arm};
+  const std::size_t roadmap_count = robot_arms.size();
+  const int total = static_cast<int>(roadmap_count + arms + 2 * n);
   std::vector<PartResult> results(n);
   std::vector<ComfortMap> maps(arms);
   std::vector<ComfortMapSummary> map_summaries(arms);
+  std::vector<Roadmap> roadmaps(roadmap_count);
   std::mutex progress_mutex;
   int done = 0;
   auto report = [&](const std::string& label) {
@@ -265,27 +316,44 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     ++done;
     if (progress) progress(label, done, total);
   };
+  auto report_partial = [&](const std::string& label) {
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    if (progress) progress(label, done, total);
+  };
   auto comfort_seed = [&](std::size_t a) {
     ComfortMapSettings comfort = settings.comfort;
     comfort.seed = part_seed(settings.seed, "comfort:" + cell->human_arms()[a].spec.name, 3);
     return comfort;
   };
-  run_tasks(settings.jobs, arms + n, [&](std::size_t t) {
-    // Comfort maps are the longest tasks: they go first.
-    if (t < arms) {
+  run_tasks(settings.jobs, roadmap_count + arms + n, [&](std::size_t t) {
+    // Longest first: the robot roadmaps, then the comfort maps, then the parts.
+    if (t < roadmap_count) {
+      RoadmapSettings roadmap = settings.roadmap;
+      roadmap.suction_arm = settings.handover.suction_arm;
+      roadmap.seed = part_seed(settings.seed, "roadmap:" + robot_arms[t], 6);
+      const std::string label = "roadmap, " + robot_arms[t] + " arm";
+      roadmaps[t] = build_roadmap(*cell, robot_arms[t], roadmap, [&](int milestones) {
+        report_partial(label + ": " + std::to_string(milestones) + "/" +
+                       std::to_string(roadmap.nodes) + " milestones");
+      });
+      report(label + " (" + std::to_string(roadmaps[t].nodes.size()) + " nodes, " +
+             std::to_string(roadmaps[t].edges.size()) + " edges)");
+    } else if (t < roadmap_count + arms) {
+      const std::size_t a = t - roadmap_count;
       const auto start_map = std::chrono::steady_clock::now();
-      const core::HumanArm& arm = cell->human_arms()[t];
-      maps[t] = ComfortMap::build(arm.chain, comfort_seed(t));
-      auto& s = map_summaries[t];
+      const core::HumanArm& arm = cell->human_arms()[a];
+      maps[a] = ComfortMap::build(arm.chain, comfort_seed(a));
+      auto& s = map_summaries[a];
       s.arm = arm.spec.name;
-      s.filled_bins = maps[t].filled_bins();
-      s.coverage = maps[t].coverage();
+      s.filled_bins = maps[a].filled_bins();
+      s.coverage = maps[a].coverage();
       s.seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_map).count();
       report("comfort map, " + arm.spec.name + " arm");
     } else {
-      results[t - arms] = build_part(product, t - arms, *cell, settings);
-      report(product.parts[t - arms].name);
+      const std::size_t i = t - roadmap_count - arms;
+      results[i] = build_part(product, i, *cell, settings);
+      report(product.parts[i].name);
     }
   });
 
@@ -294,6 +362,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     PartResult& r = results[i];
     BoardGrasps grasps{r.robot, r.suction, r.human, r.record.mass_properties.com};
     HandoverSettings handover = settings.handover;
+    handover.pick_resolution = settings.roadmap.resolution;
     handover.seed = part_seed(settings.seed, product.parts[i].name, 4);
     r.handover = plan_handover_goals(*cell, product, i, grasps, comfort, handover);
     ErgonomicsInputs in;
@@ -335,7 +404,27 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
         if (c.rank == 0) s.goal_quality = c.quality;
       }
     }
-    report(product.parts[i].name + " handover");
+    RegraspSettings regrasp = settings.regrasp;
+    regrasp.suction_arm = settings.handover.suction_arm;
+    regrasp.receiving_arm = settings.handover.receiving_arm;
+    regrasp.lift = settings.handover.pick_lift;
+    regrasp.seed = part_seed(settings.seed, product.parts[i].name, 7);
+    r.regrasp =
+        plan_regrasp(*cell, product, i, grasps, r.handover, roadmaps[0], roadmaps[1], regrasp);
+    const auto& g = r.regrasp;
+    s.regrasp_filters = static_cast<int>(g.filters.size());
+    s.regrasp_nodes = static_cast<int>(g.nodes.size());
+    s.regrasp_edges = static_cast<int>(g.edges.size());
+    s.transfers = g.transfers;
+    s.transfers_connected = g.transfers_connected;
+    s.bridges = g.bridges;
+    s.goals_considered = g.goals_considered;
+    s.goals_served = g.goals_served;
+    s.first_served_rank = g.first_served_rank;
+    // A board without goals already says why; the regrasp failure adds only a new reason.
+    if (s.handover_failure.empty()) s.regrasp_failure = g.failure;
+    s.regrasp_seconds = g.seconds;
+    report(product.parts[i].name + " handover and regrasp graph");
   });
 
   db::Meta meta;
@@ -352,13 +441,21 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   writer.write_meta(meta);
   BuildSummary summary;
   summary.output = output_path;
+  std::vector<std::int64_t> roadmap_ids;
+  for (const auto& m : roadmaps) {
+    roadmap_ids.push_back(writer.add_roadmap(to_record(m)));
+    summary.roadmaps.push_back(
+        {m.arm, static_cast<int>(m.nodes.size()), static_cast<int>(m.edges.size()), m.seconds});
+  }
   for (auto& r : results) {
     const std::int64_t id = writer.add_part(r.record);
     writer.add_placements(id, r.placements);
     const auto robot_ids = writer.add_robot_grasps(id, r.robot);
     const auto suction_ids = writer.add_suction_grasps(id, r.suction);
     const auto human_ids = writer.add_human_grasps(id, r.human);
-    write_handover(writer, id, r.handover, robot_ids, suction_ids, human_ids);
+    const HandoverIds handover_ids =
+        write_handover(writer, id, r.handover, robot_ids, suction_ids, human_ids);
+    write_regrasp(writer, id, r.regrasp, roadmap_ids, robot_ids, suction_ids, handover_ids);
     writer.add_ergonomics(id, r.ergonomics);
     summary.parts.push_back(r.summary);
   }

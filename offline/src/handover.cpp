@@ -9,9 +9,11 @@
 #include "hila/core/error.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
+#include "hila/offline/arm_workspace.hpp"
 #include "hila/offline/comfort.hpp"
 #include "hila/offline/comfort_map.hpp"
 #include "hila/offline/human_grasps.hpp"
+#include "hila/offline/suction_pick.hpp"
 
 namespace hila::offline {
 
@@ -451,6 +453,22 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   const int n_pos = static_cast<int>(settings.rr_positions.size());
   const int n_orient = static_cast<int>(orientations.size());
   const int n_suction = static_cast<int>(grasps.suction.size());
+  // Suction grasps usable from the stack: a robot-robot pose with any other is unreachable.
+  std::vector<char> pickable(static_cast<std::size_t>(n_suction), 0);
+  {
+    ArmWorkspace pick(cell, suction_arm.spec.name, suction_arm.spec.name, &part.mesh);
+    for (int s = 0; s < n_suction; ++s) {
+      pickable[static_cast<std::size_t>(s)] =
+          plan_suction_pick(pick, part.initial, grasps.suction[static_cast<std::size_t>(s)],
+                            settings.pick_lift, settings.pick_resolution)
+              .ok();
+    }
+  }
+  if (std::count(pickable.begin(), pickable.end(), 1) == 0) {
+    return finish("the " + suction_arm.spec.name + " arm cannot take the board from the stack " +
+                  "with any of its " + std::to_string(n_suction) +
+                  " suction grasps (IK, collision at the initial pose, or the lift)");
+  }
   std::vector<int> favoured, spread;
   for (int i = 0; i < n_pos * n_orient * n_suction; ++i) {
     ((i / n_suction) % n_orient < n_favoured ? favoured : spread).push_back(i);
@@ -465,6 +483,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   for (const int combo : order) {
     if (examined >= settings.rr_poses) break;
     const int s = combo % n_suction;
+    if (!pickable[static_cast<std::size_t>(s)]) continue;
     const int o = (combo / n_suction) % n_orient;
     const int p = combo / (n_suction * n_orient);
     core::Pose board = core::Pose::Identity();

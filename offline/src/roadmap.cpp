@@ -19,8 +19,10 @@
 
 #include "hila/core/collision.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/roadmap_graph.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
+#include "hila/offline/arm_workspace.hpp"
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
@@ -41,42 +43,12 @@ void from_vector(const Eigen::VectorXd& q, ob::State* s) {
   for (Eigen::Index i = 0; i < q.size(); ++i) v->values[i] = q[i];
 }
 
-// The arm against the static cell (the other arm at home). One instance per thread.
-class ArmChecker {
- public:
-  ArmChecker(const core::Cell& cell, const core::Arm& arm, int arm_index)
-      : cell_(cell),
-        arm_(arm),
-        scene_(core::build_cell_scene(cell)),
-        data_(scene_.model),
-        bodies_(scene_.arm_bodies[static_cast<std::size_t>(arm_index)]),
-        q_(cell.home_configuration()),
-        human_q_(cell.human_neutral()) {
-    core::set_cell_state(cell_, scene_, data_, q_, human_q_);
-  }
-  bool valid(const Eigen::VectorXd& arm_q) {
-    if (!arm_.chain.within_limits(arm_q, 1e-12)) return false;
-    cell_.set_arm(q_, arm_, arm_q);
-    core::set_robot_state(cell_, scene_, data_, q_);
-    return !core::in_collision(scene_.model, data_, bodies_);
-  }
-
- private:
-  const core::Cell& cell_;
-  const core::Arm& arm_;
-  core::CellScene scene_;
-  core::CollisionData data_;
-  std::vector<int> bodies_;
-  Eigen::VectorXd q_;
-  Eigen::VectorXd human_q_;
-};
-
 // Uniform joint-space samples mixed with IK samples of gripper poses whose opening axis is
 // near vertical (the slip-constrained region, thin in joint space).
 class SlipBiasedSampler : public ob::ValidStateSampler {
  public:
   SlipBiasedSampler(const ob::SpaceInformation* si, const core::Cell& cell, const core::Arm& arm,
-                    ArmChecker& checker, const RoadmapSettings& settings)
+                    ArmWorkspace& checker, const RoadmapSettings& settings)
       : ob::ValidStateSampler(si),
         cell_(cell),
         arm_(arm),
@@ -104,7 +76,7 @@ class SlipBiasedSampler : public ob::ValidStateSampler {
       } else {
         q = uniform_joints();
       }
-      if (checker_.valid(q)) {
+      if (checker_.arm_valid(q)) {
         from_vector(q, state);
         return true;
       }
@@ -117,7 +89,7 @@ class SlipBiasedSampler : public ob::ValidStateSampler {
     for (int attempt = 0; attempt < 100; ++attempt) {
       Eigen::VectorXd q = centre;
       for (Eigen::Index i = 0; i < q.size(); ++i) q[i] += n(rng_);
-      if (checker_.valid(q)) {
+      if (checker_.arm_valid(q)) {
         from_vector(q, state);
         return true;
       }
@@ -128,8 +100,8 @@ class SlipBiasedSampler : public ob::ValidStateSampler {
  private:
   double uniform() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
   Eigen::VectorXd uniform_joints() {
-    const auto& lo = arm_.chain.lower_limits();
-    const auto& hi = arm_.chain.upper_limits();
+    const Eigen::VectorXd lo = roadmap_lower(arm_, settings_);
+    const Eigen::VectorXd hi = roadmap_upper(arm_, settings_);
     Eigen::VectorXd q(lo.size());
     for (Eigen::Index i = 0; i < q.size(); ++i) q[i] = lo[i] + uniform() * (hi[i] - lo[i]);
     return q;
@@ -154,12 +126,14 @@ class SlipBiasedSampler : public ob::ValidStateSampler {
     // Mostly the branch nearest home (dense within one branch, so near neighbours connect).
     const auto pick = uniform() < 0.75 ? 0 : rng_() % static_cast<std::uint64_t>(n);
     q = solutions.q[static_cast<std::size_t>(pick)];
-    return true;
+    const Eigen::VectorXd lo = roadmap_lower(arm_, settings_);
+    const Eigen::VectorXd hi = roadmap_upper(arm_, settings_);
+    return (q.array() >= lo.array()).all() && (q.array() <= hi.array()).all();
   }
 
   const core::Cell& cell_;
   const core::Arm& arm_;
-  ArmChecker& checker_;
+  ArmWorkspace& checker_;
   RoadmapSettings settings_;
   std::mt19937_64 rng_;
   core::Pose base_;
@@ -180,6 +154,20 @@ class LinearPrm : public og::PRM {
 
 }  // namespace
 
+Eigen::VectorXd roadmap_lower(const core::Arm& arm, const RoadmapSettings& settings) {
+  return arm.chain.lower_limits()
+      .array()
+      .max(arm.spec.home.array() - settings.joint_range)
+      .matrix();
+}
+
+Eigen::VectorXd roadmap_upper(const core::Arm& arm, const RoadmapSettings& settings) {
+  return arm.chain.upper_limits()
+      .array()
+      .min(arm.spec.home.array() + settings.joint_range)
+      .matrix();
+}
+
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
                                           double resolution) {
   const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
@@ -188,21 +176,20 @@ std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen:
   return out;
 }
 
-std::vector<int> attach_configuration(const core::Cell& cell, const Roadmap& roadmap,
-                                      const GraspSlip& grasp, const Eigen::VectorXd& q, int k) {
-  const core::Arm& arm = cell.arm(roadmap.arm);
-  int arm_index = 0;
-  while (&cell.arms()[static_cast<std::size_t>(arm_index)] != &arm) ++arm_index;
-  ArmChecker checker(cell, arm, arm_index);
-  const Eigen::Matrix3d base_rotation = core::arm_base_in_world(cell, arm).linear();
+std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Roadmap& roadmap,
+                                             const GraspSlip& grasp, const Eigen::VectorXd& q,
+                                             int k) {
+  const Eigen::Matrix3d base_rotation = workspace.base().linear();
   const Eigen::Vector3d normal = grasp.axis.cross(grasp.lever);
   const double limit = std::sin(core::deg_to_rad(std::min(grasp.theta_c_deg, 90.0))) + 1e-12;
   auto ok = [&](const Eigen::VectorXd& x) {
-    return checker.valid(x) && std::abs(gravity_in_tcp(arm, base_rotation, x).dot(normal)) <= limit;
+    return std::abs(gravity_in_tcp(workspace.arm(), base_rotation, x).dot(normal)) <= limit &&
+           workspace.valid(x);
   };
-  std::vector<int> out;
+  std::vector<Attachment> out;
   if (!ok(q)) return out;
   std::vector<std::pair<double, int>> near;
+  near.reserve(roadmap.nodes.size());
   for (std::size_t i = 0; i < roadmap.nodes.size(); ++i) {
     near.emplace_back((roadmap.nodes[i] - q).norm(), static_cast<int>(i));
   }
@@ -215,9 +202,51 @@ std::vector<int> attach_configuration(const core::Cell& cell, const Roadmap& roa
       if (!free) break;
       free = ok(x);
     }
-    if (free) out.push_back(near[j].second);
+    if (free) out.push_back({near[j].second, near[j].first});
   }
   return out;
+}
+
+std::vector<bool> held_board_filter(ArmWorkspace& workspace, const Roadmap& roadmap,
+                                    std::vector<bool> edges) {
+  // Node verdicts: -1 unknown, 0 blocked, 1 clear.
+  std::vector<signed char> node_clear(roadmap.nodes.size(), -1);
+  auto clear_node = [&](int n) {
+    auto& v = node_clear[static_cast<std::size_t>(n)];
+    if (v < 0) v = workspace.board_clear(roadmap.nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
+    return v == 1;
+  };
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    if (!edges[e]) continue;
+    const auto [a, b] = roadmap.edges[e];
+    bool ok = clear_node(a) && clear_node(b);
+    if (ok) {
+      for (const auto& q :
+           edge_samples(roadmap.nodes[static_cast<std::size_t>(a)],
+                        roadmap.nodes[static_cast<std::size_t>(b)], roadmap.resolution)) {
+        if (!workspace.board_clear(q)) {
+          ok = false;
+          break;
+        }
+      }
+    }
+    edges[e] = ok;
+  }
+  return edges;
+}
+
+db::RoadmapRecord to_record(const Roadmap& roadmap) {
+  db::RoadmapRecord r;
+  r.arm = roadmap.arm;
+  r.dof = roadmap.dof;
+  r.resolution = roadmap.resolution;
+  r.nodes = roadmap.nodes;
+  r.node_gravity = roadmap.node_gravity;
+  r.node_inclination_deg = roadmap.node_inclination_deg;
+  r.edges = roadmap.edges;
+  r.edge_length = roadmap.edge_length;
+  r.edge_max_inclination_deg = roadmap.edge_max_inclination_deg;
+  return r;
 }
 
 std::vector<bool> slip_filter(const Roadmap& roadmap, const GraspSlip& grasp) {
@@ -240,30 +269,7 @@ std::vector<bool> slip_filter(const Roadmap& roadmap, const GraspSlip& grasp) {
 }
 
 std::vector<int> connected_components(const Roadmap& roadmap, const std::vector<bool>& edges) {
-  std::vector<int> parent(roadmap.nodes.size());
-  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-  auto find = [&](int x) {
-    while (parent[static_cast<std::size_t>(x)] != x) {
-      parent[static_cast<std::size_t>(x)] =
-          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-      x = parent[static_cast<std::size_t>(x)];
-    }
-    return x;
-  };
-  for (std::size_t e = 0; e < roadmap.edges.size(); ++e) {
-    if (!edges[e]) continue;
-    const int ra = find(roadmap.edges[e].first), rb = find(roadmap.edges[e].second);
-    if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-  }
-  std::vector<int> id(parent.size(), -1);
-  std::vector<int> root_id(parent.size(), -1);
-  int next = 0;
-  for (std::size_t i = 0; i < parent.size(); ++i) {
-    const auto r = static_cast<std::size_t>(find(static_cast<int>(i)));
-    if (root_id[r] < 0) root_id[r] = next++;
-    id[i] = root_id[r];
-  }
-  return id;
+  return core::connected_components(static_cast<int>(roadmap.nodes.size()), roadmap.edges, edges);
 }
 
 Eigen::Vector3d gravity_in_tcp(const core::Arm& arm, const Eigen::Matrix3d& base_rotation,
@@ -273,7 +279,8 @@ Eigen::Vector3d gravity_in_tcp(const core::Arm& arm, const Eigen::Matrix3d& base
 }
 
 Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
-                      const RoadmapSettings& settings) {
+                      const RoadmapSettings& settings,
+                      const std::function<void(int milestones)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   const core::Arm& arm = cell.arm(arm_name);
   if (!arm.ur_ik) {
@@ -282,8 +289,6 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
                            "analytic IK)",
                            "none");
   }
-  int arm_index = 0;
-  while (&cell.arms()[static_cast<std::size_t>(arm_index)] != &arm) ++arm_index;
   const int dof = arm.chain.dof();
   const Eigen::Matrix3d base_rotation = core::arm_base_in_world(cell, arm).linear();
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
@@ -291,13 +296,14 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
   auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
   ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
   for (int i = 0; i < dof; ++i) {
-    bounds.setLow(static_cast<unsigned>(i), arm.chain.lower_limits()[i]);
-    bounds.setHigh(static_cast<unsigned>(i), arm.chain.upper_limits()[i]);
+    bounds.setLow(static_cast<unsigned>(i), roadmap_lower(arm, settings)[i]);
+    bounds.setHigh(static_cast<unsigned>(i), roadmap_upper(arm, settings)[i]);
   }
   space->setBounds(bounds);
   auto si = std::make_shared<ob::SpaceInformation>(space);
-  ArmChecker checker(cell, arm, arm_index);
-  si->setStateValidityChecker([&](const ob::State* s) { return checker.valid(to_vector(s, dof)); });
+  ArmWorkspace checker(cell, arm_name, settings.suction_arm);
+  si->setStateValidityChecker(
+      [&](const ob::State* s) { return checker.arm_valid(to_vector(s, dof)); });
   si->setStateValidityCheckingResolution(settings.resolution / space->getMaximumExtent());
   si->setValidStateSamplerAllocator([&](const ob::SpaceInformation* s) {
     return std::make_shared<SlipBiasedSampler>(s, cell, arm, checker, settings);
@@ -308,8 +314,15 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
   prm.setMaxNearestNeighbors(static_cast<unsigned>(settings.neighbours));
   prm.setProblemDefinition(std::make_shared<ob::ProblemDefinition>(si));
   prm.setup();
-  prm.growRoadmap(ob::PlannerTerminationCondition(
-      [&] { return prm.milestoneCount() >= static_cast<unsigned long>(settings.nodes); }));
+  unsigned long reported = 0;
+  prm.growRoadmap(ob::PlannerTerminationCondition([&] {
+    const unsigned long count = prm.milestoneCount();
+    if (progress && count >= reported + 250) {
+      reported = count - count % 250;
+      progress(static_cast<int>(reported));
+    }
+    return count >= static_cast<unsigned long>(settings.nodes);
+  }));
 
   ob::PlannerData data(si);
   prm.getPlannerData(data);
@@ -341,7 +354,7 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm_name,
       double worst = std::max(map.node_inclination_deg[static_cast<std::size_t>(key.first)],
                               map.node_inclination_deg[static_cast<std::size_t>(key.second)]);
       for (const auto& q : samples) {
-        if (!checker.valid(q)) {
+        if (!checker.arm_valid(q)) {
           free = false;
           break;
         }

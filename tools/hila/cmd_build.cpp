@@ -20,6 +20,7 @@ struct BuildOptions {
   int handover_candidates = offline::HandoverSettings{}.candidates;
   double comfort_threshold = offline::HandoverSettings{}.comfort_threshold;
   std::string bodies;
+  int roadmap_nodes = offline::RoadmapSettings{}.nodes;
 };
 
 int run_build(const BuildOptions& opt) {
@@ -29,6 +30,7 @@ int run_build(const BuildOptions& opt) {
   settings.comfort.samples = opt.comfort_samples;
   settings.handover.candidates = opt.handover_candidates;
   settings.handover.comfort_threshold = opt.comfort_threshold;
+  settings.roadmap.nodes = opt.roadmap_nodes;
   if (!opt.bodies.empty())
     settings.human_bodies = offline::parse_human_bodies(opt.bodies, "--bodies");
   // Progress only for a person watching a terminal; logs and pipes stay clean.
@@ -75,6 +77,29 @@ int run_build(const BuildOptions& opt) {
     std::cout << std::setw(9) << std::setprecision(2) << p.handover_seconds
               << (p.two_hands ? "  (two hands)" : "") << "\n";
   }
+  for (const auto& m : summary.roadmaps) {
+    std::cout << "  roadmap, " << m.arm << " arm: " << m.nodes << " nodes, " << m.edges
+              << " edges (" << std::setprecision(1) << m.seconds << " s)\n";
+  }
+  std::cout
+      << "  regrasp graph (first goals' shared grasps; transfers = receiving arm, robot-robot "
+         "-> robot-human, within the grasp's filter):\n";
+  std::cout
+      << "  #  part           filters  nodes  edges  transfers  goals served  first  time s\n";
+  for (const auto& p : summary.parts) {
+    std::cout << "  " << p.order << "  " << std::left << std::setw(14) << p.name << std::right
+              << std::setw(8) << p.regrasp_filters << std::setw(7) << p.regrasp_nodes
+              << std::setw(7) << p.regrasp_edges << std::setw(6) << p.transfers_connected << "/"
+              << std::left << std::setw(4) << p.transfers << std::right << std::setw(9)
+              << p.goals_served << "/" << std::left << std::setw(4) << p.goals_considered
+              << std::right << std::setw(5);
+    if (p.first_served_rank >= 0) {
+      std::cout << p.first_served_rank;
+    } else {
+      std::cout << "-";
+    }
+    std::cout << std::setw(8) << std::setprecision(2) << p.regrasp_seconds << "\n";
+  }
   if (!settings.human_bodies.empty()) {
     std::cout << "  body set: " << offline::format_human_bodies(settings.human_bodies) << "\n";
     for (const auto& p : summary.parts) {
@@ -87,12 +112,17 @@ int run_build(const BuildOptions& opt) {
     if (!p.handover_failure.empty()) {
       std::cerr << "hila: " << p.name << ": no handover goal: " << p.handover_failure << "\n";
     }
+    if (!p.regrasp_failure.empty()) {
+      std::cerr << "hila: " << p.name
+                << ": no goal reachable in the roadmaps: " << p.regrasp_failure << "\n";
+    }
   }
   if (!failed.empty()) {
     std::cerr << "hila: " << failed.size() << " of " << summary.parts.size()
-              << " boards have no handover goal; the database was written with the reasons "
-                 "(hila inspect "
-              << summary.output << " handover --part NAME)\n";
+              << " boards have no handover goal reachable in the roadmaps; the database was "
+                 "written with the reasons (hila inspect "
+              << summary.output << " handover --part NAME, hila inspect " << summary.output
+              << " roadmap --part NAME)\n";
     return 1;
   }
   return 0;
@@ -125,6 +155,11 @@ void add_build_command(CLI::App& app, Action& action) {
       ->check(CLI::Range(0.0, 1.0));
   build->add_option("--bodies", opt->bodies,
                     "human bodies every goal must suit, e.g. 1.50:female,1.722,1.88:male");
+  build
+      ->add_option("--roadmap-nodes", opt->roadmap_nodes,
+                   "PRM milestones per robot arm roadmap (fewer: a faster, sparser build)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   build->add_option("--jobs", opt->jobs, "worker threads over parts")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

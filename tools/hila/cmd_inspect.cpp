@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
+#include "inspect_roadmap.hpp"
 
 namespace hila::tools {
 
@@ -287,8 +288,10 @@ int run_inspect(const InspectOptions& opt) {
     }
     return 0;
   }
+  if (opt.what == "roadmap") return inspect_roadmap(database, opt.arm, opt.part, opt.json);
   if (opt.what != "summary") {
-    throw core::InputError("command line", "what", "summary, grasps, comfort, handover or digest",
+    throw core::InputError("command line", "what",
+                           "summary, grasps, comfort, handover, roadmap or digest",
                            "'" + opt.what + "'");
   }
   const auto j = summary_json(database);
@@ -319,12 +322,14 @@ void add_inspect_command(CLI::App& app, Action& action) {
   auto opt = std::make_shared<InspectOptions>();
   auto* inspect = app.add_subcommand("inspect", "Show what a product database holds");
   inspect->add_option("database", opt->database, "database file")->required();
-  inspect->add_option("what", opt->what, "summary (default), grasps, comfort, handover or digest")
+  inspect
+      ->add_option("what", opt->what,
+                   "summary (default), grasps, comfort, handover, roadmap or digest")
       ->capture_default_str();
-  inspect->add_option("--part", opt->part, "part name (for grasps and handover)");
+  inspect->add_option("--part", opt->part, "part name (for grasps, handover and roadmap)");
   inspect->add_option("--limit", opt->limit, "goals listed (handover, text)")
       ->capture_default_str();
-  inspect->add_option("--arm", opt->arm, "human arm name (for comfort)");
+  inspect->add_option("--arm", opt->arm, "human arm (comfort) or robot arm (roadmap) name");
   inspect->add_flag("--json", opt->json, "print JSON");
   inspect->callback([opt, &action] { action = [opt] { return run_inspect(*opt); }; });
 }

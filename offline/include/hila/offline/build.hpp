@@ -12,6 +12,7 @@
 #include "hila/offline/ergonomics.hpp"
 #include "hila/offline/handover.hpp"
 #include "hila/offline/human_grasps.hpp"
+#include "hila/offline/regrasp.hpp"
 #include "hila/offline/robot_grasps.hpp"
 #include "hila/offline/suction_grasps.hpp"
 
@@ -26,6 +27,8 @@ struct BuildSettings {
   ComfortMapSettings comfort;  // one map per human arm of the cell
   HandoverSettings handover;
   ErgonomicsSettings ergonomics;
+  RoadmapSettings roadmap;  // one per arm; suction_arm follows handover.suction_arm
+  RegraspSettings regrasp;  // arms follow handover's
   // Empty: handover goals must be comfortable for the cell's human. Otherwise for every body of
   // the set (statures and sexes, served by the cell human's maps; see HumanComfort).
   std::vector<core::HumanBodySpec> human_bodies;
@@ -55,6 +58,25 @@ struct PartBuildSummary {
   double goal_distance = 0.0;    // Eq. 8
   std::string handover_failure;  // empty when the board has goals
   double handover_seconds = 0.0;
+  // Regrasp graph (filtered roadmaps, paper §V).
+  int regrasp_filters = 0;
+  int regrasp_nodes = 0;
+  int regrasp_edges = 0;
+  int transfers = 0;  // receiving-arm robot-robot -> robot-human transfers tried
+  int transfers_connected = 0;
+  int bridges = 0;
+  int goals_considered = 0;
+  int goals_served = 0;  // goals whose whole chain connects in the roadmaps
+  int first_served_rank = -1;
+  std::string regrasp_failure;
+  double regrasp_seconds = 0.0;
+};
+
+struct RoadmapSummary {
+  std::string arm;
+  int nodes = 0;
+  int edges = 0;
+  double seconds = 0.0;
 };
 
 struct ComfortMapSummary {
@@ -68,8 +90,10 @@ struct BuildSummary {
   std::string output;
   std::vector<PartBuildSummary> parts;          // in assembly order
   std::vector<ComfortMapSummary> comfort_maps;  // in the cell's human-arm order
+  std::vector<RoadmapSummary> roadmaps;         // suction arm, receiving arm
   double seconds = 0.0;
-  // Boards without a handover goal (the database is still written, with the reason stored).
+  // Boards without a handover goal, or whose goals none connect in the roadmaps (the database
+  // is still written, with the reasons stored).
   std::vector<std::string> failed_parts() const;
 };
 

@@ -36,6 +36,11 @@ struct HandoverSettings {
       {0.35, -0.08, 1.30}, {0.35, 0.0, 1.30}, {0.35, 0.08, 1.30},
       {0.45, -0.08, 1.30}, {0.45, 0.0, 1.30}, {0.45, 0.08, 1.30},
       {0.35, 0.0, 1.42},   {0.45, 0.0, 1.42}, {0.40, 0.0, 1.20}};
+  // Only suction grasps the suction arm can use to take the board from the stack (IK and
+  // collision at the initial pose, then a collision-free lift of pick_lift m straight up checked
+  // at pick_resolution rad) are used at robot-robot poses.
+  double pick_lift = 0.05;
+  double pick_resolution = 0.05;
   int rr_orientations = 64;  // board orientations tried per position (spread over SO(3))
   int rr_poses = 24;         // suction-feasible robot-robot poses examined for receiving grasps
   int shared_stored = 8;     // shared grasps searched for and stored per goal

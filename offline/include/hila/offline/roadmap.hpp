@@ -2,11 +2,14 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "hila/core/cell.hpp"
+#include "hila/db/records.hpp"
+#include "hila/offline/arm_workspace.hpp"
 
 namespace hila::offline {
 
@@ -20,13 +23,19 @@ struct RoadmapSettings {
   // Edges are checked (collision) and annotated (inclination) at most this far apart in joint
   // space (rad, Euclidean over the six joints).
   double resolution = 0.05;
+  // Each joint's range in the roadmap: within this much of home (and the limits). A UR's +-2 pi
+  // joints would otherwise leave the milestones far apart (measured: 28 components, mean edge
+  // 2 rad at 3000 milestones); IK solutions are wrapped nearest home, so goals fall inside.
+  double joint_range = 3.14159265358979323846;
   std::uint64_t seed = 1;
+  // The arm that keeps the suction tool in its hand: the tool moves with it in every check.
+  std::string suction_arm = "right";
 };
 
 // A joint-space roadmap of one arm over the static cell (table, robot body, the other arm at
-// home, the human at the stance), built with OMPL's PRM on OMPL's state space and
-// nearest-neighbour structures. Every node and edge is collision-free at the resolution;
-// milestones PRM could not connect to any other are left out.
+// home, the human at the stance, the suction tool in the suction arm's hand; see ArmWorkspace),
+// built with OMPL's PRM on OMPL's state space and nearest-neighbour structures. Every node and edge
+// is collision-free at the resolution; milestones PRM could not connect to any other are left out.
 struct Roadmap {
   std::string arm;
   int dof = 0;
@@ -44,8 +53,17 @@ struct Roadmap {
   double seconds = 0.0;
 };
 
+// `progress` (optional) is called with the milestone count as PRM grows (every 250).
 Roadmap build_roadmap(const core::Cell& cell, const std::string& arm,
-                      const RoadmapSettings& settings);
+                      const RoadmapSettings& settings,
+                      const std::function<void(int milestones)>& progress = {});
+
+// The joint box the roadmap samples: the limits, narrowed to home +- joint_range.
+Eigen::VectorXd roadmap_lower(const core::Arm& arm, const RoadmapSettings& settings);
+Eigen::VectorXd roadmap_upper(const core::Arm& arm, const RoadmapSettings& settings);
+
+// The database form (edge gravity samples are not stored: filters are computed offline).
+db::RoadmapRecord to_record(const Roadmap& roadmap);
 
 // What a held part needs of the roadmap: the grasp's opening axis and the unit lever from the
 // axis to the centre of mass, both in the TCP frame, and its relaxation limit.
@@ -63,11 +81,23 @@ std::vector<bool> slip_filter(const Roadmap& roadmap, const GraspSlip& grasp);
 // the lowest node of each component).
 std::vector<int> connected_components(const Roadmap& roadmap, const std::vector<bool>& edges);
 
-// Roadmap nodes among the `k` nearest (joint space) that a straight edge from `q` reaches
-// collision-free against the static cell and within the grasp's slip limit at the roadmap's
-// resolution; `q` itself must satisfy both, else none. (The held part is not checked yet.)
-std::vector<int> attach_configuration(const core::Cell& cell, const Roadmap& roadmap,
-                                      const GraspSlip& grasp, const Eigen::VectorXd& q, int k);
+// Of the edges set in `edges` (e.g. a slip_filter), those along which the board the workspace
+// holds stays clear of the static cell, at every node and interior sample. Nodes are checked
+// once each.
+std::vector<bool> held_board_filter(ArmWorkspace& workspace, const Roadmap& roadmap,
+                                    std::vector<bool> edges);
+
+struct Attachment {
+  int node = -1;
+  double cost = 0.0;  // joint-space length of the straight connection, rad
+};
+
+// Roadmap nodes among the `k` nearest (joint space) that a straight edge from `q` reaches within
+// the grasp's slip limit and valid in the workspace (the arm and, when it holds one, the board)
+// at the roadmap's resolution; `q` itself must satisfy both, else none. Nearest first.
+std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Roadmap& roadmap,
+                                             const GraspSlip& grasp, const Eigen::VectorXd& q,
+                                             int k);
 
 // The interior samples of the straight joint-space segment a -> b at `resolution` (what the
 // roadmap checks and annotates): ceil(|b - a| / resolution) - 1 points, evenly spaced.

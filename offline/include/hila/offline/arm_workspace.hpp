@@ -1,0 +1,69 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/collision.hpp"
+#include "hila/core/stage_scene.hpp"
+
+namespace hila::offline {
+
+// One arm moving through the static cell (table, robot body, the other arm at home, the human at
+// the stance, the suction tool in the suction arm's hand), optionally holding a board. The
+// roadmaps are built and filtered against this scene. Mutable: one per thread.
+class ArmWorkspace {
+ public:
+  // `board`: the mesh a held board has (nullptr: the arm never holds one).
+  ArmWorkspace(const core::Cell& cell, const std::string& arm, const std::string& suction_arm,
+               const core::TriangleMesh* board = nullptr);
+
+  const core::Arm& arm() const { return arm_; }
+  int arm_index() const { return arm_index_; }
+  bool is_suction_arm() const { return arm_index_ == scene_.suction_arm; }
+  const core::Pose& base() const { return base_; }
+  const core::StageScene& scene() const { return scene_; }
+
+  // Within the joint limits and the arm (with the tool when it is the suction arm) clear of the
+  // cell. Poses the arm: board_clear(q) may follow.
+  bool arm_valid(const Eigen::VectorXd& q);
+
+  // Holds the board at `board_in_tcp` with the gripper open to `jaw` (the suction arm: the jaw
+  // is ignored, the board sits on the cup). Until release() the board follows the TCP.
+  void hold(const core::Pose& board_in_tcp, double jaw);
+  // Leaves the board standing at `world` (not held): an obstacle the arm checks against, except
+  // the suction cup, which may touch it. release() parks it again.
+  void place_board(const core::Pose& world);
+  void release();
+  bool holding() const { return holding_; }
+
+  // The held board clear of everything but what it touches (the arm as posed by q).
+  bool board_clear(const Eigen::VectorXd& q);
+  // arm_valid and, when holding, board_clear.
+  bool valid(const Eigen::VectorXd& q) { return arm_valid(q) && (!holding_ || board_clear(q)); }
+
+  // The TCP in the world for arm joints q.
+  core::Pose tcp(const Eigen::VectorXd& q) const { return base_ * arm_.chain.fk(q); }
+
+ private:
+  void pose_arm(const Eigen::VectorXd& q);
+
+  const core::Cell& cell_;
+  const core::Arm& arm_;
+  int arm_index_ = 0;
+  core::StageScene scene_;
+  core::CollisionData data_;
+  std::vector<int> arm_bodies_;
+  std::vector<int> board_bodies_;
+  std::vector<std::pair<int, int>> moving_links_;  // (link, body) of this arm
+  std::vector<core::Pose> link_poses_;
+  core::Pose base_;
+  core::Pose board_in_tcp_ = core::Pose::Identity();
+  bool holding_ = false;
+  Eigen::VectorXd robot_q_;
+  Eigen::VectorXd posed_;  // arm joints the scene is posed for
+};
+
+}  // namespace hila::offline

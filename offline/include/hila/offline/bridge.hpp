@@ -1,0 +1,33 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+
+namespace hila::offline {
+
+struct BridgeSettings {
+  // Budget in validity checks, not seconds: the same inputs give the same bridge on any machine.
+  long max_checks = 40000;
+  double resolution = 0.05;  // rad, as the roadmap's edges
+  std::uint64_t seed = 1;
+};
+
+// A path from `from` to `to` where every state satisfies `valid`, for where a filtered roadmap
+// is cut: OMPL's RRT-Connect (sampling with a seeded generator of its own, so deterministic),
+// then greedy straight-line shortcuts. Every segment is re-checked at the resolution. Returns
+// the waypoints (from first, to last), or nothing within the budget.
+std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
+                                         const std::function<bool(const Eigen::VectorXd&)>& valid,
+                                         const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                         const BridgeSettings& settings);
+
+// Whether the straight segment a -> b is valid at every interior sample (the ends are assumed
+// checked), at the resolution.
+bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
+                   const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution);
+
+}  // namespace hila::offline

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/product.hpp"
+#include "hila/db/records.hpp"
+#include "hila/offline/bridge.hpp"
+#include "hila/offline/handover.hpp"
+#include "hila/offline/roadmap.hpp"
+
+namespace hila::offline {
+
+struct RegraspSettings {
+  // Handover goals are taken in Eq. 8 order, at most `goals` of them, each with its shared
+  // grasps until one connects the whole chain; the search ends once `served_goals` goals are
+  // served (the online planner tries them in the same order and rarely falls back further).
+  // Filters are made for the grasps met on the way.
+  int goals = 10;
+  int served_goals = 3;
+  int attach_neighbours = 10;  // roadmap nodes tried when connecting a configuration
+  // Where a filtered roadmap is cut (or an end does not attach), a bridge is planned.
+  BridgeSettings bridge;
+  std::uint64_t seed = 1;  // bridges' samplers
+  double lift = 0.05;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
+  std::string suction_arm = "right";
+  std::string receiving_arm = "left";
+};
+
+// The regrasp graph of one board at its assembly stage (paper §V): nodes are the board's poses
+// (suction pick from the stack, robot-robot handover, robot-human handover) × arm × grasp with
+// their IK solutions, plus each arm at home; edges are transit (arm empty), transfer (arm holding
+// the board, through the grasp's filtered roadmap) and handover (suction arm -> gripper arm).
+// Indices are 0-based into this result and the board's inputs (-1: none); the build turns them
+// into database ids:
+//  - filters: roadmap_id is the arm index (0 suction arm, 1 receiving arm), grasp_id an index
+//    into the board's robot (gripper) or suction grasps;
+//  - nodes: grasp_id as above, robot_handover_id / candidate_id index HandoverResult's vectors;
+//  - edges: from_node / to_node index `nodes`, filter_id indexes `filters`.
+struct RegraspResult {
+  std::vector<db::RoadmapFilterRecord> filters;
+  std::vector<db::RegraspNodeRecord> nodes;
+  std::vector<db::RegraspEdgeRecord> edges;
+  int shared_grasps = 0;  // shared grasps tried
+  // Shared grasps whose chain breaks before the exchange (the suction arm's pick, transit or
+  // transfer, or the receiving arm's transit): no filter is made for them.
+  int cut_before_exchange = 0;
+  int transfers = 0;  // receiving-arm robot-robot -> robot-human transfers tried
+  int transfers_connected = 0;
+  int bridges = 0;           // edges connected by a bridge rather than the roadmap
+  int goals_considered = 0;  // goals examined (in Eq. 8 order)
+  int goals_served = 0;      // goals with a connected chain home -> pick -> rr -> rh
+  int first_served_rank = -1;
+  std::string failure;  // why no goal is served (empty when one is)
+  double seconds = 0.0;
+};
+
+// Roadmaps: the suction arm's and the receiving arm's (built by build_roadmap over the same
+// cell). The board's stage (finished parts) is not part of the static cell: the online planner
+// validates against the actual assembly.
+RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& product,
+                           std::size_t index, const BoardGrasps& grasps,
+                           const HandoverResult& handover, const Roadmap& suction_roadmap,
+                           const Roadmap& receiving_roadmap, const RegraspSettings& settings);
+
+// A gripper grasp's slip data in the TCP frame (opening axis, lever to the centre of mass, θc).
+GraspSlip grasp_slip(const core::Cell& cell, const db::RobotGraspRecord& grasp,
+                     const Eigen::Vector3d& com);
+
+}  // namespace hila::offline

@@ -1,0 +1,138 @@
+#include "hila/offline/bridge.hpp"
+
+#include <ompl/base/PlannerTerminationCondition.h>
+#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/base/StateSampler.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+
+#include <memory>
+#include <random>
+
+#include "hila/offline/roadmap.hpp"
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+namespace hila::offline {
+
+namespace {
+
+// Uniform joint samples from a seeded generator (OMPL's own samplers draw from a process-wide
+// seed, which would make bridges depend on what ran before).
+class SeededSampler : public ob::StateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, std::uint64_t seed)
+      : ob::StateSampler(space), rng_(seed) {}
+  void sampleUniform(ob::State* state) override {
+    const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
+    auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+    for (std::size_t i = 0; i < bounds.low.size(); ++i) {
+      v->values[i] = bounds.low[i] + uniform() * (bounds.high[i] - bounds.low[i]);
+    }
+  }
+  void sampleUniformNear(ob::State* state, const ob::State* near, double distance) override {
+    const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
+    auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+    const auto* c = near->as<ob::RealVectorStateSpace::StateType>();
+    for (std::size_t i = 0; i < bounds.low.size(); ++i) {
+      v->values[i] = std::clamp(c->values[i] + (2.0 * uniform() - 1.0) * distance, bounds.low[i],
+                                bounds.high[i]);
+    }
+  }
+  void sampleGaussian(ob::State* state, const ob::State* mean, double stddev) override {
+    sampleUniformNear(state, mean, 2.0 * stddev);
+  }
+
+ private:
+  double uniform() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
+  std::mt19937_64 rng_;
+};
+
+Eigen::VectorXd to_vector(const ob::State* s, int dof) {
+  const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+  Eigen::VectorXd q(dof);
+  for (int i = 0; i < dof; ++i) q[i] = v->values[i];
+  return q;
+}
+
+}  // namespace
+
+bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
+                   const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution) {
+  for (const auto& q : edge_samples(a, b, resolution)) {
+    if (!valid(q)) return false;
+  }
+  return true;
+}
+
+std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
+                                         const std::function<bool(const Eigen::VectorXd&)>& valid,
+                                         const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                         const BridgeSettings& settings) {
+  if (!valid(from) || !valid(to)) return {};
+  if (segment_valid(valid, from, to, settings.resolution)) return {from, to};
+  const int dof = arm.chain.dof();
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
+  ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
+  for (int i = 0; i < dof; ++i) {
+    bounds.setLow(static_cast<unsigned>(i), arm.chain.lower_limits()[i]);
+    bounds.setHigh(static_cast<unsigned>(i), arm.chain.upper_limits()[i]);
+  }
+  space->setBounds(bounds);
+  const std::uint64_t seed = settings.seed;
+  space->setStateSamplerAllocator(
+      [seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  long checks = 0;
+  si->setStateValidityChecker([&](const ob::State* s) {
+    ++checks;
+    return valid(to_vector(s, dof));
+  });
+  si->setStateValidityCheckingResolution(settings.resolution / space->getMaximumExtent());
+  si->setup();
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  ob::ScopedState<> start(space), goal(space);
+  for (int i = 0; i < dof; ++i) {
+    start[static_cast<unsigned>(i)] = from[i];
+    goal[static_cast<unsigned>(i)] = to[i];
+  }
+  pdef->setStartAndGoalStates(start, goal);
+  og::RRTConnect planner(si);
+  planner.setProblemDefinition(pdef);
+  planner.setup();
+  const ob::PlannerStatus status =
+      planner.solve(ob::PlannerTerminationCondition([&] { return checks >= settings.max_checks; }));
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) return {};
+  const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
+  std::vector<Eigen::VectorXd> raw;
+  for (std::size_t i = 0; i < path->getStateCount(); ++i) {
+    raw.push_back(to_vector(path->getState(i), dof));
+  }
+  // Greedy shortcuts: from each kept waypoint, the farthest later one a straight segment reaches.
+  std::vector<Eigen::VectorXd> out{raw.front()};
+  std::size_t at = 0;
+  while (at + 1 < raw.size()) {
+    std::size_t next = at + 1;
+    for (std::size_t j = raw.size() - 1; j > at + 1; --j) {
+      if (segment_valid(valid, raw[at], raw[j], settings.resolution)) {
+        next = j;
+        break;
+      }
+    }
+    // RRT-Connect's own segments were checked by OMPL's motion validator; re-check at exactly
+    // the documented resolution.
+    if (next == at + 1 && !segment_valid(valid, raw[at], raw[next], settings.resolution)) {
+      return {};
+    }
+    out.push_back(raw[next]);
+    at = next;
+  }
+  return out;
+}
+
+}  // namespace hila::offline
