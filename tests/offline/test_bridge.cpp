@@ -1,0 +1,342 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "hila/offline/bridge.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+using Validity = std::function<bool(const Eigen::VectorXd&)>;
+
+const core::Arm& left_arm() {
+  static const auto cell = test::reference_cell();
+  return cell->arm("left");
+}
+
+// A wall across joint 0 (|q0 - wall_q0| < half_thickness) for every other joint value, with one
+// gap where |q1 - gap_q1| < half_gap: the only way from one side to the other.
+struct Wall {
+  double wall_q0 = 0.0;
+  double half_thickness = 0.15;
+  double gap_q1 = 0.0;
+  double half_gap = 0.3;
+
+  bool blocked(const Eigen::VectorXd& q) const {
+    return std::abs(q[0] - wall_q0) < half_thickness && std::abs(q[1] - gap_q1) >= half_gap;
+  }
+};
+
+struct Scenario {
+  Eigen::VectorXd from, to;
+  Wall wall;
+};
+
+// From home to home + 1 rad in joint 0, the wall half-way with its gap 1.2 rad off in joint 1,
+// so the straight line hits the wall but a detour exists.
+Scenario wall_scenario() {
+  const core::Arm& arm = left_arm();
+  Scenario s;
+  s.from = arm.spec.home;
+  s.to = arm.spec.home;
+  s.to[0] += 1.0;
+  s.wall.wall_q0 = arm.spec.home[0] + 0.5;
+  s.wall.gap_q1 = arm.spec.home[1] + 1.2;
+  return s;
+}
+
+Validity validity_of(const Wall& wall) {
+  return [wall](const Eigen::VectorXd& q) { return !wall.blocked(q); };
+}
+
+bool within_limits(const core::Arm& arm, const Eigen::VectorXd& q) {
+  return ((q - arm.chain.lower_limits()).array() >= 0.0).all() &&
+         ((arm.chain.upper_limits() - q).array() >= 0.0).all();
+}
+
+// Independent re-check: every state on every segment, ends included, at `resolution` / 5.
+void expect_path_valid(const std::vector<Eigen::VectorXd>& path, const Validity& valid,
+                       double resolution) {
+  const double step = resolution / 5.0;
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    const Eigen::VectorXd& a = path[i];
+    const Eigen::VectorXd& b = path[i + 1];
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::VectorXd q = a + (b - a) * (static_cast<double>(k) / steps);
+      ASSERT_TRUE(valid(q)) << "segment " << i
+                            << " is invalid at t = " << static_cast<double>(k) / steps << ": "
+                            << q.transpose();
+    }
+  }
+}
+
+// Dense brute force of segment_valid's contract: interior states only.
+bool dense_segment_valid(const Validity& valid, const Eigen::VectorXd& a,
+                         const Eigen::VectorXd& b) {
+  const int steps = std::max(2, static_cast<int>(std::ceil((b - a).norm() / 1e-4)));
+  for (int k = 1; k < steps; ++k) {
+    if (!valid(a + (b - a) * (static_cast<double>(k) / steps))) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST(Bridge, ScenarioIsWellPosed) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  ASSERT_EQ(arm.chain.dof(), s.from.size());
+  EXPECT_TRUE(within_limits(arm, s.from));
+  EXPECT_TRUE(within_limits(arm, s.to));
+  Eigen::VectorXd gap = s.from;
+  gap[0] = s.wall.wall_q0;
+  gap[1] = s.wall.gap_q1;
+  EXPECT_TRUE(within_limits(arm, gap));
+  const Validity valid = validity_of(s.wall);
+  EXPECT_TRUE(valid(s.from));
+  EXPECT_TRUE(valid(s.to));
+  EXPECT_TRUE(valid(gap));
+  EXPECT_FALSE(valid((s.from + s.to) / 2.0));
+  EXPECT_FALSE(offline::segment_valid(valid, s.from, s.to, 0.05));
+}
+
+TEST(Bridge, DetourAroundWallIsValid) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  const Validity valid = validity_of(s.wall);
+  for (std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    offline::BridgeSettings settings;
+    settings.seed = seed;
+    const auto path = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+    ASSERT_GE(path.size(), 3u) << "the straight line is blocked, so a detour needs a waypoint";
+    EXPECT_EQ(path.front(), s.from);
+    EXPECT_EQ(path.back(), s.to);
+    for (const auto& q : path) {
+      EXPECT_TRUE(within_limits(arm, q)) << q.transpose();
+    }
+    // Valid when re-sampled 5x denser: the detour really passes through the gap.
+    expect_path_valid(path, valid, settings.resolution);
+  }
+}
+
+TEST(Bridge, DetourHoldsAtFinerResolution) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  const Validity valid = validity_of(s.wall);
+  offline::BridgeSettings settings;
+  settings.resolution = 0.01;
+  settings.seed = 9;
+  const auto path = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+  ASSERT_GE(path.size(), 3u);
+  EXPECT_EQ(path.front(), s.from);
+  EXPECT_EQ(path.back(), s.to);
+  expect_path_valid(path, valid, settings.resolution);
+}
+
+TEST(Bridge, SameSeedGivesIdenticalPath) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  const Validity valid = validity_of(s.wall);
+  offline::BridgeSettings settings;
+  settings.seed = 42;
+  const auto first = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+  // Another plan with a different seed in between must not disturb the next one.
+  offline::BridgeSettings other = settings;
+  other.seed = 43;
+  const auto between = offline::plan_bridge(arm, valid, s.from, s.to, other);
+  EXPECT_FALSE(between.empty());
+  const auto second = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+  ASSERT_FALSE(first.empty());
+  ASSERT_EQ(first.size(), second.size());
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    ASSERT_EQ(first[i].size(), second[i].size());
+    for (Eigen::Index j = 0; j < first[i].size(); ++j) {
+      // Bitwise: not merely close.
+      EXPECT_EQ(std::memcmp(&first[i][j], &second[i][j], sizeof(double)), 0)
+          << "waypoint " << i << " joint " << j << ": " << first[i][j] << " vs " << second[i][j];
+    }
+  }
+}
+
+TEST(Bridge, StraightLineValidReturnsJustTheEnds) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  const Validity valid = validity_of(s.wall);
+  // Both on the near side of the wall, moving along joints the wall does not constrain.
+  Eigen::VectorXd from = s.from, to = s.from;
+  to[1] += 0.4;
+  to[2] -= 0.3;
+  to[5] += 0.7;
+  ASSERT_TRUE(offline::segment_valid(valid, from, to, 0.05));
+  const auto path = offline::plan_bridge(arm, valid, from, to, {});
+  ASSERT_EQ(path.size(), 2u);
+  EXPECT_EQ(path[0], from);
+  EXPECT_EQ(path[1], to);
+  // Also when the segment passes straight through the gap.
+  from[1] = to[1] = s.wall.gap_q1;
+  to = from;
+  to[0] += 1.0;
+  ASSERT_TRUE(valid(from) && valid(to));
+  const auto through = offline::plan_bridge(arm, valid, from, to, {});
+  ASSERT_EQ(through.size(), 2u);
+  EXPECT_EQ(through[0], from);
+  EXPECT_EQ(through[1], to);
+}
+
+TEST(Bridge, InvalidEndsReturnNothing) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  long calls = 0;
+  const Validity valid = [&](const Eigen::VectorXd& q) {
+    ++calls;
+    return !s.wall.blocked(q);
+  };
+  Eigen::VectorXd inside = s.from;
+  inside[0] = s.wall.wall_q0;
+  ASSERT_FALSE(valid(inside));
+  calls = 0;
+  EXPECT_TRUE(offline::plan_bridge(arm, valid, s.from, inside, {}).empty());
+  EXPECT_TRUE(offline::plan_bridge(arm, valid, inside, s.to, {}).empty());
+  // Rejected up front, not after spending the budget.
+  EXPECT_LE(calls, 4);
+}
+
+TEST(Bridge, EnclosedGoalReturnsNothingWithinBudget) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  // `to` is valid but sealed in a shell (0.15 < |q - to| < 0.4) far thicker than the resolution.
+  const Eigen::VectorXd goal = s.to;
+  long calls = 0;
+  const Validity valid = [&](const Eigen::VectorXd& q) {
+    ++calls;
+    const double r = (q - goal).norm();
+    return !(r > 0.15 && r < 0.4);
+  };
+  offline::BridgeSettings settings;
+  settings.max_checks = 5000;
+  settings.seed = 5;
+  const auto path = offline::plan_bridge(arm, valid, s.from, goal, settings);
+  EXPECT_TRUE(path.empty());
+  // The budget was spent (the planner did not give up early) and respected, give or take one
+  // motion's worth of checks.
+  EXPECT_GE(calls, settings.max_checks);
+  EXPECT_LE(calls, settings.max_checks + 2000);
+}
+
+TEST(Bridge, SegmentValidMatchesDenseCheck) {
+  const Scenario s = wall_scenario();
+  const Validity valid = validity_of(s.wall);
+  const double resolution = 0.05;
+  struct Case {
+    Eigen::VectorXd a, b;
+    bool expected;
+  };
+  std::vector<Case> cases;
+  // Straight across the wall: blocked.
+  cases.push_back({s.from, s.to, false});
+  // Across the wall through the gap: clear.
+  {
+    Eigen::VectorXd a = s.from, b = s.to;
+    a[1] = b[1] = s.wall.gap_q1;
+    cases.push_back({a, b, true});
+  }
+  // Along the near side, never reaching the wall: clear.
+  {
+    Eigen::VectorXd b = s.from;
+    b[1] += 2.0;
+    b[3] -= 1.0;
+    cases.push_back({s.from, b, true});
+  }
+  // Diagonally across the wall, reaching the gap only half-way through: blocked.
+  {
+    Eigen::VectorXd a = s.from, b = s.to;
+    a[1] = s.wall.gap_q1 - 1.5;
+    b[1] = s.wall.gap_q1 + 0.5;
+    b[4] += 0.5;
+    cases.push_back({a, b, false});
+  }
+  // Starting inside the gap and leaving it sideways inside the wall: blocked.
+  {
+    Eigen::VectorXd a = s.from;
+    a[0] = s.wall.wall_q0;
+    a[1] = s.wall.gap_q1;
+    Eigen::VectorXd b = a;
+    b[1] += 1.0;
+    b[0] += 0.3;
+    cases.push_back({a, b, false});
+  }
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const auto& c = cases[i];
+    EXPECT_EQ(dense_segment_valid(valid, c.a, c.b), c.expected) << "case " << i;
+    EXPECT_EQ(offline::segment_valid(valid, c.a, c.b, resolution), c.expected) << "case " << i;
+  }
+
+  // Random segments against a ball obstacle, built around their closest approach to the centre:
+  // either well inside the ball (a chord far longer than the resolution) or outside it, with
+  // both ends outside.
+  const Eigen::VectorXd centre = s.from;
+  const double radius = 0.5;
+  const Validity ball = [&](const Eigen::VectorXd& q) { return (q - centre).norm() >= radius; };
+  std::mt19937_64 rng(8);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto dim = centre.size();
+  for (int trial = 0; trial < 60; ++trial) {
+    Eigen::VectorXd u(dim), v(dim);
+    for (Eigen::Index j = 0; j < dim; ++j) {
+      u[j] = normal(rng);
+      v[j] = normal(rng);
+    }
+    u.normalize();
+    v = (v - v.dot(u) * u).normalized();
+    const bool through = trial % 2 == 0;
+    const double approach = through ? 0.3 * unit(rng) : radius + 1e-6 + 0.5 * unit(rng);
+    const Eigen::VectorXd closest = centre + approach * v;
+    const Eigen::VectorXd a = closest - (0.6 + 0.9 * unit(rng)) * u;
+    const Eigen::VectorXd b = closest + (0.6 + 0.9 * unit(rng)) * u;
+    ASSERT_TRUE(ball(a) && ball(b));
+    EXPECT_EQ(dense_segment_valid(ball, a, b), !through) << "trial " << trial;
+    EXPECT_EQ(offline::segment_valid(ball, a, b, resolution), !through) << "trial " << trial;
+  }
+}
+
+TEST(Bridge, SegmentValidChecksInteriorOnly) {
+  Eigen::VectorXd a(2), b(2);
+  a << 0.0, 0.0;
+  b << 1.0, 0.0;
+  // Only the two ends are invalid: the documented contract is that they are assumed checked.
+  const Validity ends_invalid = [&](const Eigen::VectorXd& q) { return q != a && q != b; };
+  EXPECT_TRUE(offline::segment_valid(ends_invalid, a, b, 0.05));
+  // A single invalid interior state on the sampling grid is caught.
+  Eigen::VectorXd mid(2);
+  mid << 0.5, 0.0;
+  const Validity mid_invalid = [&](const Eigen::VectorXd& q) { return (q - mid).norm() > 1e-9; };
+  EXPECT_FALSE(offline::segment_valid(mid_invalid, a, b, 0.25));
+  // Resolution coarser than the segment: no interior samples at all.
+  long calls = 0;
+  const Validity counting = [&](const Eigen::VectorXd&) {
+    ++calls;
+    return false;
+  };
+  EXPECT_TRUE(offline::segment_valid(counting, a, b, 2.0));
+  EXPECT_EQ(calls, 0);
+  // At resolution 1/8 a unit segment has 7 interior samples.
+  EXPECT_FALSE(offline::segment_valid(counting, a, b, 0.125));
+  calls = 0;
+  const Validity counting_ok = [&](const Eigen::VectorXd&) {
+    ++calls;
+    return true;
+  };
+  EXPECT_TRUE(offline::segment_valid(counting_ok, a, b, 0.125));
+  EXPECT_EQ(calls, 7);
+}
