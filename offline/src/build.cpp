@@ -225,7 +225,15 @@ void write_regrasp(db::DatabaseWriter& writer, std::int64_t part_id, const Regra
 std::vector<std::string> BuildSummary::failed_parts() const {
   std::vector<std::string> out;
   for (const auto& p : parts) {
-    if (!p.handover_failure.empty() || !p.regrasp_failure.empty()) out.push_back(p.name);
+    if (!p.handover_failure.empty()) out.push_back(p.name);
+  }
+  return out;
+}
+
+std::vector<std::string> BuildSummary::unconnected_parts() const {
+  std::vector<std::string> out;
+  for (const auto& p : parts) {
+    if (!p.regrasp_failure.empty()) out.push_back(p.name);
   }
   return out;
 }

@@ -31,6 +31,7 @@ offline::BuildSettings quick_settings(std::uint64_t seed = 7, int jobs = 1) {
   s.handover.rr_poses = 6;
   s.handover.human_ik_goals = 2;
   s.ergonomics.flexion_step_deg = 15.0;
+  s.roadmap.nodes = 300;
   return s;
 }
 

@@ -64,6 +64,10 @@ TEST(Roadmap, NodesAreFreeAndTheirInclinationMatchesBruteForceFk) {
   for (std::size_t i = 0; i < map.nodes.size(); ++i) {
     const auto& q = map.nodes[i];
     EXPECT_TRUE(ref.arm.chain.within_limits(q, 1e-12));
+    // Inside the roadmap's joint box around home.
+    EXPECT_TRUE((q.array() >= offline::roadmap_lower(ref.arm, small_settings()).array()).all());
+    EXPECT_TRUE((q.array() <= offline::roadmap_upper(ref.arm, small_settings()).array()).all());
+    EXPECT_LE((q - ref.arm.spec.home).cwiseAbs().maxCoeff(), small_settings().joint_range + 1e-12);
     EXPECT_FALSE(ref.colliding(q)) << "node " << i;
     EXPECT_NEAR(map.node_inclination_deg[i], ref.inclination_deg(q), 1e-6) << i;
     near_vertical += map.node_inclination_deg[i] <= 11.0 ? 1 : 0;
@@ -196,9 +200,14 @@ TEST(Roadmap, AttachingAConfigurationRespectsTheSlipLimit) {
   const auto cell = test::reference_cell();
   const offline::GraspSlip loose{Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 90.0};
   // A node attaches to itself (a zero-length edge) and to some neighbours.
-  const auto self = offline::attach_configuration(*cell, map, loose, map.nodes[0], 10);
+  offline::ArmWorkspace workspace(*cell, "left", "right");
+  const auto self = offline::attach_configuration(workspace, map, loose, map.nodes[0], 10);
   ASSERT_FALSE(self.empty());
-  EXPECT_EQ(self.front(), 0);
+  EXPECT_EQ(self.front().node, 0);
+  EXPECT_EQ(self.front().cost, 0.0);
+  for (const auto& a : self) {
+    EXPECT_NEAR(a.cost, (map.nodes[static_cast<std::size_t>(a.node)] - map.nodes[0]).norm(), 1e-12);
+  }
   // Under a 1-degree limit, a node that violates it attaches to nothing; every attachment of a
   // node within it is a node within it.
   const offline::GraspSlip tight{Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 1.0};
@@ -207,12 +216,12 @@ TEST(Roadmap, AttachingAConfigurationRespectsTheSlipLimit) {
   for (std::size_t i = 0; i < map.nodes.size() && checked < 8; ++i, ++checked) {
     const bool within =
         std::abs(map.node_gravity[i].dot(normal)) <= std::sin(core::deg_to_rad(1.0));
-    const auto attached = offline::attach_configuration(*cell, map, tight, map.nodes[i], 10);
+    const auto attached = offline::attach_configuration(workspace, map, tight, map.nodes[i], 10);
     if (!within) {
       EXPECT_TRUE(attached.empty()) << i;
     }
-    for (const int n : attached) {
-      EXPECT_LE(std::abs(map.node_gravity[static_cast<std::size_t>(n)].dot(normal)),
+    for (const auto& a : attached) {
+      EXPECT_LE(std::abs(map.node_gravity[static_cast<std::size_t>(a.node)].dot(normal)),
                 std::sin(core::deg_to_rad(1.0)) + 1e-12);
     }
   }

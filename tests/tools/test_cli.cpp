@@ -205,7 +205,8 @@ TEST(Cli, SameSeedSameDigestWhateverTheJobs) {
   // Sparse maps keep this quick; boards without goals (exit 1) are part of the content too.
   const std::string dir = test::temp_dir("cli_digest");
   const std::string options =
-      " --cell " + test::cell_path() + " --seed 3 --comfort-samples 20000 --handover-candidates 60";
+      " --cell " + test::cell_path() +
+      " --seed 3 --comfort-samples 20000 --handover-candidates 60 --roadmap-nodes 300";
   const int a =
       run("build " + test::product_path() + options + " --jobs 2 -o " + dir + "/a.hila").status;
   const int b =
@@ -235,7 +236,7 @@ TEST(Cli, BuildAndInspectBadInputs) {
   // with the reasons, names each failing board and exits 1.
   const CommandRun strict = run("build " + test::product_path() + " -o " + dir +
                                 "/ok.hila --comfort-samples 20000 --handover-candidates 40 "
-                                "--comfort-threshold 0.99");
+                                "--comfort-threshold 0.99 --roadmap-nodes 200");
   EXPECT_EQ(strict.status, 1) << strict.out;
   EXPECT_NE(strict.out.find("lateral_left: no handover goal: no candidate is comfortable"),
             std::string::npos)

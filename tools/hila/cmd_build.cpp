@@ -119,10 +119,9 @@ int run_build(const BuildOptions& opt) {
   }
   if (!failed.empty()) {
     std::cerr << "hila: " << failed.size() << " of " << summary.parts.size()
-              << " boards have no handover goal reachable in the roadmaps; the database was "
-                 "written with the reasons (hila inspect "
-              << summary.output << " handover --part NAME, hila inspect " << summary.output
-              << " roadmap --part NAME)\n";
+              << " boards have no handover goal; the database was written with the reasons "
+                 "(hila inspect "
+              << summary.output << " handover --part NAME)\n";
     return 1;
   }
   return 0;

@@ -92,9 +92,11 @@ struct BuildSummary {
   std::vector<ComfortMapSummary> comfort_maps;  // in the cell's human-arm order
   std::vector<RoadmapSummary> roadmaps;         // suction arm, receiving arm
   double seconds = 0.0;
-  // Boards without a handover goal, or whose goals none connect in the roadmaps (the database
-  // is still written, with the reasons stored).
+  // Boards without a handover goal (the database is still written, with the reasons stored).
   std::vector<std::string> failed_parts() const;
+  // Boards with goals none of which connects through the roadmaps (home -> pick -> robot-robot
+  // -> robot-human). Not a failure: the online planner repairs cut roadmaps, at a cost in time.
+  std::vector<std::string> unconnected_parts() const;
 };
 
 // Called as each part finishes (from a worker thread, serialised): name, parts done, total.
