@@ -69,12 +69,10 @@ Connection connect(ArmPlanning& arm, const std::vector<bool>& allowed, const Gra
       return c;
     }
   }
-  const Eigen::Vector3d normal = slip.axis.cross(slip.lever);
-  const double limit = std::sin(core::deg_to_rad(std::min(slip.theta_c_deg, 90.0))) + 1e-12;
+  const SlipTest holds(slip);
   const Eigen::Matrix3d base_rotation = arm.workspace.base().linear();
   auto valid = [&](const Eigen::VectorXd& q) {
-    return std::abs(gravity_in_tcp(arm.workspace.arm(), base_rotation, q).dot(normal)) <= limit &&
-           arm.workspace.valid(q);
+    return holds(gravity_in_tcp(arm.workspace.arm(), base_rotation, q)) && arm.workspace.valid(q);
   };
   c.path = plan_bridge(arm.workspace.arm(), valid, from, to, bridge);
   if (c.path.empty()) return c;

@@ -180,11 +180,9 @@ std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Road
                                              const GraspSlip& grasp, const Eigen::VectorXd& q,
                                              int k) {
   const Eigen::Matrix3d base_rotation = workspace.base().linear();
-  const Eigen::Vector3d normal = grasp.axis.cross(grasp.lever);
-  const double limit = std::sin(core::deg_to_rad(std::min(grasp.theta_c_deg, 90.0))) + 1e-12;
+  const SlipTest holds(grasp);
   auto ok = [&](const Eigen::VectorXd& x) {
-    return std::abs(gravity_in_tcp(workspace.arm(), base_rotation, x).dot(normal)) <= limit &&
-           workspace.valid(x);
+    return holds(gravity_in_tcp(workspace.arm(), base_rotation, x)) && workspace.valid(x);
   };
   std::vector<Attachment> out;
   if (!ok(q)) return out;
@@ -206,6 +204,10 @@ std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Road
   }
   return out;
 }
+
+SlipTest::SlipTest(const GraspSlip& grasp)
+    : normal_(grasp.axis.cross(grasp.lever)),
+      limit_(std::sin(core::deg_to_rad(std::min(grasp.theta_c_deg, 90.0))) + 1e-12) {}
 
 std::vector<bool> held_board_filter(ArmWorkspace& workspace, const Roadmap& roadmap,
                                     std::vector<bool> edges) {
@@ -250,10 +252,7 @@ db::RoadmapRecord to_record(const Roadmap& roadmap) {
 }
 
 std::vector<bool> slip_filter(const Roadmap& roadmap, const GraspSlip& grasp) {
-  // sin(slip) = |g . (axis x lever)|: one dot product per sample.
-  const Eigen::Vector3d normal = grasp.axis.cross(grasp.lever);
-  const double limit = std::sin(core::deg_to_rad(std::min(grasp.theta_c_deg, 90.0))) + 1e-12;
-  auto holds = [&](const Eigen::Vector3d& g) { return std::abs(g.dot(normal)) <= limit; };
+  const SlipTest holds(grasp);
   std::vector<bool> node_ok(roadmap.nodes.size());
   for (std::size_t i = 0; i < node_ok.size(); ++i) node_ok[i] = holds(roadmap.node_gravity[i]);
   std::vector<bool> out(roadmap.edges.size(), false);

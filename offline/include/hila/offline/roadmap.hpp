@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -71,6 +72,20 @@ struct GraspSlip {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitY();
   Eigen::Vector3d lever = Eigen::Vector3d::Zero();
   double theta_c_deg = 90.0;
+};
+
+// The grasp's slip test for a gravity direction in the TCP frame: sin(slip) = |g . (axis x
+// lever)| within sin(theta_c) (see core::slip_angle_deg). Built once, one dot product per call.
+class SlipTest {
+ public:
+  explicit SlipTest(const GraspSlip& grasp);
+  bool operator()(const Eigen::Vector3d& gravity_in_tcp) const {
+    return std::abs(gravity_in_tcp.dot(normal_)) <= limit_;
+  }
+
+ private:
+  Eigen::Vector3d normal_;
+  double limit_;
 };
 
 // The roadmap's edges a grasp may use: every sample (both ends and the interior samples) has a
