@@ -124,6 +124,18 @@ void ArmWorkspace::release() {
   posed_.resize(0);
 }
 
+std::string ArmWorkspace::why_invalid(const Eigen::VectorXd& q) {
+  if (!arm_.chain.within_limits(q, 1e-12)) return "outside the joint limits";
+  pose_arm(q);
+  core::CollisionPair pair;
+  const auto& model = scene_.cell.model;
+  if (core::in_collision(model, data_, arm_bodies_, &pair) ||
+      (holding_ && core::in_collision(model, data_, board_bodies_, &pair))) {
+    return model.body_name(pair.body_a) + " vs " + model.body_name(pair.body_b);
+  }
+  return "";
+}
+
 bool ArmWorkspace::board_clear(const Eigen::VectorXd& q) {
   if (!holding_) return true;
   if (posed_.size() != q.size() || posed_ != q) pose_arm(q);

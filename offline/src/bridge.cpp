@@ -9,6 +9,7 @@
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/util/Console.h>
 
+#include <algorithm>
 #include <memory>
 #include <random>
 
@@ -80,8 +81,14 @@ std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
   auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
   ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
   for (int i = 0; i < dof; ++i) {
-    bounds.setLow(static_cast<unsigned>(i), arm.chain.lower_limits()[i]);
-    bounds.setHigh(static_cast<unsigned>(i), arm.chain.upper_limits()[i]);
+    const double home = arm.spec.home[i];
+    // Widened to the ends when they lie outside the box (they are valid, so within the limits).
+    const double low = std::min(
+        {std::max(arm.chain.lower_limits()[i], home - settings.joint_range), from[i], to[i]});
+    const double high = std::max(
+        {std::min(arm.chain.upper_limits()[i], home + settings.joint_range), from[i], to[i]});
+    bounds.setLow(static_cast<unsigned>(i), low);
+    bounds.setHigh(static_cast<unsigned>(i), high);
   }
   space->setBounds(bounds);
   const std::uint64_t seed = settings.seed;
@@ -103,6 +110,7 @@ std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
   }
   pdef->setStartAndGoalStates(start, goal);
   og::RRTConnect planner(si);
+  planner.setRange(settings.range);
   planner.setProblemDefinition(pdef);
   planner.setup();
   const ob::PlannerStatus status =

@@ -274,8 +274,8 @@ std::string settings_hash(const BuildSettings& s) {
   text << "handover " << h.candidates << ' ' << h.max_draws << ' ' << h.max_rotation_deg << ' '
        << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.two_hand_separation << ' '
        << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
-       << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' '
-       << h.human_ik_goals << ' ' << h.pick_lift << ' ' << h.pick_resolution;
+       << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' ' << h.rr_per_grasp
+       << ' ' << h.human_ik_goals << ' ' << h.pick_lift << ' ' << h.pick_resolution;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
@@ -286,7 +286,7 @@ std::string settings_hash(const BuildSettings& s) {
        << m.vertical_cone_deg << ' ' << m.resolution << ' ' << m.joint_range << '\n';
   const auto& g = s.regrasp;
   text << "regrasp " << g.goals << ' ' << g.served_goals << ' ' << g.attach_neighbours << ' '
-       << g.bridge.max_checks << '\n';
+       << g.bridge.max_checks << ' ' << g.transfer_bridges << '\n';
   return db::sha256_hex(text.str());
 }
 

@@ -477,8 +477,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   shuffle(spread, rng);
   std::vector<int> order = favoured;
   order.insert(order.end(), spread.begin(), spread.end());
-  std::vector<std::vector<Receiving>> rr_grasps;          // per kept robot-robot pose
-  std::vector<int> rr_of_grasp(grasps.robot.size(), -1);  // first rr pose receiving each grasp
+  std::vector<std::vector<Receiving>> rr_grasps;  // per kept robot-robot pose
+  // The first rr_per_grasp rr poses receiving each grasp, in search order.
+  std::vector<std::vector<int>> rr_of_grasp(grasps.robot.size());
   int examined = 0;
   for (const int combo : order) {
     if (examined >= settings.rr_poses) break;
@@ -520,8 +521,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         rr.arm = suction_arm.spec.name;
         rr.joints = suction_q;
         for (const auto& r : received) {
-          auto& slot = rr_of_grasp[static_cast<std::size_t>(r.grasp)];
-          if (slot < 0) slot = static_cast<int>(result.robot_handovers.size());
+          auto& poses = rr_of_grasp[static_cast<std::size_t>(r.grasp)];
+          if (static_cast<int>(poses.size()) < settings.rr_per_grasp) {
+            poses.push_back(static_cast<int>(result.robot_handovers.size()));
+          }
         }
         result.robot_handovers.push_back(rr);
         rr_grasps.push_back(std::move(received));
@@ -583,24 +586,28 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       }
       int shared = 0;
       for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
-        const int rr = rr_of_grasp[static_cast<std::size_t>(g)];
-        if (rr < 0) continue;
+        const auto& poses = rr_of_grasp[static_cast<std::size_t>(g)];
+        if (poses.empty()) continue;
         Receiving at_rh;
         if (!receive(c.board, g, rh_bodies, at_rh)) continue;
         ++shared;
-        const auto& at_rr = rr_grasps[static_cast<std::size_t>(rr)];
-        const auto it = std::find_if(at_rr.begin(), at_rr.end(),
-                                     [&](const Receiving& r) { return r.grasp == g; });
-        db::SharedGraspRecord s;
-        s.candidate_id = ci;
-        s.robot_grasp_id = g;
-        s.robot_handover_id = rr;
-        s.arm = receiving_arm.spec.name;
-        s.joints_rr = it->joints;
-        s.joints_rh = at_rh.joints;
-        s.inclination_rr_deg = it->slip_deg;
-        s.inclination_rh_deg = at_rh.slip_deg;
-        result.shared.push_back(s);
+        // One record per rr pose: the regrasp graph takes the next when a pose's suction
+        // transfer is cut in the roadmap.
+        for (const int rr : poses) {
+          const auto& at_rr = rr_grasps[static_cast<std::size_t>(rr)];
+          const auto it = std::find_if(at_rr.begin(), at_rr.end(),
+                                       [&](const Receiving& r) { return r.grasp == g; });
+          db::SharedGraspRecord s;
+          s.candidate_id = ci;
+          s.robot_grasp_id = g;
+          s.robot_handover_id = rr;
+          s.arm = receiving_arm.spec.name;
+          s.joints_rr = it->joints;
+          s.joints_rh = at_rh.joints;
+          s.inclination_rr_deg = it->slip_deg;
+          s.inclination_rh_deg = at_rh.slip_deg;
+          result.shared.push_back(s);
+        }
         if (shared >= settings.shared_stored) break;  // membership in 𝕊 is settled
       }
       restore_receiving();

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <optional>
 #include <tuple>
 
 #include "hila/core/error.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/core/soft_finger.hpp"
+#include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
 #include "hila/offline/bridge.hpp"
 #include "hila/offline/suction_pick.hpp"
@@ -41,34 +43,43 @@ double path_length(const std::vector<Eigen::VectorXd>& path) {
   return length;
 }
 
-// Shortest path from `from` to `to` over the allowed edges, both ends attached by straight edges
-// that keep the slip limit and the workspace's validity (as the workspace currently holds);
-// where the filtered roadmap is cut, a bridge planned under the same checks.
-Connection connect(ArmPlanning& arm, const std::vector<bool>& allowed, const GraspSlip& slip,
-                   const Eigen::VectorXd& from, const Eigen::VectorXd& to, int k,
-                   core::GraphSearchWorkspace& search, const BridgeSettings& bridge) {
+// A configuration and the roadmap nodes it attaches to (straight edges keeping the slip limit
+// and the workspace's validity as it currently holds), computed once however many queries use it.
+struct Endpoint {
+  Eigen::VectorXd q;
+  std::vector<Attachment> attached;
+};
+
+Endpoint endpoint(ArmPlanning& arm, const GraspSlip& slip, const Eigen::VectorXd& q, int k) {
+  return {q, attach_configuration(arm.workspace, arm.roadmap, slip, q, k)};
+}
+
+// Shortest path between two attached configurations over the allowed edges.
+Connection roadmap_path(const ArmPlanning& arm, const std::vector<bool>& allowed,
+                        const Endpoint& from, const Endpoint& to,
+                        core::GraphSearchWorkspace& search) {
   Connection c;
-  const auto entries = attach_configuration(arm.workspace, arm.roadmap, slip, from, k);
-  const auto exits = entries.empty()
-                         ? std::vector<Attachment>{}
-                         : attach_configuration(arm.workspace, arm.roadmap, slip, to, k);
-  if (!exits.empty()) {
-    std::vector<core::GraphEndpoint> in, out;
-    for (const auto& a : entries) in.push_back({a.node, a.cost});
-    for (const auto& a : exits) out.push_back({a.node, a.cost});
-    const core::GraphPath path = core::shortest_path(arm.graph, allowed, in, out, search);
-    if (path.found) {
-      c.connected = true;
-      c.via = "roadmap";
-      c.path_nodes = static_cast<int>(path.nodes.size());
-      c.path.push_back(from);
-      for (const int n : path.nodes)
-        c.path.push_back(arm.roadmap.nodes[static_cast<std::size_t>(n)]);
-      c.path.push_back(to);
-      c.cost = path_length(c.path);
-      return c;
-    }
-  }
+  if (from.attached.empty() || to.attached.empty()) return c;
+  std::vector<core::GraphEndpoint> in, out;
+  for (const auto& a : from.attached) in.push_back({a.node, a.cost});
+  for (const auto& a : to.attached) out.push_back({a.node, a.cost});
+  const core::GraphPath path = core::shortest_path(arm.graph, allowed, in, out, search);
+  if (!path.found) return c;
+  c.connected = true;
+  c.via = "roadmap";
+  c.path_nodes = static_cast<int>(path.nodes.size());
+  c.path.push_back(from.q);
+  for (const int n : path.nodes) c.path.push_back(arm.roadmap.nodes[static_cast<std::size_t>(n)]);
+  c.path.push_back(to.q);
+  c.cost = path_length(c.path);
+  return c;
+}
+
+// Where the filtered roadmap is cut (or an end does not attach): a bridge planned under the
+// same checks (the slip limit and the workspace as it currently holds).
+Connection bridge_path(ArmPlanning& arm, const GraspSlip& slip, const Eigen::VectorXd& from,
+                       const Eigen::VectorXd& to, const BridgeSettings& bridge) {
+  Connection c;
   const SlipTest holds(slip);
   const Eigen::Matrix3d base_rotation = arm.workspace.base().linear();
   auto valid = [&](const Eigen::VectorXd& q) {
@@ -81,6 +92,60 @@ Connection connect(ArmPlanning& arm, const std::vector<bool>& allowed, const Gra
   c.cost = path_length(c.path);
   return c;
 }
+
+// The roadmap first, then a bridge.
+Connection connect(ArmPlanning& arm, const std::vector<bool>& allowed, const GraspSlip& slip,
+                   const Eigen::VectorXd& from, const Eigen::VectorXd& to, int k,
+                   core::GraphSearchWorkspace& search, const BridgeSettings& bridge) {
+  const Endpoint start = endpoint(arm, slip, from, k);
+  if (!start.attached.empty()) {
+    Connection c = roadmap_path(arm, allowed, start, endpoint(arm, slip, to, k), search);
+    if (c.connected) return c;
+  }
+  return bridge_path(arm, slip, from, to, bridge);
+}
+
+// Both arms at the exchange: the suction arm holding the board at the robot-robot pose and the
+// receiving arm closing on it. Each arm's workspace has the other at home, so a suction-arm IK
+// branch other than the one the handover search checked must be re-checked with the receiving
+// arm in place.
+class ExchangeCheck {
+ public:
+  ExchangeCheck(const core::Cell& cell, const core::TriangleMesh& board,
+                const std::string& suction_arm, const std::string& receiving_arm)
+      : cell_(cell),
+        scene_(core::build_stage_scene(cell, board, {}, suction_arm)),
+        data_(scene_.cell.model),
+        suction_(cell.arm(suction_arm)),
+        receiving_(cell.arm(receiving_arm)),
+        robot_q_(cell.home_configuration()) {
+    for (std::size_t i = 0; i < cell.arms().size(); ++i) {
+      if (&cell.arms()[i] == &receiving_) receiving_bodies_ = scene_.cell.arm_bodies[i];
+    }
+    core::set_cell_state(cell, scene_.cell, data_, robot_q_, cell.human_neutral());
+  }
+
+  bool clear(const core::Pose& board, const Eigen::VectorXd& suction_q,
+             const Eigen::VectorXd& receiving_q, double jaw) {
+    cell_.set_arm(robot_q_, suction_, suction_q);
+    cell_.set_arm(robot_q_, receiving_, receiving_q);
+    cell_.set_jaw(robot_q_, receiving_, jaw);
+    core::set_robot_state(cell_, scene_.cell, data_, robot_q_);
+    core::set_tool_held(cell_, scene_, data_,
+                        core::arm_base_in_world(cell_, suction_) * suction_.chain.fk(suction_q));
+    data_.set_body_pose(scene_.board, board);
+    return !core::in_collision(scene_.cell.model, data_, receiving_bodies_);
+  }
+
+ private:
+  const core::Cell& cell_;
+  core::StageScene scene_;
+  core::CollisionData data_;
+  const core::Arm& suction_;
+  const core::Arm& receiving_;
+  std::vector<int> receiving_bodies_;
+  Eigen::VectorXd robot_q_;
+};
 
 db::RoadmapFilterRecord make_filter(const Roadmap& roadmap, std::int64_t roadmap_index,
                                     const std::string& kind, std::int64_t grasp, double theta_c_deg,
@@ -162,6 +227,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, &part.mesh),
       std::vector<bool>(receiving_roadmap.edges.size(), true)};
   core::GraphSearchWorkspace search;
+  ExchangeCheck exchange(cell, part.mesh, settings.suction_arm, settings.receiving_arm);
   std::uint64_t bridges = 0;
   auto bridge = [&] {
     BridgeSettings b = settings.bridge;
@@ -265,9 +331,37 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     Connection transfer;
     if (pick.node >= 0 && pick.lift.size() > 0) {
       const auto& grasp = grasps.suction[static_cast<std::size_t>(rr.suction_grasp_id)];
-      suction.workspace.hold(cup_in_tcp * grasp.cup.inverse(), 0.0);
-      transfer = connect(suction, result.filters[static_cast<std::size_t>(pick.filter)].edges,
-                         no_slip_limit, pick.lift, rr.joints, k, search, bridge());
+      const core::Pose board_in_tcp = cup_in_tcp * grasp.cup.inverse();
+      suction.workspace.hold(board_in_tcp, 0.0);
+      // The handover search kept one IK solution; another branch at the same pose may be the
+      // one the held board can reach from the stack. The stored one is tried first.
+      std::vector<Eigen::VectorXd> ends{rr.joints};
+      core::UrIkSolutions ik;
+      const int n = suction_arm.ur_ik->solve(
+          suction.workspace.base().inverse() * rr.board * board_in_tcp.inverse(),
+          suction_arm.spec.home, ik);
+      for (int i = 0; i < n; ++i) {
+        const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(i)];
+        if ((q - rr.joints).norm() > 1e-6 && suction.workspace.valid(q)) ends.push_back(q);
+      }
+      // Through the roadmap to each branch, then bridges to the first few.
+      const auto& edges = result.filters[static_cast<std::size_t>(pick.filter)].edges;
+      const Endpoint lifted = endpoint(suction, no_slip_limit, pick.lift, k);
+      std::size_t chosen = 0;
+      for (int pass = 0; pass < 2 && !transfer.connected; ++pass) {
+        for (chosen = 0; chosen < ends.size(); ++chosen) {
+          if (pass == 1 && static_cast<int>(chosen) >= settings.transfer_bridges) break;
+          transfer = pass == 0
+                         ? roadmap_path(suction, edges, lifted,
+                                        endpoint(suction, no_slip_limit, ends[chosen], k), search)
+                         : bridge_path(suction, no_slip_limit, pick.lift, ends[chosen], bridge());
+          if (transfer.connected) break;
+        }
+      }
+      if (transfer.connected) {  // the node's solution the transfer reaches comes first
+        std::swap(ends.front(), ends[chosen]);
+        result.nodes[static_cast<std::size_t>(node)].solutions = ends;
+      }
       suction.workspace.release();
       if (transfer.connected) {  // the path starts at the pick, below the lift
         transfer.path.insert(transfer.path.begin(),
@@ -299,24 +393,71 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     gripper_filters[g] = f;
     return f;
   };
-  std::map<std::pair<std::int64_t, std::int64_t>, std::pair<int, bool>> rr_left;  // (r, g)
-  auto rr_left_for = [&](const db::SharedGraspRecord& s) {
+  // The receiving arm's configurations for a gripper grasp with the board at `board`: every IK
+  // branch valid in the workspace (holding the board when `holding`), `preferred` (the handover
+  // search's) first. The arm changes branch only through configurations the held board and the
+  // slip limit rarely allow, so each branch is its own regrasp node.
+  const core::Arm& receiving_arm = receiving.workspace.arm();
+  const core::Pose receiving_base_inv = receiving.workspace.base().inverse();
+  auto receiving_branches = [&](const core::Pose& board, const db::RobotGraspRecord& grasp,
+                                const Eigen::VectorXd& preferred) {
+    std::vector<Eigen::VectorXd> out{preferred};
+    core::UrIkSolutions ik;
+    const int n = receiving_arm.ur_ik->solve(receiving_base_inv * board * grasp.tcp,
+                                             receiving_arm.spec.home, ik);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(i)];
+      if ((q - preferred).norm() > 1e-6 && receiving.workspace.valid(q)) out.push_back(q);
+    }
+    return out;
+  };
+  const double jaw_max = cell.spec().gripper.jaw_max;
+  const Endpoint home_end = endpoint(receiving, no_slip_limit, receiving_arm.spec.home, k);
+  struct LeftEnd {
+    int node = -1;
+    bool transit = false;  // home -> node connected and the exchange clear
+  };
+  // Per (robot handover, grasp): one node per receiving-arm branch at the exchange.
+  std::map<std::pair<std::int64_t, std::int64_t>, std::vector<LeftEnd>> rr_left;
+  auto rr_left_for = [&](const db::SharedGraspRecord& s) -> const std::vector<LeftEnd>& {
     const auto key = std::make_pair(s.robot_handover_id, s.robot_grasp_id);
     auto it = rr_left.find(key);
     if (it != rr_left.end()) return it->second;
+    std::vector<LeftEnd>& ends = rr_left[key];
     const auto& rr = handover.robot_handovers[static_cast<std::size_t>(s.robot_handover_id)];
-    const int node = add_node("robot_handover", settings.receiving_arm, "gripper", s.robot_grasp_id,
-                              s.robot_handover_id, -1, rr.board, {s.joints_rr});
-    const Connection transit =
-        connect(receiving, receiving.all_edges, no_slip_limit, receiving.workspace.arm().spec.home,
-                s.joints_rr, k, search, bridge());
-    add_edge("transit", settings.receiving_arm, home_receiving, node, -1, transit);
-    Connection exchange;
-    exchange.connected = true;
-    add_edge("handover", settings.receiving_arm, rr_node_for(s.robot_handover_id), node, -1,
-             exchange);
-    rr_left[key] = {node, transit.connected};
-    return rr_left[key];
+    const int suction_node = rr_node_for(s.robot_handover_id);
+    if (!rr_transfer[s.robot_handover_id]) return ends;  // no use reaching an unreachable pose
+    const auto& grasp = grasps.robot[static_cast<std::size_t>(s.robot_grasp_id)];
+    const double jaw = std::min(jaw_max, grasp.jaw_width + kJawMargin);
+    // The suction arm may hold the board in another IK branch than the handover search checked.
+    const auto& suction_q = result.nodes[static_cast<std::size_t>(suction_node)].solutions.front();
+    // Transits through the roadmap to every branch; bridges (costly when they fail) only when
+    // none connects, to the first few branches.
+    std::vector<Connection> transits;
+    for (const auto& q : receiving_branches(rr.board, grasp, s.joints_rr)) {
+      if (!exchange.clear(rr.board, suction_q, q, jaw)) continue;
+      LeftEnd end;
+      end.node = add_node("robot_handover", settings.receiving_arm, "gripper", s.robot_grasp_id,
+                          s.robot_handover_id, -1, rr.board, {q});
+      ends.push_back(end);
+      transits.push_back(roadmap_path(receiving, receiving.all_edges, home_end,
+                                      endpoint(receiving, no_slip_limit, q, k), search));
+    }
+    const bool any = std::any_of(transits.begin(), transits.end(),
+                                 [](const Connection& c) { return c.connected; });
+    for (std::size_t i = 0; i < ends.size(); ++i) {
+      if (!any && static_cast<int>(i) < settings.transfer_bridges) {
+        transits[i] = bridge_path(
+            receiving, no_slip_limit, receiving_arm.spec.home,
+            result.nodes[static_cast<std::size_t>(ends[i].node)].solutions.front(), bridge());
+      }
+      add_edge("transit", settings.receiving_arm, home_receiving, ends[i].node, -1, transits[i]);
+      Connection exchange_edge;
+      exchange_edge.connected = true;
+      add_edge("handover", settings.receiving_arm, suction_node, ends[i].node, -1, exchange_edge);
+      ends[i].transit = transits[i].connected;
+    }
+    return ends;
   };
 
   // Goals in Eq. 8 order; each goal's shared grasps until one connects the whole chain. Filters
@@ -332,25 +473,74 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       if (served) continue;  // the goal's remaining grasps are not needed
       const auto& s = handover.shared[shared[next_shared]];
       ++result.shared_grasps;
-      const auto [rr_node, transit_ok] = rr_left_for(s);
+      std::vector<int> starts;  // receiving-arm nodes at the exchange reached from home
+      for (const auto& end : rr_left_for(s)) {
+        if (end.transit) starts.push_back(end.node);
+      }
       // Only a grasp whose chain up to the exchange connects is worth its filter.
-      if (!transit_ok || !rr_transfer[s.robot_handover_id]) {
+      if (starts.empty()) {
         ++result.cut_before_exchange;
         continue;
       }
       const int filter = gripper_filter_for(s.robot_grasp_id);
+      const auto& edges = result.filters[static_cast<std::size_t>(filter)].edges;
       const auto& candidate = handover.candidates[static_cast<std::size_t>(s.candidate_id)];
+      const auto& grasp = grasps.robot[static_cast<std::size_t>(s.robot_grasp_id)];
+      const GraspSlip slip = grasp_slip(cell, grasp, grasps.com);
+      receiving.workspace.hold(grasp.tcp.inverse(),
+                               std::min(jaw_max, grasp.jaw_width + kJawMargin));
+      const auto goals_rh = receiving_branches(candidate.board, grasp, s.joints_rh);
+      // Branch pairs, the handover search's first, then nearest first: through the roadmap,
+      // then bridges for the nearest few.
+      std::vector<std::tuple<double, int, std::size_t>> pairs;
+      for (std::size_t a = 0; a < starts.size(); ++a) {
+        const auto& qa = result.nodes[static_cast<std::size_t>(starts[a])].solutions.front();
+        for (std::size_t b = 0; b < goals_rh.size(); ++b) {
+          pairs.emplace_back(a == 0 && b == 0 ? -1.0 : (goals_rh[b] - qa).norm(), starts[a], b);
+        }
+      }
+      std::sort(pairs.begin(), pairs.end());
+      std::map<int, Endpoint> from_ends;  // by node
+      std::vector<std::optional<Endpoint>> to_ends(goals_rh.size());
+      Connection transfer;
+      int from_node = starts.front();
+      std::size_t to_branch = 0;
+      for (const auto& [distance, node, b] : pairs) {
+        auto it = from_ends.find(node);
+        if (it == from_ends.end()) {
+          it = from_ends
+                   .emplace(
+                       node,
+                       endpoint(receiving, slip,
+                                result.nodes[static_cast<std::size_t>(node)].solutions.front(), k))
+                   .first;
+        }
+        if (it->second.attached.empty()) continue;
+        if (!to_ends[b]) to_ends[b] = endpoint(receiving, slip, goals_rh[b], k);
+        transfer = roadmap_path(receiving, edges, it->second, *to_ends[b], search);
+        if (transfer.connected) {
+          from_node = node;
+          to_branch = b;
+          break;
+        }
+      }
+      for (std::size_t i = 0; i < pairs.size() && !transfer.connected &&
+                              static_cast<int>(i) < settings.transfer_bridges;
+           ++i) {
+        const auto& [distance, node, b] = pairs[i];
+        transfer = bridge_path(receiving, slip,
+                               result.nodes[static_cast<std::size_t>(node)].solutions.front(),
+                               goals_rh[b], bridge());
+        if (transfer.connected) {
+          from_node = node;
+          to_branch = b;
+        }
+      }
+      receiving.workspace.release();
       const int rh_node =
           add_node("human_handover", settings.receiving_arm, "gripper", s.robot_grasp_id, -1,
-                   s.candidate_id, candidate.board, {s.joints_rh});
-      const auto& grasp = grasps.robot[static_cast<std::size_t>(s.robot_grasp_id)];
-      receiving.workspace.hold(grasp.tcp.inverse(),
-                               std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + kJawMargin));
-      const Connection transfer = connect(
-          receiving, result.filters[static_cast<std::size_t>(filter)].edges,
-          grasp_slip(cell, grasp, grasps.com), s.joints_rr, s.joints_rh, k, search, bridge());
-      receiving.workspace.release();
-      add_edge("transfer", settings.receiving_arm, rr_node, rh_node, filter, transfer);
+                   s.candidate_id, candidate.board, {goals_rh[to_branch]});
+      add_edge("transfer", settings.receiving_arm, from_node, rh_node, filter, transfer);
       ++result.transfers;
       result.transfers_connected += transfer.connected ? 1 : 0;
       served = transfer.connected;

@@ -261,7 +261,8 @@ int run_inspect(const InspectOptions& opt) {
     if (!j["failure"].get<std::string>().empty()) {
       std::cout << "  no goal: " << j["failure"].get<std::string>() << "\n";
     }
-    std::cout << "  rank  distance m  Q      human hand (grasp)   shared grasps (theta_c deg)\n";
+    std::cout << "  rank  distance m  Q      human hand (grasp)   shared grasps (theta_c deg) at "
+                 "rr poses\n";
     int shown = 0;
     for (const auto& g : j["ranked_goals"]) {
       if (shown++ == opt.limit) {
@@ -275,11 +276,19 @@ int run_inspect(const InspectOptions& opt) {
         hand += " + " + g["second_arm"].get<std::string>() + " (" +
                 std::to_string(g["second_grasp"].get<std::int64_t>()) + ")";
       }
+      // A grasp is stored once per robot-robot pose receiving it: "grasp (theta_c) rr a/b".
       std::string shared;
+      std::int64_t last_grasp = -1;
       for (const auto& s : g["shared_grasps"]) {
-        shared += (shared.empty() ? "" : ", ") +
-                  std::to_string(s["robot_grasp"].get<std::int64_t>()) + " (" +
-                  std::to_string(static_cast<int>(s["theta_c_deg"].get<double>())) + ")";
+        const auto grasp = s["robot_grasp"].get<std::int64_t>();
+        const std::string rr = std::to_string(s["robot_handover"].get<std::int64_t>());
+        if (grasp == last_grasp) {
+          shared += "/" + rr;
+          continue;
+        }
+        last_grasp = grasp;
+        shared += (shared.empty() ? "" : ", ") + std::to_string(grasp) + " (" +
+                  std::to_string(static_cast<int>(s["theta_c_deg"].get<double>())) + ") rr " + rr;
       }
       std::cout << std::setw(6) << g["rank"].get<int>() << std::setw(12) << std::fixed
                 << std::setprecision(3) << g["distance"].get<double>() << "  " << std::setw(5)

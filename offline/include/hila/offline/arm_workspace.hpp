@@ -44,6 +44,10 @@ class ArmWorkspace {
   // arm_valid and, when holding, board_clear.
   bool valid(const Eigen::VectorXd& q) { return arm_valid(q) && (!holding_ || board_clear(q)); }
 
+  // What makes q invalid, for diagnostics: "outside the joint limits", "BODY vs BODY" (the first
+  // contact found) or "" when valid.
+  std::string why_invalid(const Eigen::VectorXd& q);
+
   // The TCP in the world for arm joints q.
   core::Pose tcp(const Eigen::VectorXd& q) const { return base_ * arm_.chain.fk(q); }
 

@@ -14,6 +14,11 @@ struct BridgeSettings {
   long max_checks = 40000;
   double resolution = 0.05;  // rad, as the roadmap's edges
   std::uint64_t seed = 1;
+  // RRT-Connect's step (rad). OMPL's default, a fifth of the space's extent, is several radians
+  // for a UR: in a slip- and clearance-constrained space nearly every such step fails.
+  double range = 0.4;
+  // Each joint within this much of home (and the limits), as the roadmaps (rad).
+  double joint_range = 3.14159265358979323846;
 };
 
 // A path from `from` to `to` where every state satisfies `valid`, for where a filtered roadmap

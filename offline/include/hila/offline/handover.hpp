@@ -39,11 +39,14 @@ struct HandoverSettings {
   // Only suction grasps the suction arm can use to take the board from the stack (IK and
   // collision at the initial pose, then a collision-free lift of pick_lift m straight up checked
   // at pick_resolution rad) are used at robot-robot poses.
-  double pick_lift = 0.05;
+  double pick_lift = 0.15;
   double pick_resolution = 0.05;
   int rr_orientations = 64;  // board orientations tried per position (spread over SO(3))
   int rr_poses = 24;         // suction-feasible robot-robot poses examined for receiving grasps
   int shared_stored = 8;     // shared grasps searched for and stored per goal
+  // Robot-robot poses stored per shared grasp (one shared-grasp record each, in search order):
+  // when the suction arm's transfer to one is cut in the roadmap, the regrasp graph tries the next.
+  int rr_per_grasp = 3;
   // The first goals in Eq. 8 order are confirmed by direct IK of the human arm (best Q over
   // restarts; a candidate failing it leaves S) and carry the human's posture.
   int human_ik_goals = 10;

@@ -23,6 +23,10 @@ struct RegraspSettings {
   int attach_neighbours = 10;  // roadmap nodes tried when connecting a configuration
   // Where a filtered roadmap is cut (or an end does not attach), a bridge is planned.
   BridgeSettings bridge;
+  // The receiving arm may take the board in any IK branch at the exchange and hand it over in
+  // any at the goal: transits and transfers are tried through the roadmap for every branch
+  // (pair), then bridged for at most this many.
+  int transfer_bridges = 2;
   std::uint64_t seed = 1;  // bridges' samplers
   double lift = 0.05;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
   std::string suction_arm = "right";
