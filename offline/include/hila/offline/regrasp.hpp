@@ -28,7 +28,7 @@ struct RegraspSettings {
   // (pair), then bridged for at most this many.
   int transfer_bridges = 2;
   std::uint64_t seed = 1;  // bridges' samplers
-  double lift = 0.05;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
+  double lift = 0.15;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
   std::string suction_arm = "right";
   std::string receiving_arm = "left";
 };
