@@ -23,25 +23,6 @@ namespace hila::offline {
 
 namespace {
 
-std::string file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw core::InputError(path, "(file)", "a readable file", "cannot open");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-// Files are joined with their names and lengths so that moving bytes between files changes the
-// hash.
-std::string hash_files(const std::vector<std::string>& paths) {
-  std::string all;
-  for (const auto& p : paths) {
-    const std::string bytes = file_bytes(p);
-    all += p.substr(p.find_last_of('/') + 1) + '\0' + std::to_string(bytes.size()) + '\0' + bytes;
-  }
-  return db::sha256_hex(all);
-}
-
 std::string mesh_hash(const core::TriangleMesh& mesh) {
   std::string bytes;
   bytes.reserve(mesh.vertices.size() * 24 + mesh.triangles.size() * 12);
@@ -249,16 +230,6 @@ std::uint64_t part_seed(std::uint64_t seed, const std::string& part_name, std::u
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
   return z ^ (z >> 31);
-}
-
-std::string cell_hash(const core::CellSpec& cell) {
-  return hash_files({cell.file, cell.robot_urdf, cell.suction.tool_urdf, cell.human_urdf});
-}
-
-std::string product_hash(const core::ProductSpec& product) {
-  std::vector<std::string> files{product.file};
-  for (const auto& p : product.parts) files.push_back(p.mesh_file);
-  return hash_files(files);
 }
 
 std::string settings_hash(const BuildSettings& s) {

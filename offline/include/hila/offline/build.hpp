@@ -8,6 +8,7 @@
 #include "hila/core/cell.hpp"
 #include "hila/core/human_model.hpp"
 #include "hila/core/product.hpp"
+#include "hila/db/provenance.hpp"
 #include "hila/offline/comfort_map.hpp"
 #include "hila/offline/ergonomics.hpp"
 #include "hila/offline/handover.hpp"
@@ -102,10 +103,10 @@ struct BuildSummary {
 // Called as each part finishes (from a worker thread, serialised): name, parts done, total.
 using BuildProgress = std::function<void(const std::string& part, int done, int total)>;
 
-// Hashes that tie a database to its inputs: the cell file and every URDF it references; the
-// product file and every mesh it references; the content-relevant settings (not `jobs`).
-std::string cell_hash(const core::CellSpec& cell);
-std::string product_hash(const core::ProductSpec& product);
+// Hashes that tie a database to its inputs: the cell's and the product's (db/provenance.hpp)
+// and the content-relevant settings' (not `jobs`).
+using db::cell_hash;
+using db::product_hash;
 std::string settings_hash(const BuildSettings& settings);
 
 // The per-part seed: independent of the part's position in the file and of the thread that
