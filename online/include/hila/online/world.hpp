@@ -1,0 +1,41 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/collision.hpp"
+#include "hila/core/product.hpp"
+#include "hila/core/stage_scene.hpp"
+#include "hila/online/scene.hpp"
+
+namespace hila::online {
+
+// The scene as one collision world for handling one board: the cell with the human at the
+// scene's stance, the finished boards where the scene says, the board and the suction tool
+// (both moving) and the scene's extra obstacles (static). Const after construction: one
+// CollisionData per thread (make_data()).
+class World {
+ public:
+  World(const core::Cell& cell, const core::ProductSpec& product, const Scene& scene,
+        const std::string& board, const std::string& suction_arm = "right");
+
+  const core::Cell& cell() const { return cell_; }
+  const core::StageScene& stage() const { return stage_; }
+  const core::PartSpec& board() const { return board_; }
+  const std::vector<int>& obstacles() const { return obstacles_; }  // the scene's extra bodies
+  // A CollisionData with the human at the scene's stance, the board at its initial pose, the
+  // tool where the scene has it (on the table, or in the suction arm's hand at its current
+  // joints) and the robot at the scene's joints.
+  core::CollisionData make_data() const;
+
+ private:
+  const core::Cell& cell_;
+  const core::PartSpec& board_;
+  Scene scene_;
+  std::vector<core::PlacedPart> finished_;
+  core::StageScene stage_;
+  std::vector<int> obstacles_;
+};
+
+}  // namespace hila::online

@@ -1,0 +1,160 @@
+#include "hila/online/validator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "hila/core/soft_finger.hpp"
+#include "hila/core/stage_scene.hpp"
+
+namespace hila::online {
+
+namespace {
+
+class Reporter {
+ public:
+  explicit Reporter(ValidationReport& report) : report_(report) {}
+  void add(const std::string& kind, double time, const std::string& detail) {
+    for (const auto& v : report_.violations) {
+      if (v.kind == kind) return;  // the first of each kind
+    }
+    report_.violations.push_back({kind, time, detail});
+  }
+
+ private:
+  ValidationReport& report_;
+};
+
+std::string joint_text(int joint, double value, double limit, const char* unit) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "joint " << joint + 1 << ": " << value << " " << unit << " against " << limit;
+  return s.str();
+}
+
+}  // namespace
+
+ValidationReport validate_motion(const World& world, core::CollisionData& data,
+                                 const Motion& motion, const ValidatorSettings& settings) {
+  ValidationReport report;
+  Reporter violation(report);
+  const core::Cell& cell = world.cell();
+  const core::Arm* arm = nullptr;
+  std::size_t arm_index = 0;
+  for (std::size_t i = 0; i < cell.arms().size(); ++i) {
+    if (cell.arms()[i].spec.name == motion.arm) {
+      arm = &cell.arms()[i];
+      arm_index = i;
+    }
+  }
+  if (arm == nullptr) {
+    violation.add("format", 0.0, "unknown arm '" + motion.arm + "'");
+    return report;
+  }
+  const int dof = arm->chain.dof();
+  const std::size_t n = motion.q.size();
+  if (n == 0 || motion.time.size() != n) {
+    violation.add("format", 0.0, "expected one time per waypoint and at least one waypoint");
+    return report;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (motion.q[i].size() != dof || !motion.q[i].allFinite() || !std::isfinite(motion.time[i]) ||
+        (i > 0 && !(motion.time[i] > motion.time[i - 1]))) {
+      violation.add("format", motion.time[i],
+                    "waypoint " + std::to_string(i) +
+                        ": expected finite joints of the arm's size at an increasing time");
+      return report;
+    }
+  }
+
+  // Rates: velocity between waypoints, acceleration between consecutive velocities.
+  const auto& vmax = arm->spec.max_velocity;
+  const auto& amax = arm->spec.max_acceleration;
+  Eigen::VectorXd previous_velocity;
+  for (std::size_t i = 1; i < n; ++i) {
+    const double dt = motion.time[i] - motion.time[i - 1];
+    const Eigen::VectorXd v = (motion.q[i] - motion.q[i - 1]) / dt;
+    for (int j = 0; j < dof && vmax.size() == dof; ++j) {
+      if (std::abs(v[j]) > vmax[j] * (1.0 + settings.rate_tolerance)) {
+        violation.add("velocity", motion.time[i], joint_text(j, std::abs(v[j]), vmax[j], "rad/s"));
+      }
+    }
+    if (previous_velocity.size() == dof && amax.size() == dof) {
+      const double mid = 0.5 * (motion.time[i] - motion.time[std::max<std::size_t>(i, 2) - 2]);
+      const Eigen::VectorXd a = (v - previous_velocity) / std::max(mid, 1e-12);
+      for (int j = 0; j < dof; ++j) {
+        if (std::abs(a[j]) > amax[j] * (1.0 + settings.rate_tolerance)) {
+          violation.add("acceleration", motion.time[i - 1],
+                        joint_text(j, std::abs(a[j]), amax[j], "rad/s^2"));
+        }
+      }
+    }
+    previous_velocity = v;
+  }
+
+  // Dense samples: full-robot FK, the tool and the board, everything moving checked.
+  const core::StageScene& stage = world.stage();
+  const bool moves_tool = motion.tool_in_hand && static_cast<int>(arm_index) == stage.suction_arm;
+  std::vector<int> moving = stage.cell.arm_bodies[arm_index];
+  if (moves_tool) moving.insert(moving.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
+  if (motion.holds_board) moving.push_back(stage.board);
+  const core::Pose base = core::arm_base_in_world(cell, *arm);
+  const core::Arm& suction = cell.arms()[static_cast<std::size_t>(stage.suction_arm)];
+  Eigen::VectorXd robot_q = motion.robot_q.size() == 0 ? cell.home_configuration() : motion.robot_q;
+  if (!motion.holds_board) data.set_body_pose(stage.board, motion.board_world);
+  if (motion.tool_in_hand && !moves_tool) {
+    // In the other, resting arm's hand: posed once by FK of the whole robot.
+    std::vector<core::Pose> links;
+    cell.robot().link_poses(robot_q, links);
+    core::set_tool_held(
+        cell, stage, data,
+        links[static_cast<std::size_t>(cell.robot().link_index(suction.spec.tip_link))]);
+  } else if (!motion.tool_in_hand) {
+    core::set_robot_pose(data, stage.tool, stage.tool_links_in_handle, motion.tool_world);
+  }
+  const Eigen::Vector3d down(0.0, 0.0, -1.0);
+  auto check = [&](const Eigen::VectorXd& q, double t) {
+    ++report.samples;
+    if (!arm->chain.within_limits(q, settings.limit_tolerance)) {
+      violation.add("joint_limit", t, "outside the arm's joint limits");
+    }
+    cell.set_arm(robot_q, *arm, q);
+    core::set_robot_state(cell, stage.cell, data, robot_q);
+    const core::Pose tcp = base * arm->chain.fk(q);
+    if (moves_tool) core::set_tool_held(cell, stage, data, tcp);
+    if (motion.holds_board) {
+      data.set_body_pose(stage.board, tcp * motion.board_in_tcp);
+      if (motion.theta_c_deg < 90.0) {
+        const double slip = core::slip_angle_deg(tcp.linear() * motion.slip_axis_tcp,
+                                                 tcp.linear() * motion.slip_lever_tcp, down);
+        report.worst_slip_deg = std::max(report.worst_slip_deg, slip);
+        if (slip > motion.theta_c_deg + settings.slip_tolerance_deg) {
+          std::ostringstream s;
+          s.precision(4);
+          s << "slip angle " << slip << " deg against theta_c " << motion.theta_c_deg << " deg";
+          violation.add("slip", t, s.str());
+        }
+      }
+    }
+    core::CollisionPair pair;
+    if (core::in_collision(stage.cell.model, data, moving, &pair)) {
+      violation.add("collision", t,
+                    stage.cell.model.body_name(pair.body_a) + " vs " +
+                        stage.cell.model.body_name(pair.body_b));
+    }
+  };
+  check(motion.q.front(), motion.time.front());
+  for (std::size_t i = 1; i < n; ++i) {
+    const Eigen::VectorXd& a = motion.q[i - 1];
+    const Eigen::VectorXd& b = motion.q[i];
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil((b - a).norm() / settings.resolution)));
+    for (int k = 1; k <= steps; ++k) {
+      const double s = static_cast<double>(k) / steps;
+      check(a + s * (b - a), motion.time[i - 1] + s * (motion.time[i] - motion.time[i - 1]));
+    }
+  }
+  return report;
+}
+
+}  // namespace hila::online
