@@ -6,12 +6,12 @@
 #include <optional>
 #include <tuple>
 
+#include "hila/core/bridge.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
-#include "hila/offline/bridge.hpp"
 #include "hila/offline/suction_pick.hpp"
 
 namespace hila::offline {
@@ -78,14 +78,14 @@ Connection roadmap_path(const ArmPlanning& arm, const std::vector<bool>& allowed
 // Where the filtered roadmap is cut (or an end does not attach): a bridge planned under the
 // same checks (the slip limit and the workspace as it currently holds).
 Connection bridge_path(ArmPlanning& arm, const GraspSlip& slip, const Eigen::VectorXd& from,
-                       const Eigen::VectorXd& to, const BridgeSettings& bridge) {
+                       const Eigen::VectorXd& to, const core::BridgeSettings& bridge) {
   Connection c;
   const SlipTest holds(slip);
   const Eigen::Matrix3d base_rotation = arm.workspace.base().linear();
   auto valid = [&](const Eigen::VectorXd& q) {
     return holds(gravity_in_tcp(arm.workspace.arm(), base_rotation, q)) && arm.workspace.valid(q);
   };
-  c.path = plan_bridge(arm.workspace.arm(), valid, from, to, bridge);
+  c.path = core::plan_bridge(arm.workspace.arm(), valid, from, to, bridge);
   if (c.path.empty()) return c;
   c.connected = true;
   c.via = "bridge";
@@ -96,7 +96,7 @@ Connection bridge_path(ArmPlanning& arm, const GraspSlip& slip, const Eigen::Vec
 // The roadmap first, then a bridge.
 Connection connect(ArmPlanning& arm, const std::vector<bool>& allowed, const GraspSlip& slip,
                    const Eigen::VectorXd& from, const Eigen::VectorXd& to, int k,
-                   core::GraphSearchWorkspace& search, const BridgeSettings& bridge) {
+                   core::GraphSearchWorkspace& search, const core::BridgeSettings& bridge) {
   const Endpoint start = endpoint(arm, slip, from, k);
   if (!start.attached.empty()) {
     Connection c = roadmap_path(arm, allowed, start, endpoint(arm, slip, to, k), search);
@@ -230,7 +230,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   ExchangeCheck exchange(cell, part.mesh, settings.suction_arm, settings.receiving_arm);
   std::uint64_t bridges = 0;
   auto bridge = [&] {
-    BridgeSettings b = settings.bridge;
+    core::BridgeSettings b = settings.bridge;
     b.resolution = receiving_roadmap.resolution;
     b.seed = settings.seed + 0x9E3779B97F4A7C15ULL * ++bridges;
     return b;

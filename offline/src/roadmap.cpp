@@ -168,14 +168,6 @@ Eigen::VectorXd roadmap_upper(const core::Arm& arm, const RoadmapSettings& setti
       .matrix();
 }
 
-std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
-                                          double resolution) {
-  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
-  std::vector<Eigen::VectorXd> out;
-  for (int i = 1; i < steps; ++i) out.push_back(a + (b - a) * (static_cast<double>(i) / steps));
-  return out;
-}
-
 std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Roadmap& roadmap,
                                              const GraspSlip& grasp, const Eigen::VectorXd& q,
                                              int k) {

@@ -4,10 +4,10 @@
 #include <string>
 #include <vector>
 
+#include "hila/core/bridge.hpp"
 #include "hila/core/cell.hpp"
 #include "hila/core/product.hpp"
 #include "hila/db/records.hpp"
-#include "hila/offline/bridge.hpp"
 #include "hila/offline/handover.hpp"
 #include "hila/offline/roadmap.hpp"
 
@@ -22,7 +22,7 @@ struct RegraspSettings {
   int served_goals = 3;
   int attach_neighbours = 10;  // roadmap nodes tried when connecting a configuration
   // Where a filtered roadmap is cut (or an end does not attach), a bridge is planned.
-  BridgeSettings bridge;
+  core::BridgeSettings bridge;
   // The receiving arm may take the board in any IK branch at the exchange and hand it over in
   // any at the goal: transits and transfers are tried through the roadmap for every branch
   // (pair), then bridged for at most this many.

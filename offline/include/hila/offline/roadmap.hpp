@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "hila/core/bridge.hpp"
 #include "hila/core/cell.hpp"
 #include "hila/db/records.hpp"
 #include "hila/offline/arm_workspace.hpp"
@@ -114,10 +115,7 @@ std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Road
                                              const GraspSlip& grasp, const Eigen::VectorXd& q,
                                              int k);
 
-// The interior samples of the straight joint-space segment a -> b at `resolution` (what the
-// roadmap checks and annotates): ceil(|b - a| / resolution) - 1 points, evenly spaced.
-std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
-                                          double resolution);
+using core::edge_samples;  // core/bridge.hpp
 
 // Gravity's direction in the TCP frame for arm joints q (world gravity -z), the arm's base
 // rotated by `base_rotation` in the world (core::arm_base_in_world, computed once by callers).

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "hila/offline/bridge.hpp"
+#include "hila/core/bridge.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -106,7 +106,7 @@ TEST(Bridge, ScenarioIsWellPosed) {
   EXPECT_TRUE(valid(s.to));
   EXPECT_TRUE(valid(gap));
   EXPECT_FALSE(valid((s.from + s.to) / 2.0));
-  EXPECT_FALSE(offline::segment_valid(valid, s.from, s.to, 0.05));
+  EXPECT_FALSE(core::segment_valid(valid, s.from, s.to, 0.05));
 }
 
 TEST(Bridge, DetourAroundWallIsValid) {
@@ -115,9 +115,9 @@ TEST(Bridge, DetourAroundWallIsValid) {
   const Validity valid = validity_of(s.wall);
   for (std::uint64_t seed : {1u, 2u, 3u, 4u}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    offline::BridgeSettings settings;
+    core::BridgeSettings settings;
     settings.seed = seed;
-    const auto path = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+    const auto path = core::plan_bridge(arm, valid, s.from, s.to, settings);
     ASSERT_GE(path.size(), 3u) << "the straight line is blocked, so a detour needs a waypoint";
     EXPECT_EQ(path.front(), s.from);
     EXPECT_EQ(path.back(), s.to);
@@ -133,10 +133,10 @@ TEST(Bridge, DetourHoldsAtFinerResolution) {
   const core::Arm& arm = left_arm();
   const Scenario s = wall_scenario();
   const Validity valid = validity_of(s.wall);
-  offline::BridgeSettings settings;
+  core::BridgeSettings settings;
   settings.resolution = 0.01;
   settings.seed = 9;
-  const auto path = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+  const auto path = core::plan_bridge(arm, valid, s.from, s.to, settings);
   ASSERT_GE(path.size(), 3u);
   EXPECT_EQ(path.front(), s.from);
   EXPECT_EQ(path.back(), s.to);
@@ -147,15 +147,15 @@ TEST(Bridge, SameSeedGivesIdenticalPath) {
   const core::Arm& arm = left_arm();
   const Scenario s = wall_scenario();
   const Validity valid = validity_of(s.wall);
-  offline::BridgeSettings settings;
+  core::BridgeSettings settings;
   settings.seed = 42;
-  const auto first = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+  const auto first = core::plan_bridge(arm, valid, s.from, s.to, settings);
   // Another plan with a different seed in between must not disturb the next one.
-  offline::BridgeSettings other = settings;
+  core::BridgeSettings other = settings;
   other.seed = 43;
-  const auto between = offline::plan_bridge(arm, valid, s.from, s.to, other);
+  const auto between = core::plan_bridge(arm, valid, s.from, s.to, other);
   EXPECT_FALSE(between.empty());
-  const auto second = offline::plan_bridge(arm, valid, s.from, s.to, settings);
+  const auto second = core::plan_bridge(arm, valid, s.from, s.to, settings);
   ASSERT_FALSE(first.empty());
   ASSERT_EQ(first.size(), second.size());
   for (std::size_t i = 0; i < first.size(); ++i) {
@@ -177,8 +177,8 @@ TEST(Bridge, StraightLineValidReturnsJustTheEnds) {
   to[1] += 0.4;
   to[2] -= 0.3;
   to[5] += 0.7;
-  ASSERT_TRUE(offline::segment_valid(valid, from, to, 0.05));
-  const auto path = offline::plan_bridge(arm, valid, from, to, {});
+  ASSERT_TRUE(core::segment_valid(valid, from, to, 0.05));
+  const auto path = core::plan_bridge(arm, valid, from, to, {});
   ASSERT_EQ(path.size(), 2u);
   EXPECT_EQ(path[0], from);
   EXPECT_EQ(path[1], to);
@@ -187,7 +187,7 @@ TEST(Bridge, StraightLineValidReturnsJustTheEnds) {
   to = from;
   to[0] += 1.0;
   ASSERT_TRUE(valid(from) && valid(to));
-  const auto through = offline::plan_bridge(arm, valid, from, to, {});
+  const auto through = core::plan_bridge(arm, valid, from, to, {});
   ASSERT_EQ(through.size(), 2u);
   EXPECT_EQ(through[0], from);
   EXPECT_EQ(through[1], to);
@@ -205,8 +205,8 @@ TEST(Bridge, InvalidEndsReturnNothing) {
   inside[0] = s.wall.wall_q0;
   ASSERT_FALSE(valid(inside));
   calls = 0;
-  EXPECT_TRUE(offline::plan_bridge(arm, valid, s.from, inside, {}).empty());
-  EXPECT_TRUE(offline::plan_bridge(arm, valid, inside, s.to, {}).empty());
+  EXPECT_TRUE(core::plan_bridge(arm, valid, s.from, inside, {}).empty());
+  EXPECT_TRUE(core::plan_bridge(arm, valid, inside, s.to, {}).empty());
   // Rejected up front, not after spending the budget.
   EXPECT_LE(calls, 4);
 }
@@ -222,10 +222,10 @@ TEST(Bridge, EnclosedGoalReturnsNothingWithinBudget) {
     const double r = (q - goal).norm();
     return !(r > 0.15 && r < 0.4);
   };
-  offline::BridgeSettings settings;
+  core::BridgeSettings settings;
   settings.max_checks = 5000;
   settings.seed = 5;
-  const auto path = offline::plan_bridge(arm, valid, s.from, goal, settings);
+  const auto path = core::plan_bridge(arm, valid, s.from, goal, settings);
   EXPECT_TRUE(path.empty());
   // The budget was spent (the planner did not give up early) and respected, give or take one
   // motion's worth of checks.
@@ -278,7 +278,7 @@ TEST(Bridge, SegmentValidMatchesDenseCheck) {
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto& c = cases[i];
     EXPECT_EQ(dense_segment_valid(valid, c.a, c.b), c.expected) << "case " << i;
-    EXPECT_EQ(offline::segment_valid(valid, c.a, c.b, resolution), c.expected) << "case " << i;
+    EXPECT_EQ(core::segment_valid(valid, c.a, c.b, resolution), c.expected) << "case " << i;
   }
 
   // Random segments against a ball obstacle, built around their closest approach to the centre:
@@ -306,7 +306,7 @@ TEST(Bridge, SegmentValidMatchesDenseCheck) {
     const Eigen::VectorXd b = closest + (0.6 + 0.9 * unit(rng)) * u;
     ASSERT_TRUE(ball(a) && ball(b));
     EXPECT_EQ(dense_segment_valid(ball, a, b), !through) << "trial " << trial;
-    EXPECT_EQ(offline::segment_valid(ball, a, b, resolution), !through) << "trial " << trial;
+    EXPECT_EQ(core::segment_valid(ball, a, b, resolution), !through) << "trial " << trial;
   }
 }
 
@@ -316,27 +316,27 @@ TEST(Bridge, SegmentValidChecksInteriorOnly) {
   b << 1.0, 0.0;
   // Only the two ends are invalid: the documented contract is that they are assumed checked.
   const Validity ends_invalid = [&](const Eigen::VectorXd& q) { return q != a && q != b; };
-  EXPECT_TRUE(offline::segment_valid(ends_invalid, a, b, 0.05));
+  EXPECT_TRUE(core::segment_valid(ends_invalid, a, b, 0.05));
   // A single invalid interior state on the sampling grid is caught.
   Eigen::VectorXd mid(2);
   mid << 0.5, 0.0;
   const Validity mid_invalid = [&](const Eigen::VectorXd& q) { return (q - mid).norm() > 1e-9; };
-  EXPECT_FALSE(offline::segment_valid(mid_invalid, a, b, 0.25));
+  EXPECT_FALSE(core::segment_valid(mid_invalid, a, b, 0.25));
   // Resolution coarser than the segment: no interior samples at all.
   long calls = 0;
   const Validity counting = [&](const Eigen::VectorXd&) {
     ++calls;
     return false;
   };
-  EXPECT_TRUE(offline::segment_valid(counting, a, b, 2.0));
+  EXPECT_TRUE(core::segment_valid(counting, a, b, 2.0));
   EXPECT_EQ(calls, 0);
   // At resolution 1/8 a unit segment has 7 interior samples.
-  EXPECT_FALSE(offline::segment_valid(counting, a, b, 0.125));
+  EXPECT_FALSE(core::segment_valid(counting, a, b, 0.125));
   calls = 0;
   const Validity counting_ok = [&](const Eigen::VectorXd&) {
     ++calls;
     return true;
   };
-  EXPECT_TRUE(offline::segment_valid(counting_ok, a, b, 0.125));
+  EXPECT_TRUE(core::segment_valid(counting_ok, a, b, 0.125));
   EXPECT_EQ(calls, 7);
 }

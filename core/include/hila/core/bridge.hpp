@@ -1,13 +1,15 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "hila/core/cell.hpp"
 
-namespace hila::offline {
+namespace hila::core {
 
 struct BridgeSettings {
   // Budget in validity checks, not seconds: the same inputs give the same bridge on any machine.
@@ -19,20 +21,27 @@ struct BridgeSettings {
   double range = 0.4;
   // Each joint within this much of home (and the limits), as the roadmaps (rad).
   double joint_range = 3.14159265358979323846;
+  // Online queries also stop at a deadline (the check budget keeps offline builds deterministic).
+  std::optional<std::chrono::steady_clock::time_point> deadline;
 };
 
 // A path from `from` to `to` where every state satisfies `valid`, for where a filtered roadmap
 // is cut: OMPL's RRT-Connect (sampling with a seeded generator of its own, so deterministic),
 // then greedy straight-line shortcuts. Every segment is re-checked at the resolution. Returns
 // the waypoints (from first, to last), or nothing within the budget.
-std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
+std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
                                          const std::function<bool(const Eigen::VectorXd&)>& valid,
                                          const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                                          const BridgeSettings& settings);
+
+// The interior samples of the straight joint-space segment a -> b at `resolution`:
+// ceil(|b - a| / resolution) - 1 points, evenly spaced (what roadmaps check and annotate).
+std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                          double resolution);
 
 // Whether the straight segment a -> b is valid at every interior sample (the ends are assumed
 // checked), at the resolution.
 bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
                    const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution);
 
-}  // namespace hila::offline
+}  // namespace hila::core

@@ -1,4 +1,4 @@
-#include "hila/offline/bridge.hpp"
+#include "hila/core/bridge.hpp"
 
 #include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/ProblemDefinition.h>
@@ -10,15 +10,14 @@
 #include <ompl/util/Console.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <random>
-
-#include "hila/offline/roadmap.hpp"
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
-namespace hila::offline {
+namespace hila::core {
 
 namespace {
 
@@ -62,6 +61,14 @@ Eigen::VectorXd to_vector(const ob::State* s, int dof) {
 
 }  // namespace
 
+std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                          double resolution) {
+  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
+  std::vector<Eigen::VectorXd> out;
+  for (int i = 1; i < steps; ++i) out.push_back(a + (b - a) * (static_cast<double>(i) / steps));
+  return out;
+}
+
 bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
                    const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution) {
   for (const auto& q : edge_samples(a, b, resolution)) {
@@ -70,7 +77,7 @@ bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
   return true;
 }
 
-std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
+std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
                                          const std::function<bool(const Eigen::VectorXd&)>& valid,
                                          const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                                          const BridgeSettings& settings) {
@@ -113,8 +120,10 @@ std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
   planner.setRange(settings.range);
   planner.setProblemDefinition(pdef);
   planner.setup();
-  const ob::PlannerStatus status =
-      planner.solve(ob::PlannerTerminationCondition([&] { return checks >= settings.max_checks; }));
+  const ob::PlannerStatus status = planner.solve(ob::PlannerTerminationCondition([&] {
+    return checks >= settings.max_checks ||
+           (settings.deadline && std::chrono::steady_clock::now() >= *settings.deadline);
+  }));
   if (status != ob::PlannerStatus::EXACT_SOLUTION) return {};
   const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
   std::vector<Eigen::VectorXd> raw;
@@ -143,4 +152,4 @@ std::vector<Eigen::VectorXd> plan_bridge(const core::Arm& arm,
   return out;
 }
 
-}  // namespace hila::offline
+}  // namespace hila::core
