@@ -1,0 +1,112 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hila/core/collision.hpp"
+#include "hila/core/roadmap_graph.hpp"
+#include "hila/db/records.hpp"
+#include "hila/online/world.hpp"
+
+namespace hila::online {
+
+// One arm's stored roadmap as the planner searches it. Const after construction: shared.
+struct ArmRoadmap {
+  explicit ArmRoadmap(db::RoadmapRecord stored);
+  db::RoadmapRecord record;
+  core::RoadmapGraph graph;
+};
+
+// The board in the moving arm's hand, if any.
+struct HeldBoard {
+  bool held = false;
+  core::Pose board_in_tcp = core::Pose::Identity();
+  double jaw = 0.085;  // the gripper's opening while it holds (ignored for the suction arm)
+  // Slip: the opening axis and the unit lever to the centre of mass in the TCP frame, and the
+  // grasp's limit (90: none).
+  Eigen::Vector3d axis_tcp = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d lever_tcp = Eigen::Vector3d::Zero();
+  double theta_c_deg = 90.0;
+};
+
+struct MotionRequest {
+  Eigen::VectorXd start;
+  Eigen::VectorXd goal;
+  // Roadmap edges the held board's grasp may use (the stored filter); nullptr: every edge.
+  const std::vector<bool>* filter = nullptr;
+  HeldBoard held;
+  Eigen::VectorXd robot_q;                          // the whole robot while this arm moves
+  bool tool_in_hand = true;                         // the suction arm holds the tool
+  core::Pose tool_world = core::Pose::Identity();   // the tool's handle when not in hand
+  core::Pose board_world = core::Pose::Identity();  // the board when not held
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+};
+
+enum class MotionStatus { kSolved, kInvalidStart, kInvalidGoal, kNoPath, kTimeout };
+const char* to_string(MotionStatus status);
+
+struct MotionResult {
+  MotionStatus status = MotionStatus::kNoPath;
+  std::string reason;                 // why not solved, naming what is in the way
+  std::vector<Eigen::VectorXd> path;  // start ... goal, straight segments between waypoints
+  std::string via;                    // "direct", "roadmap" or "bridge"
+  int searches = 0;                   // A* runs (one more after each invalidated edge)
+  int edges_checked = 0;              // roadmap edges validated against the scene
+  int edges_invalidated = 0;          // of those, blocked in the scene
+  double seconds = 0.0;
+  bool solved() const { return status == MotionStatus::kSolved; }
+};
+
+struct MotionSettings {
+  int attach_neighbours = 10;  // roadmap nodes tried per end
+  int attachments = 3;         // valid attachments kept per end
+  int max_searches = 200;
+  long bridge_checks = 20000;  // a bridge's validity-check budget (also bounded by the deadline)
+  std::uint64_t seed = 1;
+};
+
+// Plans one arm's motion through its stored roadmap for the scene as it is: both ends attached
+// to nearby nodes, A* over the allowed edges, the path's edges validated lazily against the
+// whole world (the held board and the tool included) and blocked edges dropped before searching
+// again; where the roadmap is cut, an RRT-Connect bridge under the same checks. Holds the
+// per-thread state (collision data, search workspace, edge verdicts): one per thread. Never
+// throws on the planning path: failures are statuses with reasons.
+class ArmMotionPlanner {
+ public:
+  ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap, const std::string& arm,
+                   const MotionSettings& settings = {});
+
+  MotionResult plan(const MotionRequest& request);
+
+  // Under the request last passed to prepare() or plan().
+  void prepare(const MotionRequest& request);
+  bool valid(const Eigen::VectorXd& q);
+  std::string why_invalid(const Eigen::VectorXd& q);
+  bool segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+
+ private:
+  bool edge_valid(int edge);
+  std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q);
+
+  const World& world_;
+  const ArmRoadmap& roadmap_;
+  const core::Arm& arm_;
+  int arm_index_ = 0;
+  MotionSettings settings_;
+  core::CollisionData data_;
+  core::GraphSearchWorkspace search_;
+  std::vector<int> moving_;
+  core::Pose base_;
+  Eigen::VectorXd robot_q_;
+  HeldBoard held_;
+  bool moves_tool_ = false;
+  std::vector<bool> allowed_;
+  std::vector<signed char> node_state_;  // -1 unknown, 0 blocked, 1 clear (this request)
+  int checked_ = 0;
+  int invalidated_ = 0;
+};
+
+}  // namespace hila::online

@@ -1,0 +1,236 @@
+#include "hila/online/arm_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hila/core/bridge.hpp"
+#include "hila/core/soft_finger.hpp"
+#include "hila/core/stage_scene.hpp"
+
+namespace hila::online {
+
+namespace {
+
+int arm_index_of(const core::Cell& cell, const core::Arm& arm) {
+  int i = 0;
+  while (&cell.arms()[static_cast<std::size_t>(i)] != &arm) ++i;
+  return i;
+}
+
+}  // namespace
+
+const char* to_string(MotionStatus status) {
+  switch (status) {
+    case MotionStatus::kSolved:
+      return "solved";
+    case MotionStatus::kInvalidStart:
+      return "invalid start";
+    case MotionStatus::kInvalidGoal:
+      return "invalid goal";
+    case MotionStatus::kNoPath:
+      return "no path";
+    case MotionStatus::kTimeout:
+      return "timeout";
+  }
+  return "unknown";
+}
+
+ArmRoadmap::ArmRoadmap(db::RoadmapRecord stored)
+    : record(std::move(stored)), graph(record.nodes, record.edges) {}
+
+ArmMotionPlanner::ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap,
+                                   const std::string& arm, const MotionSettings& settings)
+    : world_(world),
+      roadmap_(roadmap),
+      arm_(world.cell().arm(arm)),
+      arm_index_(arm_index_of(world.cell(), arm_)),
+      settings_(settings),
+      data_(world.make_data()),
+      base_(core::arm_base_in_world(world.cell(), arm_)) {}
+
+void ArmMotionPlanner::prepare(const MotionRequest& request) {
+  const core::Cell& cell = world_.cell();
+  const core::StageScene& stage = world_.stage();
+  robot_q_ = request.robot_q.size() == 0 ? cell.home_configuration() : request.robot_q;
+  held_ = request.held;
+  if (held_.held && arm_index_ != stage.suction_arm) cell.set_jaw(robot_q_, arm_, held_.jaw);
+  moves_tool_ = request.tool_in_hand && arm_index_ == stage.suction_arm;
+  moving_ = stage.cell.arm_bodies[static_cast<std::size_t>(arm_index_)];
+  if (moves_tool_)
+    moving_.insert(moving_.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
+  if (held_.held) moving_.push_back(stage.board);
+  core::set_robot_state(cell, stage.cell, data_, robot_q_);
+  if (request.tool_in_hand && !moves_tool_) {
+    const core::Arm& suction = cell.arms()[static_cast<std::size_t>(stage.suction_arm)];
+    std::vector<core::Pose> links;
+    cell.robot().link_poses(robot_q_, links);
+    core::set_tool_held(
+        cell, stage, data_,
+        links[static_cast<std::size_t>(cell.robot().link_index(suction.spec.tip_link))]);
+  } else if (!request.tool_in_hand) {
+    core::set_robot_pose(data_, stage.tool, stage.tool_links_in_handle, request.tool_world);
+  }
+  if (!held_.held) data_.set_body_pose(stage.board, request.board_world);
+  const std::size_t edges = roadmap_.record.edges.size();
+  if (request.filter != nullptr && request.filter->size() == edges) {
+    allowed_ = *request.filter;
+  } else {
+    allowed_.assign(edges, true);
+  }
+  node_state_.assign(roadmap_.record.nodes.size(), -1);
+  checked_ = 0;
+  invalidated_ = 0;
+}
+
+bool ArmMotionPlanner::valid(const Eigen::VectorXd& q) {
+  return why_invalid(q).empty();
+}
+
+std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {
+  if (q.size() != arm_.chain.dof() || !arm_.chain.within_limits(q, 1e-9)) {
+    return "outside the joint limits";
+  }
+  const core::Pose tcp = base_ * arm_.chain.fk(q);
+  if (held_.held && held_.theta_c_deg < 90.0) {
+    const double slip =
+        core::slip_angle_deg(tcp.linear() * held_.axis_tcp, tcp.linear() * held_.lever_tcp,
+                             Eigen::Vector3d(0.0, 0.0, -1.0));
+    if (slip > held_.theta_c_deg) return "the held board would slip";
+  }
+  const core::Cell& cell = world_.cell();
+  const core::StageScene& stage = world_.stage();
+  cell.set_arm(robot_q_, arm_, q);
+  core::set_robot_state(cell, stage.cell, data_, robot_q_);
+  if (moves_tool_) core::set_tool_held(cell, stage, data_, tcp);
+  if (held_.held) data_.set_body_pose(stage.board, tcp * held_.board_in_tcp);
+  core::CollisionPair pair;
+  if (core::in_collision(stage.cell.model, data_, moving_, &pair)) {
+    return stage.cell.model.body_name(pair.body_a) + " vs " +
+           stage.cell.model.body_name(pair.body_b);
+  }
+  return "";
+}
+
+bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  for (const auto& q : core::edge_samples(a, b, roadmap_.record.resolution)) {
+    if (!valid(q)) return false;
+  }
+  return true;
+}
+
+bool ArmMotionPlanner::edge_valid(int edge) {
+  const auto [u, v] = roadmap_.record.edges[static_cast<std::size_t>(edge)];
+  for (const int n : {u, v}) {
+    auto& state = node_state_[static_cast<std::size_t>(n)];
+    if (state < 0) state = valid(roadmap_.record.nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
+    if (state == 0) return false;
+  }
+  ++checked_;
+  return segment_valid(roadmap_.record.nodes[static_cast<std::size_t>(u)],
+                       roadmap_.record.nodes[static_cast<std::size_t>(v)]);
+}
+
+std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd& q) {
+  const auto& nodes = roadmap_.record.nodes;
+  std::vector<std::pair<double, int>> near;
+  near.reserve(nodes.size());
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    near.emplace_back((nodes[i] - q).norm(), static_cast<int>(i));
+  }
+  const auto take =
+      std::min<std::size_t>(near.size(), static_cast<std::size_t>(settings_.attach_neighbours));
+  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(take), near.end());
+  std::vector<core::GraphEndpoint> out;
+  for (std::size_t j = 0; j < take; ++j) {
+    if (static_cast<int>(out.size()) >= settings_.attachments) break;
+    const int n = near[j].second;
+    auto& state = node_state_[static_cast<std::size_t>(n)];
+    if (state < 0) state = valid(nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
+    if (state == 1 && segment_valid(q, nodes[static_cast<std::size_t>(n)])) {
+      out.push_back({n, near[j].first});
+    }
+  }
+  return out;
+}
+
+MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
+  const auto started = std::chrono::steady_clock::now();
+  MotionResult r;
+  auto finish = [&](MotionStatus status, std::string reason) {
+    r.status = status;
+    r.reason = std::move(reason);
+    r.edges_checked = checked_;
+    r.edges_invalidated = invalidated_;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (status != MotionStatus::kSolved) r.path.clear();
+    return r;
+  };
+  auto late = [&] { return std::chrono::steady_clock::now() >= request.deadline; };
+  prepare(request);
+  if (const std::string why = why_invalid(request.start); !why.empty()) {
+    return finish(MotionStatus::kInvalidStart, "the start is invalid: " + why);
+  }
+  if (const std::string why = why_invalid(request.goal); !why.empty()) {
+    return finish(MotionStatus::kInvalidGoal, "the goal is invalid: " + why);
+  }
+  if (segment_valid(request.start, request.goal)) {
+    r.path = {request.start, request.goal};
+    r.via = "direct";
+    return finish(MotionStatus::kSolved, "");
+  }
+  // Through the roadmap, lazily validated.
+  const auto entries = attach(request.start);
+  const auto exits = entries.empty() ? std::vector<core::GraphEndpoint>{} : attach(request.goal);
+  while (!entries.empty() && !exits.empty() && r.searches < settings_.max_searches) {
+    if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the search");
+    ++r.searches;
+    const core::GraphPath path =
+        core::shortest_path(roadmap_.graph, allowed_, entries, exits, search_);
+    if (!path.found) break;
+    bool clear = true;
+    for (std::size_t i = 1; i < path.nodes.size() && clear; ++i) {
+      const int a = path.nodes[i - 1];
+      const int b = path.nodes[i];
+      for (auto it = roadmap_.graph.neighbours_begin(a); it != roadmap_.graph.neighbours_end(a);
+           ++it) {
+        if (it->node != b || !allowed_[static_cast<std::size_t>(it->edge)]) continue;
+        if (!edge_valid(it->edge)) {
+          allowed_[static_cast<std::size_t>(it->edge)] = false;
+          ++invalidated_;
+          clear = false;
+        }
+        break;
+      }
+    }
+    if (!clear) continue;
+    r.path.push_back(request.start);
+    for (const int n : path.nodes)
+      r.path.push_back(roadmap_.record.nodes[static_cast<std::size_t>(n)]);
+    r.path.push_back(request.goal);
+    r.via = "roadmap";
+    return finish(MotionStatus::kSolved, "");
+  }
+  if (late()) return finish(MotionStatus::kTimeout, "the deadline passed before a bridge");
+  // The roadmap is cut here: a bridge under the same checks, within the deadline.
+  core::BridgeSettings bridge;
+  bridge.max_checks = settings_.bridge_checks;
+  bridge.resolution = roadmap_.record.resolution;
+  bridge.seed = settings_.seed;
+  bridge.deadline = request.deadline;
+  r.path = core::plan_bridge(
+      arm_, [&](const Eigen::VectorXd& q) { return valid(q); }, request.start, request.goal,
+      bridge);
+  if (!r.path.empty()) {
+    r.via = "bridge";
+    return finish(MotionStatus::kSolved, "");
+  }
+  if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the bridge");
+  return finish(MotionStatus::kNoPath,
+                entries.empty() ? "the start attaches to no roadmap node and no bridge was found"
+                : exits.empty()
+                    ? "the goal attaches to no roadmap node and no bridge was found"
+                    : "the roadmap is cut between start and goal (" + std::to_string(invalidated_) +
+                          " edges blocked in the scene) and no bridge was found");
+}
+
+}  // namespace hila::online

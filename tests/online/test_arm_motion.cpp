@@ -1,0 +1,164 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "hila/core/product.hpp"
+#include "hila/core/stage_scene.hpp"
+#include "hila/offline/roadmap.hpp"
+#include "hila/online/arm_motion.hpp"
+#include "hila/online/validator.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+const core::ProductSpec& cabinet() {
+  static const core::ProductSpec product = core::load_product(test::product_path());
+  return product;
+}
+
+// A small left-arm roadmap of the reference cell (the offline builder, as the database stores it).
+const online::ArmRoadmap& left_roadmap() {
+  static const online::ArmRoadmap roadmap = [] {
+    offline::RoadmapSettings settings;
+    settings.nodes = 400;
+    return online::ArmRoadmap(
+        offline::to_record(offline::build_roadmap(*test::reference_cell(), "left", settings)));
+  }();
+  return roadmap;
+}
+
+// Waypoints 4 s apart: slow enough for every velocity and acceleration limit.
+online::Motion timed(const std::vector<Eigen::VectorXd>& path, const core::Pose& board) {
+  online::Motion m;
+  m.arm = "left";
+  m.q = path;
+  for (std::size_t i = 0; i < path.size(); ++i) m.time.push_back(4.0 * static_cast<double>(i));
+  m.robot_q = test::reference_cell()->home_configuration();
+  m.board_world = board;
+  return m;
+}
+
+std::string describe(const online::ValidationReport& r) {
+  std::string out;
+  for (const auto& v : r.violations) out += v.kind + ": " + v.detail + "; ";
+  return out;
+}
+
+online::MotionRequest request(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  online::MotionRequest q;
+  q.start = a;
+  q.goal = b;
+  q.robot_q = test::reference_cell()->home_configuration();
+  q.board_world = cabinet().part("top").initial;
+  return q;
+}
+
+// Seeded far-apart node pairs of the roadmap.
+std::vector<std::pair<Eigen::VectorXd, Eigen::VectorXd>> far_pairs(int count) {
+  const auto& nodes = left_roadmap().record.nodes;
+  std::mt19937_64 rng(7);
+  std::vector<std::pair<Eigen::VectorXd, Eigen::VectorXd>> out;
+  while (static_cast<int>(out.size()) < count) {
+    const auto& a = nodes[rng() % nodes.size()];
+    const auto& b = nodes[rng() % nodes.size()];
+    if ((a - b).norm() > 2.0) out.emplace_back(a, b);
+  }
+  return out;
+}
+
+online::SceneObstacle crate_at(const Eigen::Vector3d& p, double size) {
+  online::SceneObstacle crate;
+  crate.name = "crate";
+  crate.box_size = Eigen::Vector3d::Constant(size);
+  crate.pose = core::Pose(Eigen::Translation3d(p));
+  return crate;
+}
+
+}  // namespace
+
+TEST(ArmMotion, SolvedMotionsPassTheIndependentValidator) {
+  const auto& cell = *test::reference_cell();
+  const online::Scene scene = online::nominal_scene(cell, cabinet());
+  const online::World world(cell, cabinet(), scene, "top");
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  core::CollisionData data = world.make_data();
+  int solved = 0;
+  for (const auto& [a, b] : far_pairs(8)) {
+    const auto result = planner.plan(request(a, b));
+    if (!result.solved()) continue;
+    ++solved;
+    ASSERT_GE(result.path.size(), 2u);
+    EXPECT_TRUE(result.path.front().isApprox(a, 0.0));
+    EXPECT_TRUE(result.path.back().isApprox(b, 0.0));
+    const auto report =
+        online::validate_motion(world, data, timed(result.path, cabinet().part("top").initial));
+    EXPECT_TRUE(report.valid()) << result.via << ": " << describe(report);
+  }
+  EXPECT_GE(solved, 6) << "of 8 node pairs";
+}
+
+TEST(ArmMotion, AnObstacleOnTheStoredPathIsRepairedAround) {
+  const auto& cell = *test::reference_cell();
+  const online::Scene nominal = online::nominal_scene(cell, cabinet());
+  const online::World nominal_world(cell, cabinet(), nominal, "top");
+  online::ArmMotionPlanner planner(nominal_world, left_roadmap(), "left");
+  // A roadmap path with interior nodes.
+  online::MotionResult before;
+  Eigen::VectorXd a, b;
+  for (const auto& pair : far_pairs(20)) {
+    before = planner.plan(request(pair.first, pair.second));
+    if (before.solved() && before.via == "roadmap" && before.path.size() >= 4) {
+      a = pair.first;
+      b = pair.second;
+      break;
+    }
+  }
+  ASSERT_TRUE(before.solved() && before.via == "roadmap");
+  // A crate at the TCP of the path's middle waypoint.
+  const core::Arm& left = cell.arm("left");
+  const Eigen::VectorXd& middle = before.path[before.path.size() / 2];
+  const core::Pose tcp = core::arm_base_in_world(cell, left) * left.chain.fk(middle);
+  online::Scene blocked = nominal;
+  blocked.obstacles.push_back(crate_at(tcp.translation(), 0.08));
+  const online::World world(cell, cabinet(), blocked, "top");
+  core::CollisionData data = world.make_data();
+  const auto old =
+      online::validate_motion(world, data, timed(before.path, cabinet().part("top").initial));
+  ASSERT_FALSE(old.valid()) << "the crate must block the stored path";
+
+  online::ArmMotionPlanner repaired(world, left_roadmap(), "left");
+  const auto after = repaired.plan(request(a, b));
+  ASSERT_TRUE(after.solved()) << after.reason;
+  EXPECT_TRUE(after.via == "bridge" || after.edges_invalidated > 0) << after.via;
+  const auto report =
+      online::validate_motion(world, data, timed(after.path, cabinet().part("top").initial));
+  EXPECT_TRUE(report.valid()) << describe(report);
+}
+
+TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
+  const auto& cell = *test::reference_cell();
+  const auto pair = far_pairs(1).front();
+  const core::Arm& left = cell.arm("left");
+  const core::Pose tcp = core::arm_base_in_world(cell, left) * left.chain.fk(pair.second);
+  online::Scene scene = online::nominal_scene(cell, cabinet());
+  scene.obstacles.push_back(crate_at(tcp.translation(), 0.12));  // wider than the open jaw
+  const online::World world(cell, cabinet(), scene, "top");
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  const auto blocked = planner.plan(request(pair.first, pair.second));
+  EXPECT_EQ(blocked.status, online::MotionStatus::kInvalidGoal);
+  EXPECT_NE(blocked.reason.find("obstacle/crate"), std::string::npos) << blocked.reason;
+  EXPECT_TRUE(blocked.path.empty());
+
+  const online::World free_world(cell, cabinet(), online::nominal_scene(cell, cabinet()), "top");
+  online::ArmMotionPlanner free_planner(free_world, left_roadmap(), "left");
+  auto late = request(pair.first, pair.second);
+  late.deadline = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+  const auto result = free_planner.plan(late);
+  // Only a direct straight segment can beat a deadline that has passed.
+  if (result.via != "direct") {
+    EXPECT_EQ(result.status, online::MotionStatus::kTimeout) << result.reason;
+    EXPECT_TRUE(result.path.empty());
+  }
+}
