@@ -102,11 +102,19 @@ Scene nominal_scene(const core::Cell& cell, const core::ProductSpec& product) {
   return s;
 }
 
+SceneFiles read_scene_files(const std::string& path) {
+  const core::YamlNode root = core::YamlNode::load_file(path);
+  const core::YamlNode files = root.at("files");
+  files.expect_only({"cell", "product"});
+  return {files.resolve_path(files.at("cell").as_string()),
+          files.resolve_path(files.at("product").as_string())};
+}
+
 Scene load_scene(const std::string& path, const core::Cell& cell,
                  const core::ProductSpec& product) {
   const core::YamlNode root = core::YamlNode::load_file(path);
-  root.expect_only({"product", "boards", "tool", "tool_in_hand", "assembly_frame", "finished",
-                    "human", "obstacles", "robot"});
+  root.expect_only({"product", "files", "boards", "tool", "tool_in_hand", "assembly_frame",
+                    "finished", "human", "obstacles", "robot"});
   Scene s = nominal_scene(cell, product);
   s.file = path;
   const core::YamlNode name = root.at("product");

@@ -159,6 +159,14 @@ TEST(Scene, BadInputsNameTheFileTheFieldAndWhatWasExpected) {
          {"human.stance", "clear of the table"});
 }
 
+TEST(Scene, TheNominalSceneNamesTheCabinetsCellAndProductFiles) {
+  const online::SceneFiles files = online::read_scene_files(scene_path());
+  EXPECT_EQ(core::load_product(files.product).name, "cabinet");
+  EXPECT_EQ(core::load_cell_spec(files.cell).arms.size(), 2u);
+  test::expect_input_error(
+      [] { online::read_scene_files(write_scene("no_files", "product: cabinet\n")); }, {"files"});
+}
+
 TEST(Scene, MissingFileIsAnInputError) {
   test::expect_input_error([] { load("/nonexistent/scene.yaml"); }, {"/nonexistent/scene.yaml"});
 }

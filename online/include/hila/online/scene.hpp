@@ -51,6 +51,14 @@ struct Scene {
   Scene with_finished(const core::ProductSpec& spec, const std::string& board) const;
 };
 
+// The cell and product files a scene names (`files: {cell: ..., product: ...}`, relative to the
+// scene file), read before the scene itself can be checked against them. Throws core::InputError.
+struct SceneFiles {
+  std::string cell;
+  std::string product;
+};
+SceneFiles read_scene_files(const std::string& path);
+
 // Reads and checks a scene file against the cell and the product: unknown boards, arms or
 // fields, non-finite numbers, a board detected below the table top, a board both finished and
 // detected, joints outside their limits, a human stance over the table. Throws core::InputError

@@ -1,0 +1,43 @@
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/product.hpp"
+#include "hila/db/database.hpp"
+#include "hila/online/arm_motion.hpp"
+
+namespace hila::online {
+
+// Everything the online planner reads, loaded once: the cell, the product and the database
+// built from exactly these files (refused otherwise), with each arm's roadmap ready to search.
+// Immutable after load: one model serves every query and thread (Pinocchio's Model; the
+// per-thread state lives in the planners).
+class PlannerModel {
+ public:
+  // Throws core::InputError / db::DatabaseError naming the file and field: a missing, corrupt
+  // or outdated database, one built from another cell or product (the hashes differ: "rebuild
+  // with hila build ..."), or one without roadmaps.
+  static std::shared_ptr<const PlannerModel> load(const std::string& database_path,
+                                                  const std::string& cell_path,
+                                                  const std::string& product_path);
+
+  const core::Cell& cell() const { return *cell_; }
+  const core::ProductSpec& product() const { return product_; }
+  const db::Database& database() const { return database_; }
+  // Throws core::InputError naming the database for an arm without a roadmap.
+  const ArmRoadmap& roadmap(const std::string& arm) const;
+
+ private:
+  PlannerModel(std::shared_ptr<const core::Cell> cell, core::ProductSpec product,
+               db::Database database);
+
+  std::shared_ptr<const core::Cell> cell_;
+  core::ProductSpec product_;
+  db::Database database_;
+  std::map<std::string, std::unique_ptr<ArmRoadmap>> roadmaps_;
+};
+
+}  // namespace hila::online

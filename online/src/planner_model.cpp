@@ -1,0 +1,48 @@
+#include "hila/online/planner_model.hpp"
+
+#include "hila/core/error.hpp"
+#include "hila/db/provenance.hpp"
+
+namespace hila::online {
+
+std::shared_ptr<const PlannerModel> PlannerModel::load(const std::string& database_path,
+                                                       const std::string& cell_path,
+                                                       const std::string& product_path) {
+  auto cell = core::Cell::load(cell_path);
+  core::ProductSpec product = core::load_product(product_path);
+  db::OpenOptions options;
+  options.expected_cell_hash = db::cell_hash(cell->spec());
+  options.expected_product_hash = db::product_hash(product);
+  db::Database database = db::Database::open(database_path, options);
+  if (database.meta().product_name != product.name) {
+    throw db::DatabaseError(database_path, "meta.product_name",
+                            "the product '" + product.name + "' of " + product_path,
+                            "'" + database.meta().product_name + "'");
+  }
+  return std::shared_ptr<const PlannerModel>(
+      new PlannerModel(std::move(cell), std::move(product), std::move(database)));
+}
+
+PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::ProductSpec product,
+                           db::Database database)
+    : cell_(std::move(cell)), product_(std::move(product)), database_(std::move(database)) {
+  for (const auto& arm : cell_->arms()) {
+    const db::RoadmapRecord* record = database_.roadmap(arm.spec.name);
+    if (record == nullptr) {
+      throw db::DatabaseError(
+          database_.path(), "roadmaps", "a roadmap for arm '" + arm.spec.name + "'", "none",
+          "rebuild with: hila build " + product_.file + " -o " + database_.path());
+    }
+    roadmaps_[arm.spec.name] = std::make_unique<ArmRoadmap>(*record);
+  }
+}
+
+const ArmRoadmap& PlannerModel::roadmap(const std::string& arm) const {
+  const auto it = roadmaps_.find(arm);
+  if (it == roadmaps_.end()) {
+    throw core::InputError(database_.path(), "roadmaps", "an arm of the cell", "'" + arm + "'");
+  }
+  return *it->second;
+}
+
+}  // namespace hila::online
