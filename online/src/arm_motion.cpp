@@ -167,7 +167,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   };
   auto late = [&] { return std::chrono::steady_clock::now() >= request.deadline; };
   prepare(request);
-  if (const std::string why = why_invalid(request.start); !why.empty()) {
+  if (const std::string why = why_invalid(request.start);
+      !why.empty() && !(request.start_in_contact && why.find(" vs ") != std::string::npos)) {
     return finish(MotionStatus::kInvalidStart, "the start is invalid: " + why);
   }
   if (const std::string why = why_invalid(request.goal); !why.empty()) {
@@ -178,7 +179,15 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     r.via = "direct";
     return finish(MotionStatus::kSolved, "");
   }
+  std::string direct_blocker;  // what stops the straight motion, for the reason
+  for (const auto& q :
+       core::edge_samples(request.start, request.goal, roadmap_.record.resolution)) {
+    direct_blocker = why_invalid(q);
+    if (!direct_blocker.empty()) break;
+  }
   // Through the roadmap, lazily validated.
+  // A start in contact leaves straight up first (its lift is the request's goal, in practice):
+  // the roadmap is entered from the goal side only when the direct segment failed.
   const auto entries = attach(request.start);
   const auto exits = entries.empty() ? std::vector<core::GraphEndpoint>{} : attach(request.goal);
   while (!entries.empty() && !exits.empty() && r.searches < settings_.max_searches) {
@@ -225,12 +234,14 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the bridge");
-  return finish(MotionStatus::kNoPath,
-                entries.empty() ? "the start attaches to no roadmap node and no bridge was found"
-                : exits.empty()
-                    ? "the goal attaches to no roadmap node and no bridge was found"
-                    : "the roadmap is cut between start and goal (" + std::to_string(invalidated_) +
-                          " edges blocked in the scene) and no bridge was found");
+  return finish(
+      MotionStatus::kNoPath,
+      entries.empty() ? "the start attaches to no roadmap node and no bridge was found"
+      : exits.empty()
+          ? "the goal attaches to no roadmap node and no bridge was found"
+          : "the roadmap is cut between start and goal (" + std::to_string(invalidated_) +
+                " edges blocked in the scene) and no bridge was found; the straight motion meets " +
+                direct_blocker);
 }
 
 }  // namespace hila::online

@@ -43,6 +43,9 @@ struct MotionRequest {
   core::Pose tool_world = core::Pose::Identity();   // the tool's handle when not in hand
   core::Pose board_world = core::Pose::Identity();  // the board when not held
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  // The start touches by design (a lift: the picked board or the grasped tool still rests on
+  // the table): its own collisions are not checked, every later sample is.
+  bool start_in_contact = false;
 };
 
 enum class MotionStatus { kSolved, kInvalidStart, kInvalidGoal, kNoPath, kTimeout };
@@ -61,10 +64,10 @@ struct MotionResult {
 };
 
 struct MotionSettings {
-  int attach_neighbours = 10;  // roadmap nodes tried per end
-  int attachments = 3;         // valid attachments kept per end
+  int attach_neighbours = 12;  // roadmap nodes tried per end
+  int attachments = 6;         // valid attachments kept per end
   int max_searches = 200;
-  long bridge_checks = 20000;  // a bridge's validity-check budget (also bounded by the deadline)
+  long bridge_checks = 4000;  // a bridge's validity-check budget (also bounded by the deadline)
   std::uint64_t seed = 1;
 };
 

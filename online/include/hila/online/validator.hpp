@@ -26,6 +26,7 @@ struct Motion {
   core::Pose board_world = core::Pose::Identity();  // where the board is when not held
   bool tool_in_hand = true;                         // the suction arm holds the tool
   core::Pose tool_world = core::Pose::Identity();   // the tool's handle when not in hand
+  bool start_in_contact = false;  // the first sample's collisions are by design (a lift)
 };
 
 struct ValidatorSettings {

@@ -1,0 +1,92 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hila/online/arm_motion.hpp"
+#include "hila/online/planner_model.hpp"
+#include "hila/online/scene.hpp"
+#include "hila/online/validator.hpp"
+
+namespace hila::online {
+
+struct BoardPlanSettings {
+  double approach = 0.05;     // m: straight approach and retreat along the cup's / gripper's axis
+  double lift = 0.15;         // m: straight up from the table after the suction pick
+  int goals = 10;             // goals tried in Eq. 8 order
+  double speed_scale = 0.5;   // of the arms' velocity and acceleration limits
+  double jaw_margin = 0.005;  // m: the gripper opens this much wider than the board while holding
+  MotionSettings motion;
+  ValidatorSettings validator;
+};
+
+// One arm's timed motion within the plan, with what happens at its end.
+struct PlanStep {
+  std::string name;  // e.g. "suction_pick", "transfer_to_robot_handover"
+  std::string arm;
+  std::string via;           // "direct", "roadmap" or "bridge" (for the planned part)
+  std::vector<double> time;  // s from the start of the board's plan
+  std::vector<Eigen::VectorXd> q;
+  std::string event;  // at the end: "suction_on", "suction_off", "gripper_close", "gripper_open",
+                      // "tool_grasped" or ""
+  double path_length = 0.0;  // rad
+  ValidationReport validation;
+};
+
+// A handover goal tried, and why it was left.
+struct GoalAttempt {
+  int rank = -1;
+  std::int64_t candidate_id = 0;
+  std::int64_t robot_grasp_id = 0;
+  std::int64_t robot_handover_id = 0;
+  std::string outcome;  // "planned" or the reason
+};
+
+enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout };
+const char* to_string(BoardPlanStatus status);
+
+struct BoardPlan {
+  BoardPlanStatus status = BoardPlanStatus::kNoGoal;
+  std::string reason;
+  std::string board;
+  int goal_rank = -1;
+  std::int64_t candidate_id = 0;
+  std::int64_t robot_grasp_id = 0;
+  std::int64_t suction_grasp_id = 0;
+  double theta_c_deg = 90.0;
+  double quality = 0.0;                                // the human's comfort at the goal
+  core::Pose robot_handover = core::Pose::Identity();  // board poses (world)
+  core::Pose human_handover = core::Pose::Identity();
+  std::vector<PlanStep> steps;
+  std::vector<GoalAttempt> attempts;
+  double planning_seconds = 0.0;
+  double duration = 0.0;          // s, the robot's motion
+  double path_length = 0.0;       // rad, both arms
+  bool validated = false;         // every step passed the validator
+  Eigen::VectorXd robot_q_after;  // the robot when the board has been taken
+  bool solved() const { return status == BoardPlanStatus::kSolved; }
+};
+
+// Plans everything the robot does for one board (DESIGN §2): the tool pick when the scene has
+// it on the table, the suction pick at the detected pose with its approach and lift, the
+// transfer to the robot-robot pose, the receiving arm's approach and grasp, the suction arm's
+// release and retreat, the slip-constrained transfer to the robot-human pose and the retreat
+// after the human takes it. Goals in Eq. 8 order; each motion through the stored roadmaps
+// repaired for the scene; every step timed and re-checked by the validator: nothing invalid is
+// returned. One per thread (holds the motion planners' state).
+class BoardPlanner {
+ public:
+  explicit BoardPlanner(const PlannerModel& model, const BoardPlanSettings& settings = {});
+
+  BoardPlan plan(const Scene& scene, const std::string& board,
+                 std::chrono::steady_clock::time_point deadline);
+
+ private:
+  const PlannerModel& model_;
+  BoardPlanSettings settings_;
+};
+
+}  // namespace hila::online
