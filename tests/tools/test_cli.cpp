@@ -40,7 +40,7 @@ std::string json_part(const std::string& out) {
 TEST(Cli, HelpListsTheSubcommands) {
   const CommandRun r = run("--help");
   EXPECT_EQ(r.status, 0);
-  for (const char* sub : {"cell", "human", "mesh", "product"}) {
+  for (const char* sub : {"cell", "human", "mesh", "product", "build", "inspect", "plan"}) {
     EXPECT_NE(r.out.find(sub), std::string::npos) << sub;
   }
   EXPECT_EQ(run("cell check --help").status, 0);
@@ -253,4 +253,27 @@ TEST(Cli, BuildAndInspectBadInputs) {
   const CommandRun part = run("inspect " + dir + "/ok.hila grasps --part drawer");
   EXPECT_EQ(part.status, 2);
   EXPECT_NE(part.out.find("drawer"), std::string::npos) << part.out;
+}
+
+TEST(Cli, PlanBadInputsGiveClearErrorsAndExitCodeTwo) {
+  const std::string scene = test::data_path("cabinet/scene.yaml");
+  const CommandRun missing = run("plan --db /nonexistent/cabinet.hila --scene " + scene + " --all");
+  EXPECT_EQ(missing.status, 2) << missing.out;
+  EXPECT_NE(missing.out.find("/nonexistent/cabinet.hila"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("hila build"), std::string::npos) << missing.out;
+
+  const CommandRun both = run("plan --db x.hila --scene " + scene + " --all --board base");
+  EXPECT_EQ(both.status, 2) << both.out;
+  EXPECT_NE(both.out.find("exactly one of --board NAME or --all"), std::string::npos) << both.out;
+
+  const CommandRun no_scene = run("plan --db x.hila --scene /nonexistent/scene.yaml --all");
+  EXPECT_EQ(no_scene.status, 2) << no_scene.out;
+  EXPECT_NE(no_scene.out.find("/nonexistent/scene.yaml"), std::string::npos) << no_scene.out;
+
+  // A scene without its cell and product files.
+  const std::string dir = test::temp_dir("cli_plan");
+  const std::string bare = test::write_file(dir, "scene.yaml", "product: cabinet\n");
+  const CommandRun no_files = run("plan --db x.hila --scene " + bare + " --all");
+  EXPECT_EQ(no_files.status, 2) << no_files.out;
+  EXPECT_NE(no_files.out.find("files"), std::string::npos) << no_files.out;
 }

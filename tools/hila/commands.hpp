@@ -17,6 +17,7 @@ void add_product_command(CLI::App& app, Action& action);
 void add_build_command(CLI::App& app, Action& action);
 void add_inspect_command(CLI::App& app, Action& action);
 void add_report_command(CLI::App& app, Action& action);
+void add_plan_command(CLI::App& app, Action& action);
 
 std::string default_cell_path();
 std::string default_product_path();

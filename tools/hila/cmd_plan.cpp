@@ -1,0 +1,177 @@
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "hila/core/error.hpp"
+#include "hila/online/board_planner.hpp"
+
+namespace hila::tools {
+
+namespace {
+
+struct PlanOptions {
+  std::string database;
+  std::string scene;
+  std::string board;
+  bool all = false;
+  std::string output;
+  bool json = false;
+  double deadline_s = 30.0;
+};
+
+nlohmann::json pose_to_json(const core::Pose& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d t = pose.translation();
+  return {{"xyz", {t.x(), t.y(), t.z()}}, {"quat_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+nlohmann::json plan_json(const online::BoardPlan& plan) {
+  nlohmann::json attempts = nlohmann::json::array();
+  for (const auto& a : plan.attempts) {
+    attempts.push_back({{"rank", a.rank},
+                        {"candidate", a.candidate_id},
+                        {"robot_grasp", a.robot_grasp_id},
+                        {"robot_handover", a.robot_handover_id},
+                        {"outcome", a.outcome}});
+  }
+  nlohmann::json steps = nlohmann::json::array();
+  for (const auto& s : plan.steps) {
+    nlohmann::json q = nlohmann::json::array();
+    for (const auto& v : s.q) q.push_back(std::vector<double>(v.data(), v.data() + v.size()));
+    steps.push_back({{"name", s.name},
+                     {"arm", s.arm},
+                     {"via", s.via},
+                     {"events", s.event},
+                     {"path_length_rad", s.path_length},
+                     {"validated", s.validation.valid()},
+                     {"time_s", s.time},
+                     {"joints_rad", q}});
+  }
+  nlohmann::json j = {{"board", plan.board},
+                      {"status", online::to_string(plan.status)},
+                      {"reason", plan.reason},
+                      {"planning_ms", 1e3 * plan.planning_seconds},
+                      {"attempts", attempts}};
+  if (plan.solved()) {
+    j["goal_rank"] = plan.goal_rank;
+    j["candidate"] = plan.candidate_id;
+    j["robot_grasp"] = plan.robot_grasp_id;
+    j["suction_grasp"] = plan.suction_grasp_id;
+    j["theta_c_deg"] = plan.theta_c_deg;
+    j["quality"] = plan.quality;
+    j["robot_handover"] = pose_to_json(plan.robot_handover);
+    j["human_handover"] = pose_to_json(plan.human_handover);
+    j["duration_s"] = plan.duration;
+    j["path_length_rad"] = plan.path_length;
+    j["validated"] = plan.validated;
+    j["steps"] = steps;
+  }
+  return j;
+}
+
+// Written beside the target and renamed: a failed write leaves any previous plan whole.
+void write_atomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw core::InputError(path, "(file)", "a writable path", "cannot create it");
+    out << text;
+    if (!out.flush()) throw core::InputError(path, "(file)", "a writable path", "write failed");
+  }
+  std::filesystem::rename(temporary, path);
+}
+
+int run_plan(const PlanOptions& opt) {
+  if (opt.all == !opt.board.empty()) {
+    throw core::InputError("hila plan", "--board/--all", "exactly one of --board NAME or --all",
+                           opt.all ? "both" : "neither");
+  }
+  if (!(opt.deadline_s > 0.0)) {
+    throw core::InputError("hila plan", "--deadline", "a positive number of seconds",
+                           std::to_string(opt.deadline_s));
+  }
+  const online::SceneFiles files = online::read_scene_files(opt.scene);
+  const auto model = online::PlannerModel::load(opt.database, files.cell, files.product);
+  online::Scene scene = online::load_scene(opt.scene, model->cell(), model->product());
+  std::vector<std::string> boards;
+  if (opt.all) {
+    for (const auto& p : model->product().parts) {
+      if (!scene.is_finished(p.name)) boards.push_back(p.name);
+    }
+  } else {
+    model->product().part(opt.board);  // InputError naming the product file for an unknown board
+    if (scene.is_finished(opt.board)) {
+      throw core::InputError(opt.scene, "finished", "'" + opt.board + "' still to be handled",
+                             "it is listed as finished");
+    }
+    boards.push_back(opt.board);
+  }
+  online::BoardPlanner planner(*model);
+  nlohmann::json out = {{"hila_plan", 1},
+                        {"database", opt.database},
+                        {"scene", opt.scene},
+                        {"product", model->product().name},
+                        {"boards", nlohmann::json::array()}};
+  int failed = 0;
+  if (!opt.json) {
+    std::cout
+        << "  board           theta_c   Q      goals  plan ms   path rad  motion s  validated\n";
+  }
+  for (const auto& board : boards) {
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::microseconds(static_cast<long>(opt.deadline_s * 1e6));
+    const online::BoardPlan plan = planner.plan(scene, board, deadline);
+    out["boards"].push_back(plan_json(plan));
+    if (!opt.json) {
+      std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;
+      if (plan.solved()) {
+        std::cout << std::setprecision(0) << std::setw(8) << plan.theta_c_deg
+                  << std::setprecision(3) << std::setw(7) << plan.quality << std::setw(7)
+                  << plan.attempts.size() << std::setprecision(1) << std::setw(9)
+                  << 1e3 * plan.planning_seconds << std::setprecision(2) << std::setw(11)
+                  << plan.path_length << std::setw(10) << plan.duration << "  "
+                  << (plan.validated ? "yes" : "NO") << "\n";
+      } else {
+        std::cout << "  not planned (" << online::to_string(plan.status) << ", "
+                  << plan.attempts.size() << " attempts, " << std::setprecision(1)
+                  << 1e3 * plan.planning_seconds << " ms): " << plan.reason << "\n";
+      }
+    }
+    if (!plan.solved()) {
+      ++failed;
+      if (opt.all) break;  // the next board's scene needs this one finished
+    }
+    scene = scene.with_finished(model->product(), board);
+    scene.tool_in_hand = true;
+    for (const auto& arm : model->cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
+  }
+  if (!opt.output.empty()) write_atomically(opt.output, out.dump(1) + "\n");
+  if (opt.json) std::cout << out.dump(1) << "\n";
+  if (failed > 0) {
+    std::cerr << "hila: " << failed << " board(s) not planned; the plan file says why\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_plan_command(CLI::App& app, Action& action) {
+  auto opt = std::make_shared<PlanOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "plan", "plan the robot's motions for boards from a database, for the scene as it is");
+  cmd->add_option("--db", opt->database, "the product database (hila build)")->required();
+  cmd->add_option("--scene", opt->scene, "the scene file (docs/scene.md)")->required();
+  cmd->add_option("--board", opt->board, "plan this board");
+  cmd->add_flag("--all", opt->all, "plan every board still to be handled, in assembly order");
+  cmd->add_option("-o,--output", opt->output, "write the plan (JSON, docs/online.md)");
+  cmd->add_flag("--json", opt->json, "print the plan as JSON instead of the table");
+  cmd->add_option("--deadline", opt->deadline_s, "seconds per board (default 30)");
+  cmd->callback([opt, &action] { action = [opt] { return run_plan(*opt); }; });
+}
+
+}  // namespace hila::tools
