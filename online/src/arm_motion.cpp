@@ -53,6 +53,8 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   const core::StageScene& stage = world_.stage();
   robot_q_ = request.robot_q.size() == 0 ? cell.home_configuration() : request.robot_q;
   held_ = request.held;
+  resolution_ = held_.held ? std::min(settings_.held_resolution, roadmap_.record.resolution)
+                           : roadmap_.record.resolution;
   if (held_.held && arm_index_ != stage.suction_arm) cell.set_jaw(robot_q_, arm_, held_.jaw);
   moves_tool_ = request.tool_in_hand && arm_index_ == stage.suction_arm;
   moving_ = stage.cell.arm_bodies[static_cast<std::size_t>(arm_index_)];
@@ -112,7 +114,7 @@ std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {
 }
 
 bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  for (const auto& q : core::edge_samples(a, b, roadmap_.record.resolution)) {
+  for (const auto& q : core::edge_samples(a, b, resolution_)) {
     if (!valid(q)) return false;
   }
   return true;
@@ -223,7 +225,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
   core::BridgeSettings bridge;
   bridge.max_checks = settings_.bridge_checks;
-  bridge.resolution = roadmap_.record.resolution;
+  bridge.resolution = resolution_;
   bridge.seed = settings_.seed;
   bridge.deadline = request.deadline;
   r.path = core::plan_bridge(

@@ -346,8 +346,6 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     const double jaw =
         std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + settings_.jaw_margin);
     const core::Pose grasp_tcp = rr.board * grasp.tcp;
-    const core::Pose pre_grasp =
-        shifted(grasp_tcp, -settings_.approach * (grasp_tcp.linear() * approach_tcp));
     MotionRequest reach;
     reach.board_world = rr.board;
     const auto grasp_q =
@@ -355,14 +353,32 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                     solutions(cell, receiving, grasp_tcp, receiving.spec.home,
                               stored("robot_handover", receiving.spec.name, grasp.id, rr.id, 0)));
     if (!grasp_q) return "receiving_grasp: no valid IK at the robot-robot pose";
-    const auto pre_q = solutions(cell, receiving, pre_grasp, *grasp_q);
-    if (pre_q.empty()) return "receiving_approach: no IK before the grasp";
+    // The approach backs off along the gripper's axis as far as the scene lets it (the exchange
+    // may be close to the robot's body), else the arm goes to the grasp directly.
+    std::optional<Eigen::VectorXd> pre_q;
+    for (const double fraction : {1.0, 0.5, 0.2}) {
+      const auto p = solutions(
+          cell, receiving,
+          shifted(grasp_tcp, -fraction * settings_.approach * (grasp_tcp.linear() * approach_tcp)),
+          *grasp_q);
+      if (p.empty()) continue;
+      reach.robot_q = robot_q;
+      reach.tool_in_hand = tool_in_hand;
+      receiving_planner.prepare(reach);
+      if (receiving_planner.valid(p.front()) &&
+          receiving_planner.segment_valid(p.front(), *grasp_q)) {
+        pre_q = p.front();
+        break;
+      }
+    }
     reach.start = now[&receiving];
-    reach.goal = pre_q.front();
-    if (auto e = step(receiving_planner, receiving, reach, "receiving_approach", "", "");
-        !e.empty())
-      return e;
-    reach.start = pre_q.front();
+    if (pre_q) {
+      reach.goal = *pre_q;
+      if (auto e = step(receiving_planner, receiving, reach, "receiving_approach", "", "");
+          !e.empty())
+        return e;
+      reach.start = *pre_q;
+    }
     reach.goal = *grasp_q;
     if (auto e = step(receiving_planner, receiving, reach, "receiving_grasp", "", "gripper_close");
         !e.empty())

@@ -67,6 +67,9 @@ struct MotionSettings {
   int attach_neighbours = 12;  // roadmap nodes tried per end
   int attachments = 6;         // valid attachments kept per end
   int max_searches = 200;
+  // Segment checks while holding a board: as fine as the validator's (rad), since a long board
+  // sweeps far between the roadmap's 0.05 rad samples; the empty arm uses the roadmap's.
+  double held_resolution = 0.01;
   long bridge_checks = 4000;  // a bridge's validity-check budget (also bounded by the deadline)
   std::uint64_t seed = 1;
 };
@@ -106,6 +109,7 @@ class ArmMotionPlanner {
   Eigen::VectorXd robot_q_;
   HeldBoard held_;
   bool moves_tool_ = false;
+  double resolution_ = 0.05;  // segment checks for the current request
   std::vector<bool> allowed_;
   std::vector<signed char> node_state_;  // -1 unknown, 0 blocked, 1 clear (this request)
   int checked_ = 0;
