@@ -105,6 +105,22 @@ Connection connect(ArmPlanning& arm, const std::vector<bool>& allowed, const Gra
   return bridge_path(arm, slip, from, to, bridge);
 }
 
+// Every IK branch of the arm with its TCP at `tcp` (world) that is valid in the workspace as it
+// currently holds, `preferred` (a branch chosen earlier) first. An arm holding a long board
+// under a tight slip limit rarely changes branch, so the branch is part of a regrasp node.
+std::vector<Eigen::VectorXd> valid_branches(ArmPlanning& arm, const core::Pose& tcp,
+                                            const Eigen::VectorXd& preferred) {
+  std::vector<Eigen::VectorXd> out{preferred};
+  core::UrIkSolutions ik;
+  const core::Arm& a = arm.workspace.arm();
+  const int n = a.ur_ik->solve(arm.workspace.base().inverse() * tcp, a.spec.home, ik);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(i)];
+    if ((q - preferred).norm() > 1e-6 && arm.workspace.valid(q)) out.push_back(q);
+  }
+  return out;
+}
+
 // Both arms at the exchange: the suction arm holding the board at the robot-robot pose and the
 // receiving arm closing on it. Each arm's workspace has the other at home, so a suction-arm IK
 // branch other than the one the handover search checked must be re-checked with the receiving
@@ -335,15 +351,8 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       suction.workspace.hold(board_in_tcp, 0.0);
       // The handover search kept one IK solution; another branch at the same pose may be the
       // one the held board can reach from the stack. The stored one is tried first.
-      std::vector<Eigen::VectorXd> ends{rr.joints};
-      core::UrIkSolutions ik;
-      const int n = suction_arm.ur_ik->solve(
-          suction.workspace.base().inverse() * rr.board * board_in_tcp.inverse(),
-          suction_arm.spec.home, ik);
-      for (int i = 0; i < n; ++i) {
-        const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(i)];
-        if ((q - rr.joints).norm() > 1e-6 && suction.workspace.valid(q)) ends.push_back(q);
-      }
+      std::vector<Eigen::VectorXd> ends =
+          valid_branches(suction, rr.board * board_in_tcp.inverse(), rr.joints);
       // Through the roadmap to each branch, then bridges to the first few.
       const auto& edges = result.filters[static_cast<std::size_t>(pick.filter)].edges;
       const Endpoint lifted = endpoint(suction, no_slip_limit, pick.lift, k);
@@ -393,24 +402,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     gripper_filters[g] = f;
     return f;
   };
-  // The receiving arm's configurations for a gripper grasp with the board at `board`: every IK
-  // branch valid in the workspace (holding the board when `holding`), `preferred` (the handover
-  // search's) first. The arm changes branch only through configurations the held board and the
-  // slip limit rarely allow, so each branch is its own regrasp node.
   const core::Arm& receiving_arm = receiving.workspace.arm();
-  const core::Pose receiving_base_inv = receiving.workspace.base().inverse();
-  auto receiving_branches = [&](const core::Pose& board, const db::RobotGraspRecord& grasp,
-                                const Eigen::VectorXd& preferred) {
-    std::vector<Eigen::VectorXd> out{preferred};
-    core::UrIkSolutions ik;
-    const int n = receiving_arm.ur_ik->solve(receiving_base_inv * board * grasp.tcp,
-                                             receiving_arm.spec.home, ik);
-    for (int i = 0; i < n; ++i) {
-      const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(i)];
-      if ((q - preferred).norm() > 1e-6 && receiving.workspace.valid(q)) out.push_back(q);
-    }
-    return out;
-  };
   const double jaw_max = cell.spec().gripper.jaw_max;
   const Endpoint home_end = endpoint(receiving, no_slip_limit, receiving_arm.spec.home, k);
   struct LeftEnd {
@@ -434,7 +426,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     // Transits through the roadmap to every branch; bridges (costly when they fail) only when
     // none connects, to the first few branches.
     std::vector<Connection> transits;
-    for (const auto& q : receiving_branches(rr.board, grasp, s.joints_rr)) {
+    for (const auto& q : valid_branches(receiving, rr.board * grasp.tcp, s.joints_rr)) {
       if (!exchange.clear(rr.board, suction_q, q, jaw)) continue;
       LeftEnd end;
       end.node = add_node("robot_handover", settings.receiving_arm, "gripper", s.robot_grasp_id,
@@ -489,7 +481,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       const GraspSlip slip = grasp_slip(cell, grasp, grasps.com);
       receiving.workspace.hold(grasp.tcp.inverse(),
                                std::min(jaw_max, grasp.jaw_width + kJawMargin));
-      const auto goals_rh = receiving_branches(candidate.board, grasp, s.joints_rh);
+      const auto goals_rh = valid_branches(receiving, candidate.board * grasp.tcp, s.joints_rh);
       // Branch pairs, the handover search's first, then nearest first: through the roadmap,
       // then bridges for the nearest few.
       std::vector<std::tuple<double, int, std::size_t>> pairs;

@@ -1,6 +1,7 @@
 #include "hila/online/arm_motion.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "hila/core/bridge.hpp"
@@ -62,19 +63,12 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
     moving_.insert(moving_.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
   if (held_.held) moving_.push_back(stage.board);
   core::set_robot_state(cell, stage.cell, data_, robot_q_);
-  if (request.tool_in_hand && !moves_tool_) {
-    const core::Arm& suction = cell.arms()[static_cast<std::size_t>(stage.suction_arm)];
-    std::vector<core::Pose> links;
-    cell.robot().link_poses(robot_q_, links);
-    core::set_tool_held(
-        cell, stage, data_,
-        links[static_cast<std::size_t>(cell.robot().link_index(suction.spec.tip_link))]);
-  } else if (!request.tool_in_hand) {
-    core::set_robot_pose(data_, stage.tool, stage.tool_links_in_handle, request.tool_world);
-  }
+  world_.place_tool(data_, robot_q_, request.tool_in_hand, request.tool_world);
   if (!held_.held) data_.set_body_pose(stage.board, request.board_world);
+  // No filter: every edge (a held board's slip and clearance are then checked lazily, as all).
   const std::size_t edges = roadmap_.record.edges.size();
-  if (request.filter != nullptr && request.filter->size() == edges) {
+  assert(request.filter == nullptr || request.filter->size() == edges);
+  if (request.filter != nullptr) {
     allowed_ = *request.filter;
   } else {
     allowed_.assign(edges, true);
@@ -85,19 +79,21 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
 }
 
 bool ArmMotionPlanner::valid(const Eigen::VectorXd& q) {
-  return why_invalid(q).empty();
+  return check(q, nullptr) == Verdict::kValid;
 }
 
-std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {
+// The hot path: no strings are built unless a reason is asked for.
+ArmMotionPlanner::Verdict ArmMotionPlanner::check(const Eigen::VectorXd& q,
+                                                  core::CollisionPair* pair) {
   if (q.size() != arm_.chain.dof() || !arm_.chain.within_limits(q, 1e-9)) {
-    return "outside the joint limits";
+    return Verdict::kOutsideLimits;
   }
   const core::Pose tcp = base_ * arm_.chain.fk(q);
   if (held_.held && held_.theta_c_deg < 90.0) {
     const double slip =
         core::slip_angle_deg(tcp.linear() * held_.axis_tcp, tcp.linear() * held_.lever_tcp,
                              Eigen::Vector3d(0.0, 0.0, -1.0));
-    if (slip > held_.theta_c_deg) return "the held board would slip";
+    if (slip > held_.theta_c_deg) return Verdict::kSlips;
   }
   const core::Cell& cell = world_.cell();
   const core::StageScene& stage = world_.stage();
@@ -105,12 +101,24 @@ std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {
   core::set_robot_state(cell, stage.cell, data_, robot_q_);
   if (moves_tool_) core::set_tool_held(cell, stage, data_, tcp);
   if (held_.held) data_.set_body_pose(stage.board, tcp * held_.board_in_tcp);
+  return core::in_collision(stage.cell.model, data_, moving_, pair) ? Verdict::kCollides
+                                                                    : Verdict::kValid;
+}
+
+std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {
   core::CollisionPair pair;
-  if (core::in_collision(stage.cell.model, data_, moving_, &pair)) {
-    return stage.cell.model.body_name(pair.body_a) + " vs " +
-           stage.cell.model.body_name(pair.body_b);
+  switch (check(q, &pair)) {
+    case Verdict::kValid:
+      return "";
+    case Verdict::kOutsideLimits:
+      return "outside the joint limits";
+    case Verdict::kSlips:
+      return "the held board would slip";
+    case Verdict::kCollides:
+      break;
   }
-  return "";
+  const auto& model = world_.stage().cell.model;
+  return model.body_name(pair.body_a) + " vs " + model.body_name(pair.body_b);
 }
 
 bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
@@ -170,7 +178,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   auto late = [&] { return std::chrono::steady_clock::now() >= request.deadline; };
   prepare(request);
   if (const std::string why = why_invalid(request.start);
-      !why.empty() && !(request.start_in_contact && why.find(" vs ") != std::string::npos)) {
+      !why.empty() &&
+      !(request.start_in_contact && check(request.start, nullptr) == Verdict::kCollides)) {
     return finish(MotionStatus::kInvalidStart, "the start is invalid: " + why);
   }
   if (const std::string why = why_invalid(request.goal); !why.empty()) {

@@ -99,19 +99,10 @@ ValidationReport validate_motion(const World& world, core::CollisionData& data,
   if (moves_tool) moving.insert(moving.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
   if (motion.holds_board) moving.push_back(stage.board);
   const core::Pose base = core::arm_base_in_world(cell, *arm);
-  const core::Arm& suction = cell.arms()[static_cast<std::size_t>(stage.suction_arm)];
   Eigen::VectorXd robot_q = motion.robot_q.size() == 0 ? cell.home_configuration() : motion.robot_q;
   if (!motion.holds_board) data.set_body_pose(stage.board, motion.board_world);
-  if (motion.tool_in_hand && !moves_tool) {
-    // In the other, resting arm's hand: posed once by FK of the whole robot.
-    std::vector<core::Pose> links;
-    cell.robot().link_poses(robot_q, links);
-    core::set_tool_held(
-        cell, stage, data,
-        links[static_cast<std::size_t>(cell.robot().link_index(suction.spec.tip_link))]);
-  } else if (!motion.tool_in_hand) {
-    core::set_robot_pose(data, stage.tool, stage.tool_links_in_handle, motion.tool_world);
-  }
+  // In the resting arm's hand (posed once) or on the table; a moving tool follows each sample.
+  world.place_tool(data, robot_q, motion.tool_in_hand, motion.tool_world);
   const Eigen::Vector3d down(0.0, 0.0, -1.0);
   auto check = [&](const Eigen::VectorXd& q, double t) {
     ++report.samples;

@@ -44,16 +44,22 @@ core::CollisionData World::make_data() const {
   std::vector<core::Pose> poses;
   cell_.human().link_poses(cell_.human_neutral(), poses);
   core::set_robot_pose(data, stage_.cell.human, poses, scene_.human_stance);
-  if (scene_.tool_in_hand) {
-    const core::Arm& arm = cell_.arms()[static_cast<std::size_t>(stage_.suction_arm)];
-    core::set_tool_held(
-        cell_, stage_, data,
-        core::arm_base_in_world(cell_, arm) * arm.chain.fk(scene_.robot.at(arm.spec.name)));
-  } else {
-    core::set_robot_pose(data, stage_.tool, stage_.tool_links_in_handle, scene_.tool);
-  }
+  place_tool(data, robot_q, scene_.tool_in_hand, scene_.tool);
   data.set_body_pose(stage_.board, scene_.initial_pose(board_));
   return data;
+}
+
+void World::place_tool(core::CollisionData& data, const Eigen::VectorXd& robot_q, bool in_hand,
+                       const core::Pose& on_table) const {
+  if (!in_hand) {
+    core::set_robot_pose(data, stage_.tool, stage_.tool_links_in_handle, on_table);
+    return;
+  }
+  const core::Arm& arm = cell_.arms()[static_cast<std::size_t>(stage_.suction_arm)];
+  std::vector<core::Pose> links;
+  cell_.robot().link_poses(robot_q, links);
+  core::set_tool_held(cell_, stage_, data,
+                      links[static_cast<std::size_t>(cell_.robot().link_index(arm.spec.tip_link))]);
 }
 
 }  // namespace hila::online

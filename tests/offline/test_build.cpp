@@ -9,6 +9,7 @@
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
 #include "hila/offline/build.hpp"
+#include "util/quick_build.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -18,21 +19,7 @@ namespace {
 
 // Smaller sampling keeps the suite quick; the bundled defaults are exercised by the demo/bench.
 offline::BuildSettings quick_settings(std::uint64_t seed = 7, int jobs = 1) {
-  offline::BuildSettings s;
-  s.seed = seed;
-  s.jobs = jobs;
-  s.robot.samples = 500;
-  s.human.samples = 300;
-  s.comfort.spacing = 0.06;
-  s.comfort.orientations = 100;
-  s.comfort.samples = 20000;
-  s.handover.candidates = 60;
-  s.handover.max_candidates = 60;
-  s.handover.rr_poses = 6;
-  s.handover.human_ik_goals = 2;
-  s.ergonomics.flexion_step_deg = 15.0;
-  s.roadmap.nodes = 300;
-  return s;
+  return test::quick_build_settings(seed, jobs);
 }
 
 std::string build(const std::string& dir, const std::string& name,

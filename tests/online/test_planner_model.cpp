@@ -5,6 +5,7 @@
 
 #include "hila/offline/build.hpp"
 #include "hila/online/planner_model.hpp"
+#include "util/quick_build.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -12,22 +13,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A small but complete cabinet database (the build's own quick settings).
+// A small but complete cabinet database.
 std::string quick_database(const std::string& dir) {
-  offline::BuildSettings s;
-  s.seed = 7;
-  s.jobs = 2;
-  s.robot.samples = 500;
-  s.human.samples = 300;
-  s.comfort.spacing = 0.06;
-  s.comfort.orientations = 100;
-  s.comfort.samples = 20000;
-  s.handover.candidates = 60;
-  s.handover.max_candidates = 60;
-  s.handover.rr_poses = 6;
-  s.handover.human_ik_goals = 2;
-  s.ergonomics.flexion_step_deg = 15.0;
-  s.roadmap.nodes = 200;
+  const offline::BuildSettings s = test::quick_build_settings(7, 2);
   const std::string out = dir + "/cabinet.hila";
   offline::build_database(test::product_path(), test::cell_path(), out, s);
   return out;

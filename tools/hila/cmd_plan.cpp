@@ -82,7 +82,12 @@ void write_atomically(const std::string& path, const std::string& text) {
     out << text;
     if (!out.flush()) throw core::InputError(path, "(file)", "a writable path", "write failed");
   }
-  std::filesystem::rename(temporary, path);
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::filesystem::remove(temporary, error);
+    throw core::InputError(path, "(file)", "a writable path", "cannot replace it");
+  }
 }
 
 int run_plan(const PlanOptions& opt) {

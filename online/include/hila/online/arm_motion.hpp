@@ -94,6 +94,8 @@ class ArmMotionPlanner {
   bool segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
 
  private:
+  enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
+  Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
   bool edge_valid(int edge);
   std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q);
 

@@ -28,6 +28,10 @@ class World {
   // tool where the scene has it (on the table, or in the suction arm's hand at its current
   // joints) and the robot at the scene's joints.
   core::CollisionData make_data() const;
+  // Poses the suction tool: in the suction arm's hand at its joints in `robot_q` (whole-robot FK),
+  // or standing on the table at `on_table` (its handle, world).
+  void place_tool(core::CollisionData& data, const Eigen::VectorXd& robot_q, bool in_hand,
+                  const core::Pose& on_table) const;
 
  private:
   const core::Cell& cell_;
