@@ -3,7 +3,6 @@
 #include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/ProblemDefinition.h>
 #include <ompl/base/SpaceInformation.h>
-#include <ompl/base/StateSampler.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/PathGeometric.h>
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
@@ -12,54 +11,13 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <random>
+
+#include "ompl_joint_space.hpp"
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
 namespace hila::core {
-
-namespace {
-
-// Uniform joint samples from a seeded generator (OMPL's own samplers draw from a process-wide
-// seed, which would make bridges depend on what ran before).
-class SeededSampler : public ob::StateSampler {
- public:
-  SeededSampler(const ob::StateSpace* space, std::uint64_t seed)
-      : ob::StateSampler(space), rng_(seed) {}
-  void sampleUniform(ob::State* state) override {
-    const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
-    auto* v = state->as<ob::RealVectorStateSpace::StateType>();
-    for (std::size_t i = 0; i < bounds.low.size(); ++i) {
-      v->values[i] = bounds.low[i] + uniform() * (bounds.high[i] - bounds.low[i]);
-    }
-  }
-  void sampleUniformNear(ob::State* state, const ob::State* near, double distance) override {
-    const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
-    auto* v = state->as<ob::RealVectorStateSpace::StateType>();
-    const auto* c = near->as<ob::RealVectorStateSpace::StateType>();
-    for (std::size_t i = 0; i < bounds.low.size(); ++i) {
-      v->values[i] = std::clamp(c->values[i] + (2.0 * uniform() - 1.0) * distance, bounds.low[i],
-                                bounds.high[i]);
-    }
-  }
-  void sampleGaussian(ob::State* state, const ob::State* mean, double stddev) override {
-    sampleUniformNear(state, mean, 2.0 * stddev);
-  }
-
- private:
-  double uniform() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
-  std::mt19937_64 rng_;
-};
-
-Eigen::VectorXd to_vector(const ob::State* s, int dof) {
-  const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
-  Eigen::VectorXd q(dof);
-  for (int i = 0; i < dof; ++i) q[i] = v->values[i];
-  return q;
-}
-
-}  // namespace
 
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
                                           double resolution) {
@@ -85,27 +43,12 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
   if (segment_valid(valid, from, to, settings.resolution)) return {from, to};
   const int dof = arm.chain.dof();
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
-  ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
-  for (int i = 0; i < dof; ++i) {
-    const double home = arm.spec.home[i];
-    // Widened to the ends when they lie outside the box (they are valid, so within the limits).
-    const double low = std::min(
-        {std::max(arm.chain.lower_limits()[i], home - settings.joint_range), from[i], to[i]});
-    const double high = std::max(
-        {std::min(arm.chain.upper_limits()[i], home + settings.joint_range), from[i], to[i]});
-    bounds.setLow(static_cast<unsigned>(i), low);
-    bounds.setHigh(static_cast<unsigned>(i), high);
-  }
-  space->setBounds(bounds);
-  const std::uint64_t seed = settings.seed;
-  space->setStateSamplerAllocator(
-      [seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  const auto space = detail::joint_space(arm, settings.joint_range, settings.seed, &from, &to);
   auto si = std::make_shared<ob::SpaceInformation>(space);
   long checks = 0;
   si->setStateValidityChecker([&](const ob::State* s) {
     ++checks;
-    return valid(to_vector(s, dof));
+    return valid(detail::to_vector(s, dof));
   });
   si->setStateValidityCheckingResolution(settings.resolution / space->getMaximumExtent());
   si->setup();
@@ -128,7 +71,7 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
   const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
   std::vector<Eigen::VectorXd> raw;
   for (std::size_t i = 0; i < path->getStateCount(); ++i) {
-    raw.push_back(to_vector(path->getState(i), dof));
+    raw.push_back(detail::to_vector(path->getState(i), dof));
   }
   // Greedy shortcuts: from each kept waypoint, the farthest later one a straight segment reaches.
   std::vector<Eigen::VectorXd> out{raw.front()};

@@ -303,6 +303,13 @@ void Cell::set_arm(Eigen::VectorXd& robot_q, const Arm& arm, const Eigen::Vector
     robot_q[vars[i]] = arm_q[static_cast<Eigen::Index>(i)];
 }
 
+Eigen::VectorXd Cell::arm_joints(const Eigen::VectorXd& robot_q, const Arm& arm) const {
+  const auto& vars = arm.chain.model_variables();
+  Eigen::VectorXd q(static_cast<Eigen::Index>(vars.size()));
+  for (std::size_t i = 0; i < vars.size(); ++i) q[static_cast<Eigen::Index>(i)] = robot_q[vars[i]];
+  return q;
+}
+
 void Cell::set_jaw(Eigen::VectorXd& robot_q, const Arm& arm, double opening) const {
   // The URDF finger joint is the half opening (each finger moves by half).
   robot_q[arm.finger_variable] = 0.5 * opening;

@@ -139,6 +139,7 @@ class Cell {
   // The robot's configuration with every arm at home and the jaws at `jaw_opening`.
   Eigen::VectorXd home_configuration(double jaw_opening = 0.085) const;
   void set_arm(Eigen::VectorXd& robot_q, const Arm& arm, const Eigen::VectorXd& arm_q) const;
+  Eigen::VectorXd arm_joints(const Eigen::VectorXd& robot_q, const Arm& arm) const;
   void set_jaw(Eigen::VectorXd& robot_q, const Arm& arm, double opening) const;
   Eigen::VectorXd human_neutral() const;
 

@@ -1,0 +1,71 @@
+#include "ompl_joint_space.hpp"
+
+#include <algorithm>
+
+namespace ob = ompl::base;
+
+namespace hila::core::detail {
+
+SeededSampler::SeededSampler(const ob::StateSpace* space, std::uint64_t seed)
+    : ob::StateSampler(space), rng_(seed) {}
+
+void SeededSampler::sampleUniform(ob::State* state) {
+  const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
+  auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+  for (std::size_t i = 0; i < bounds.low.size(); ++i) {
+    v->values[i] = bounds.low[i] + uniform() * (bounds.high[i] - bounds.low[i]);
+  }
+}
+
+void SeededSampler::sampleUniformNear(ob::State* state, const ob::State* near, double distance) {
+  const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
+  auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+  const auto* c = near->as<ob::RealVectorStateSpace::StateType>();
+  for (std::size_t i = 0; i < bounds.low.size(); ++i) {
+    v->values[i] = std::clamp(c->values[i] + (2.0 * uniform() - 1.0) * distance, bounds.low[i],
+                              bounds.high[i]);
+  }
+}
+
+void SeededSampler::sampleGaussian(ob::State* state, const ob::State* mean, double stddev) {
+  sampleUniformNear(state, mean, 2.0 * stddev);
+}
+
+std::shared_ptr<ob::RealVectorStateSpace> joint_space(const Arm& arm, double joint_range,
+                                                      std::uint64_t seed,
+                                                      const Eigen::VectorXd* include_a,
+                                                      const Eigen::VectorXd* include_b) {
+  const int dof = arm.chain.dof();
+  auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
+  ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
+  for (int i = 0; i < dof; ++i) {
+    const double home = arm.spec.home[i];
+    double low = std::max(arm.chain.lower_limits()[i], home - joint_range);
+    double high = std::min(arm.chain.upper_limits()[i], home + joint_range);
+    for (const Eigen::VectorXd* q : {include_a, include_b}) {
+      if (q == nullptr) continue;
+      low = std::min(low, (*q)[i]);
+      high = std::max(high, (*q)[i]);
+    }
+    bounds.setLow(static_cast<unsigned>(i), low);
+    bounds.setHigh(static_cast<unsigned>(i), high);
+  }
+  space->setBounds(bounds);
+  space->setStateSamplerAllocator(
+      [seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  return space;
+}
+
+Eigen::VectorXd to_vector(const ob::State* s, int dof) {
+  const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+  Eigen::VectorXd q(dof);
+  for (int i = 0; i < dof; ++i) q[i] = v->values[i];
+  return q;
+}
+
+void from_vector(const Eigen::VectorXd& q, ob::State* s) {
+  auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+  for (int i = 0; i < q.size(); ++i) v->values[i] = q[i];
+}
+
+}  // namespace hila::core::detail

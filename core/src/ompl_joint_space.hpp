@@ -1,0 +1,44 @@
+#pragma once
+
+// OMPL set-up shared by the bridge and the LazyPRM baseline: an arm's joint box with a seeded
+// sampler, so that planning is deterministic whatever ran before in the process.
+
+#include <ompl/base/StateSampler.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <random>
+
+#include "hila/core/cell.hpp"
+
+namespace hila::core::detail {
+
+// Uniform joint samples from a seeded generator (OMPL's own samplers draw from a process-wide
+// seed, which would make plans depend on what ran before).
+class SeededSampler : public ompl::base::StateSampler {
+ public:
+  SeededSampler(const ompl::base::StateSpace* space, std::uint64_t seed);
+  void sampleUniform(ompl::base::State* state) override;
+  void sampleUniformNear(ompl::base::State* state, const ompl::base::State* near,
+                         double distance) override;
+  void sampleGaussian(ompl::base::State* state, const ompl::base::State* mean,
+                      double stddev) override;
+
+ private:
+  double uniform() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
+  std::mt19937_64 rng_;
+};
+
+// The arm's joints, each within `joint_range` of home and the limits, widened to include
+// `include_a` and `include_b` (valid ends, hence within the limits) when given.
+std::shared_ptr<ompl::base::RealVectorStateSpace> joint_space(const Arm& arm, double joint_range,
+                                                              std::uint64_t seed,
+                                                              const Eigen::VectorXd* include_a,
+                                                              const Eigen::VectorXd* include_b);
+
+Eigen::VectorXd to_vector(const ompl::base::State* s, int dof);
+void from_vector(const Eigen::VectorXd& q, ompl::base::State* s);
+
+}  // namespace hila::core::detail
