@@ -246,7 +246,8 @@ std::string settings_hash(const BuildSettings& s) {
        << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.two_hand_separation << ' '
        << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
        << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' ' << h.rr_per_grasp
-       << ' ' << h.human_ik_goals << ' ' << h.pick_lift << ' ' << h.pick_resolution;
+       << ' ' << h.human_ik_goals << ' ' << h.pick_lift << ' ' << h.pick_resolution << ' '
+       << h.exchange_approach << ' ' << h.exchange_resolution;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
@@ -387,6 +388,8 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     regrasp.suction_arm = settings.handover.suction_arm;
     regrasp.receiving_arm = settings.handover.receiving_arm;
     regrasp.lift = settings.handover.pick_lift;
+    regrasp.approach = settings.handover.exchange_approach;
+    regrasp.approach_resolution = settings.handover.exchange_resolution;
     regrasp.seed = part_seed(settings.seed, product.parts[i].name, 7);
     r.regrasp =
         plan_regrasp(*cell, product, i, grasps, r.handover, roadmaps[0], roadmaps[1], regrasp);

@@ -7,6 +7,7 @@
 
 #include "hila/core/collision.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
@@ -403,12 +404,21 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     const int n = receiving_arm.ur_ik->solve(tcp, receiving_arm.spec.home, ik);
     cell.set_jaw(robot_q, receiving_arm,
                  std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + jaw_margin));
-    for (int s = 0; s < n; ++s) {
-      cell.set_arm(robot_q, receiving_arm, ik.q[static_cast<std::size_t>(s)]);
+    // The receiving arm (the suction arm holding the board as posed) clear at q.
+    auto clear = [&](const Eigen::VectorXd& q) {
+      cell.set_arm(robot_q, receiving_arm, q);
       core::set_robot_state(cell, scene.cell, data, robot_q);
-      if (!core::in_collision(scene.cell.model, data, bodies)) {
+      return !core::in_collision(scene.cell.model, data, bodies);
+    };
+    auto within = [&](const Eigen::VectorXd& q) {
+      return receiving_arm.chain.within_limits(q, 1e-9) && clear(q);
+    };
+    for (int s = 0; s < n; ++s) {
+      const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(s)];
+      if (clear(q) && core::find_pre_grasp(cell, receiving_arm, q, settings.exchange_approach,
+                                           settings.exchange_resolution, within)) {
         out.grasp = g;
-        out.joints = ik.q[static_cast<std::size_t>(s)];
+        out.joints = q;
         out.slip_deg = slip;
         return true;
       }

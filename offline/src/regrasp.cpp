@@ -8,6 +8,7 @@
 
 #include "hila/core/bridge.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/pre_grasp.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
@@ -151,6 +152,20 @@ class ExchangeCheck {
                         core::arm_base_in_world(cell_, suction_) * suction_.chain.fk(suction_q));
     data_.set_body_pose(scene_.board, board);
     return !core::in_collision(scene_.cell.model, data_, receiving_bodies_);
+  }
+
+  // Whether the receiving arm at `receiving_q` has a way in (core::find_pre_grasp, as the
+  // handover search and the online approach ask), the suction arm holding the board as in
+  // clear(). An exchange pressed against the robot's body may be valid and yet unreachable.
+  bool approachable(const core::Pose& board, const Eigen::VectorXd& suction_q,
+                    const Eigen::VectorXd& receiving_q, double jaw, double distance,
+                    double resolution) {
+    return core::find_pre_grasp(cell_, receiving_, receiving_q, distance, resolution,
+                                [&](const Eigen::VectorXd& q) {
+                                  return receiving_.chain.within_limits(q, 1e-9) &&
+                                         clear(board, suction_q, q, jaw);
+                                })
+        .has_value();
   }
 
  private:
@@ -427,7 +442,11 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     // none connects, to the first few branches.
     std::vector<Connection> transits;
     for (const auto& q : valid_branches(receiving, rr.board * grasp.tcp, s.joints_rr)) {
-      if (!exchange.clear(rr.board, suction_q, q, jaw)) continue;
+      if (!exchange.clear(rr.board, suction_q, q, jaw) ||
+          !exchange.approachable(rr.board, suction_q, q, jaw, settings.approach,
+                                 settings.approach_resolution)) {
+        continue;
+      }
       LeftEnd end;
       end.node = add_node("robot_handover", settings.receiving_arm, "gripper", s.robot_grasp_id,
                           s.robot_handover_id, -1, rr.board, {q});

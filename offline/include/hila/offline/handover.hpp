@@ -41,6 +41,11 @@ struct HandoverSettings {
   // at pick_resolution rad) are used at robot-robot poses.
   double pick_lift = 0.15;
   double pick_resolution = 0.05;
+  // The receiving arm needs a way in at a robot-robot pose: a pre-grasp this far (m) back from
+  // the grasp or along the board's edge with the straight motion into the grasp clear at
+  // exchange_resolution (rad), as the online approach (core::find_pre_grasp).
+  double exchange_approach = 0.05;
+  double exchange_resolution = 0.01;
   int rr_orientations = 64;  // board orientations tried per position (spread over SO(3))
   int rr_poses = 24;         // suction-feasible robot-robot poses examined for receiving grasps
   int shared_stored = 8;     // shared grasps searched for and stored per goal

@@ -29,6 +29,12 @@ struct RegraspSettings {
   int transfer_bridges = 2;
   std::uint64_t seed = 1;  // bridges' samplers
   double lift = 0.15;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
+  // The receiving arm's way in at the exchange: a pre-grasp this far (m) back from the grasp or
+  // along the board's edge (as the online planner's approach), the straight motion into the
+  // grasp checked at this resolution (rad, the online validator's). The build takes them from
+  // HandoverSettings (exchange_approach, exchange_resolution), as the robot-robot poses.
+  double approach = 0.05;
+  double approach_resolution = 0.01;
   std::string suction_arm = "right";
   std::string receiving_arm = "left";
 };
