@@ -36,16 +36,30 @@ const char* to_string(MotionStatus status) {
   return "unknown";
 }
 
+const char* to_string(MotionPlannerKind kind) {
+  switch (kind) {
+    case MotionPlannerKind::kRoadmap:
+      return "hila";
+    case MotionPlannerKind::kRrtConnect:
+      return "rrt_connect";
+    case MotionPlannerKind::kLazyPrm:
+      return "lazy_prm";
+  }
+  return "unknown";
+}
+
 ArmRoadmap::ArmRoadmap(db::RoadmapRecord stored)
     : record(std::move(stored)), graph(record.nodes, record.edges) {}
 
 ArmMotionPlanner::ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap,
-                                   const std::string& arm, const MotionSettings& settings)
+                                   const std::string& arm, const MotionSettings& settings,
+                                   core::LazyPrmPlanner* lazy_prm)
     : world_(world),
       roadmap_(roadmap),
       arm_(world.cell().arm(arm)),
       arm_index_(arm_index_of(world.cell(), arm_)),
       settings_(settings),
+      lazy_prm_(lazy_prm),
       data_(world.make_data()),
       base_(core::arm_base_in_world(world.cell(), arm_)) {}
 
@@ -140,6 +154,77 @@ bool ArmMotionPlanner::edge_valid(int edge) {
                        roadmap_.record.nodes[static_cast<std::size_t>(v)]);
 }
 
+// The stored path re-validated for the scene, joined to the start and goal by straight segments
+// (the stored ends are the offline scene's: the board's nominal pose, a neighbouring IK
+// solution); empty when any piece is blocked.
+std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::VectorXd>& hint,
+                                                      const Eigen::VectorXd& start,
+                                                      const Eigen::VectorXd& goal) {
+  const int n = static_cast<int>(hint.size());
+  if (n < 2 || hint.front().size() != start.size()) return {};
+  const int tries = std::max(1, settings_.join_waypoints);
+  int first = -1;
+  for (int i = 0; i < std::min(n, tries) && first < 0; ++i) {
+    if (valid(hint[static_cast<std::size_t>(i)]) &&
+        segment_valid(start, hint[static_cast<std::size_t>(i)])) {
+      first = i;
+    }
+  }
+  if (first < 0) return {};
+  int last = -1;
+  for (int j = n - 1; j >= std::max(first, n - tries) && last < 0; --j) {
+    if ((j == first || valid(hint[static_cast<std::size_t>(j)])) &&
+        segment_valid(hint[static_cast<std::size_t>(j)], goal)) {
+      last = j;
+    }
+  }
+  if (last < 0) return {};
+  for (int i = first + 1; i <= last; ++i) {
+    const auto& a = hint[static_cast<std::size_t>(i - 1)];
+    const auto& b = hint[static_cast<std::size_t>(i)];
+    if ((i != last && !valid(b)) || !segment_valid(a, b)) return {};
+  }
+  std::vector<Eigen::VectorXd> path{start};
+  for (int i = first; i <= last; ++i) path.push_back(hint[static_cast<std::size_t>(i)]);
+  path.push_back(goal);
+  return path;
+}
+
+// Greedy shortcuts within a check budget: from each kept waypoint, the farthest later one a
+// straight segment reaches. Drops repeated waypoints first.
+void ArmMotionPlanner::shorten(std::vector<Eigen::VectorXd>& path) {
+  std::vector<Eigen::VectorXd> unique;
+  for (auto& q : path) {
+    if (unique.empty() || (q - unique.back()).norm() > 1e-9) unique.push_back(std::move(q));
+  }
+  if (unique.size() == 1) unique.push_back(unique.front());  // a motion has two ends
+  path = std::move(unique);
+  long budget = settings_.shortcut_checks;
+  std::vector<Eigen::VectorXd> out{path.front()};
+  std::size_t at = 0;
+  while (at + 1 < path.size()) {
+    std::size_t next = at + 1;
+    for (std::size_t j = path.size() - 1; j > at + 1 && budget > 0; --j) {
+      const auto samples = core::edge_samples(path[at], path[j], resolution_);
+      bool clear = true;
+      for (const auto& q : samples) {
+        --budget;
+        if (!valid(q)) {
+          clear = false;
+          break;
+        }
+      }
+      if (clear) {
+        next = j;
+        break;
+      }
+    }
+    out.push_back(path[next]);
+    at = next;
+  }
+  path = std::move(out);
+}
+
 std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd& q) {
   const auto& nodes = roadmap_.record.nodes;
   std::vector<std::pair<double, int>> near;
@@ -171,8 +256,12 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     r.reason = std::move(reason);
     r.edges_checked = checked_;
     r.edges_invalidated = invalidated_;
+    if (status != MotionStatus::kSolved) {
+      r.path.clear();
+    } else if (r.via != "direct") {
+      shorten(r.path);
+    }
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    if (status != MotionStatus::kSolved) r.path.clear();
     return r;
   };
   auto late = [&] { return std::chrono::steady_clock::now() >= request.deadline; };
@@ -189,6 +278,37 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     r.path = {request.start, request.goal};
     r.via = "direct";
     return finish(MotionStatus::kSolved, "");
+  }
+  // The start in contact is valid by design (the lift's first state).
+  const auto valid_here = [&](const Eigen::VectorXd& q) {
+    return (request.start_in_contact && q == request.start) || valid(q);
+  };
+  if (settings_.planner != MotionPlannerKind::kRoadmap) {
+    if (settings_.planner == MotionPlannerKind::kRrtConnect) {
+      core::BridgeSettings scratch;
+      scratch.max_checks = settings_.baseline_checks;
+      scratch.resolution = resolution_;
+      scratch.seed = settings_.seed;
+      scratch.deadline = request.deadline;
+      r.path = core::plan_bridge(arm_, valid_here, request.start, request.goal, scratch);
+    } else if (lazy_prm_ != nullptr) {
+      r.path = lazy_prm_->plan(valid_here, request.start, request.goal, settings_.baseline_checks,
+                               request.deadline);
+    }
+    if (!r.path.empty()) {
+      r.via = to_string(settings_.planner);
+      return finish(MotionStatus::kSolved, "");
+    }
+    return finish(late() ? MotionStatus::kTimeout : MotionStatus::kNoPath,
+                  std::string(to_string(settings_.planner)) + " found no path within its budget");
+  }
+  for (const auto* hint : request.hints) {
+    if (late()) return finish(MotionStatus::kTimeout, "the deadline passed on a stored path");
+    r.path = follow(*hint, request.start, request.goal);
+    if (!r.path.empty()) {
+      r.via = "stored";
+      return finish(MotionStatus::kSolved, "");
+    }
   }
   std::string direct_blocker;  // what stops the straight motion, for the reason
   for (const auto& q :
@@ -231,15 +351,16 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed before a bridge");
+  if (!request.allow_bridge) {
+    return finish(MotionStatus::kNoPath, "the roadmap does not connect start and goal");
+  }
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
   core::BridgeSettings bridge;
   bridge.max_checks = settings_.bridge_checks;
   bridge.resolution = resolution_;
   bridge.seed = settings_.seed;
   bridge.deadline = request.deadline;
-  r.path = core::plan_bridge(
-      arm_, [&](const Eigen::VectorXd& q) { return valid(q); }, request.start, request.goal,
-      bridge);
+  r.path = core::plan_bridge(arm_, valid_here, request.start, request.goal, bridge);
   if (!r.path.empty()) {
     r.via = "bridge";
     return finish(MotionStatus::kSolved, "");

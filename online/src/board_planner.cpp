@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <map>
 #include <optional>
+#include <tuple>
 
+#include "hila/core/bridge.hpp"
+#include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/online/time_parameterization.hpp"
@@ -26,7 +29,16 @@ std::vector<Eigen::VectorXd> solutions(const core::Cell& cell, const core::Arm& 
   core::UrIkSolutions ik;
   const int n = arm.ur_ik->solve(core::arm_base_in_world(cell, arm).inverse() * tcp, seed, ik);
   std::vector<Eigen::VectorXd> out;
-  for (int i = 0; i < n; ++i) out.emplace_back(ik.q[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < n; ++i) {
+    Eigen::VectorXd q = ik.q[static_cast<std::size_t>(i)];
+    // The stored branch may be the same solution with a joint turned by a full turn (the IK
+    // wraps towards its seed): it is the stored one the offline paths end in.
+    if (preferred != nullptr && preferred->size() == q.size()) {
+      const Eigen::ArrayXd turns = (*preferred - q).array() / (2.0 * M_PI);
+      if (((turns - turns.round()).abs() < 1e-6).all()) q = *preferred;
+    }
+    out.push_back(std::move(q));
+  }
   std::sort(out.begin(), out.end(), [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     const bool pa = preferred && (a - *preferred).norm() < 1e-6;
     const bool pb = preferred && (b - *preferred).norm() < 1e-6;
@@ -56,8 +68,755 @@ const char* to_string(BoardPlanStatus status) {
   return "unknown";
 }
 
+namespace {
+
+// Where the robot is between stages.
+struct ArmsState {
+  Eigen::VectorXd robot_q;  // the whole robot, jaws included
+  bool tool_in_hand = true;
+};
+
+// A stage of the chain (e.g. the suction pick for one cup): its timed steps (from 0) and where
+// it leaves the robot, or why it failed. Stages are memoised by what determines them, so a
+// failing piece shared by many goals is planned once.
+struct Stage {
+  std::string failure;
+  std::vector<PlanStep> steps;
+  ArmsState end;
+  // The stage re-plans the one before it in another order (the receiving arm waits at its
+  // pre-grasp before the board is brought): the previous stage's steps are dropped.
+  bool supersedes_previous = false;
+  bool ok() const { return failure.empty(); }
+};
+
+using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
+
+// One plan() call: the board's records, the scene's world, both arms' motion planners and the
+// memoised stages.
+class Run {
+ public:
+  Run(const PlannerModel& model, const BoardPlanSettings& settings, const Scene& scene,
+      const core::PartSpec& part, const db::PartRecord& record,
+      std::chrono::steady_clock::time_point deadline,
+      std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>>& lazy_prm)
+      : model_(model),
+        cell_(model.cell()),
+        settings_(settings),
+        scene_(scene),
+        part_(part),
+        record_(record),
+        deadline_(deadline),
+        world_(cell_, model.product(), scene, part.name),
+        suction_(cell_.arms()[static_cast<std::size_t>(world_.stage().suction_arm)]),
+        receiving_(cell_.arms()[world_.stage().suction_arm == 0 ? 1u : 0u]),
+        suction_planner_(world_, model.roadmap(suction_.spec.name), suction_.spec.name,
+                         settings.motion, baseline(lazy_prm, suction_)),
+        receiving_planner_(world_, model.roadmap(receiving_.spec.name), receiving_.spec.name,
+                           settings.motion, baseline(lazy_prm, receiving_)),
+        validation_data_(world_.make_data()),
+        board_initial_(scene.initial_pose(part)),
+        opening_tcp_(cell_.spec().gripper.opening_axis.normalized()),
+        approach_tcp_(cell_.spec().gripper.approach_axis.normalized()) {
+    const db::Database& db = model.database();
+    for (const auto& g : db.robot_grasps(record.id)) robot_grasps_[g.id] = g;
+    for (const auto& g : db.suction_grasps(record.id)) suction_grasps_[g.id] = g;
+    for (const auto& h : db.robot_handovers(record.id)) handovers_[h.id] = h;
+    for (const auto& f : db.roadmap_filters(record.id)) {
+      filters_[{f.grasp_kind, f.grasp_id}] = f.edges;
+    }
+    nodes_ = db.regrasp_nodes(record.id);
+    for (const auto& n : nodes_) node_by_id_[n.id] = &n;
+    edges_ = db.regrasp_edges(record.id);
+    start_.robot_q = cell_.home_configuration();
+    for (const auto& arm : cell_.arms()) {
+      const auto it = scene.robot.find(arm.spec.name);
+      if (it != scene.robot.end()) cell_.set_arm(start_.robot_q, arm, it->second);
+    }
+    start_.tool_in_hand = scene.tool_in_hand;
+  }
+
+  const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps() const { return robot_grasps_; }
+  const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
+
+  // Whether the offline regrasp graph connected this goal with this shared grasp.
+  bool connected_offline(const db::HandoverCandidateRecord& goal,
+                         const db::SharedGraspRecord& shared) const {
+    for (const auto& e : edges_) {
+      if (!e.connected || e.kind != "transfer" || e.arm != receiving_.spec.name) continue;
+      const auto* to = node(e.to_node);
+      const auto* from = node(e.from_node);
+      if (to != nullptr && from != nullptr && to->candidate_id == goal.id &&
+          to->grasp_id == shared.robot_grasp_id &&
+          from->robot_handover_id == shared.robot_handover_id) {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // The whole chain for one goal and shared grasp: the memoised stages in order.
+  std::string chain(const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared,
+                    std::vector<PlanStep>& steps, ArmsState& end) {
+    const auto rr_it = handovers_.find(shared.robot_handover_id);
+    if (rr_it == handovers_.end() || suction_grasps_.count(rr_it->second.suction_grasp_id) == 0 ||
+        robot_grasps_.count(shared.robot_grasp_id) == 0) {
+      return "the database's shared grasp refers to a missing record";
+    }
+    const db::RobotHandoverRecord& rr = rr_it->second;
+    const db::RobotGraspRecord& grasp = robot_grasps_.at(shared.robot_grasp_id);
+    const Stage* stages[] = {&tool(), nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+    if (stages[0]->ok()) stages[1] = &pick(rr.suction_grasp_id);
+    if (stages[1] != nullptr && stages[1]->ok()) stages[2] = &transfer(rr);
+    if (stages[2] != nullptr && stages[2]->ok()) stages[3] = &receive(rr, grasp);
+    if (stages[3] != nullptr && stages[3]->ok()) stages[4] = &release(rr, grasp);
+    if (stages[4] != nullptr && stages[4]->ok()) stages[5] = &present(rr, grasp, goal);
+    if (stages[5] != nullptr && stages[5]->ok()) stages[6] = &leave(rr, grasp, goal);
+    double clock = 0.0;
+    std::size_t previous_begin = 0;
+    for (const Stage* stage : stages) {
+      if (!stage->ok()) return stage->failure;
+      if (stage->supersedes_previous) {
+        steps.resize(previous_begin);
+        clock = steps.empty() ? 0.0 : steps.back().time.back();
+      }
+      previous_begin = steps.size();
+      for (PlanStep s : stage->steps) {
+        for (double& t : s.time) t += clock;
+        steps.push_back(std::move(s));
+      }
+      if (!steps.empty()) clock = steps.back().time.back();
+      end = stage->end;
+    }
+    return "";
+  }
+
+ private:
+  static core::LazyPrmPlanner* baseline(
+      std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>>& lazy_prm,
+      const core::Arm& arm) {
+    // Checked every 0.01 rad like held-board motions here: the baseline gets the same checks.
+    auto& p = lazy_prm[arm.spec.name];
+    if (!p) {
+      core::LazyPrmSettings s;
+      s.resolution = 0.01;
+      p = std::make_unique<core::LazyPrmPlanner>(arm, s);
+    }
+    return p.get();
+  }
+
+  const db::RegraspNodeRecord* node(std::int64_t id) const {
+    const auto it = node_by_id_.find(id);
+    return it == node_by_id_.end() ? nullptr : it->second;
+  }
+
+  const std::vector<bool>* filter_for(const std::string& kind, std::int64_t id) const {
+    const auto it = filters_.find({kind, id});
+    return it == filters_.end() ? nullptr : &it->second;
+  }
+
+  // The connected regrasp edges of `kind` moving `arm` whose ends satisfy the predicates: their
+  // stored paths (hints) and where they end (preferred IK branches).
+  template <typename ToMatch, typename FromMatch>
+  std::vector<const db::RegraspEdgeRecord*> stored_edges(const std::string& kind,
+                                                         const core::Arm& arm, ToMatch to_match,
+                                                         FromMatch from_match) const {
+    std::vector<const db::RegraspEdgeRecord*> out;
+    for (const auto& e : edges_) {
+      if (!e.connected || e.kind != kind || e.arm != arm.spec.name || e.path.size() < 2) continue;
+      const auto* to = node(e.to_node);
+      const auto* from = node(e.from_node);
+      if (to != nullptr && from != nullptr && to_match(*to) && from_match(*from)) {
+        out.push_back(&e);
+      }
+    }
+    return out;
+  }
+
+  static Hints paths_of(const std::vector<const db::RegraspEdgeRecord*>& edges) {
+    Hints out;
+    for (const auto* e : edges) out.push_back(&e->path);
+    return out;
+  }
+
+  // Plans, times and validates one motion of the stage; on success the step is appended and
+  // the arm's joints advance to the goal. The reason when it fails.
+  // `stagings`: configurations from which the goal is a straight, valid segment (further back
+  // along an approach), tried as intermediate goals, roadmap only, when the goal itself cannot
+  // be reached: a goal pressed against the robot's body or the other arm's load may attach to
+  // no roadmap node while a pose a few centimetres away does.
+  std::string step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& arm,
+                   MotionRequest request, const std::string& name, const std::string& start_event,
+                   const std::string& end_event,
+                   const std::vector<Eigen::VectorXd>& stagings = {}) {
+    if (std::chrono::steady_clock::now() >= deadline_) return name + ": the deadline passed";
+    request.robot_q = stage.end.robot_q;
+    request.tool_in_hand = stage.end.tool_in_hand;
+    request.tool_world = scene_.tool;
+    request.deadline = deadline_;
+    MotionResult motion = planner.plan(request);
+    for (std::size_t i = 0; !motion.solved() && motion.status != MotionStatus::kTimeout &&
+                            motion.status != MotionStatus::kInvalidStart && i < stagings.size();
+         ++i) {
+      MotionRequest staged = request;
+      staged.goal = stagings[i];
+      staged.allow_bridge = false;
+      MotionResult via_staging = planner.plan(staged);
+      if (!via_staging.solved() || !planner.segment_valid(stagings[i], request.goal)) continue;
+      via_staging.path.push_back(request.goal);
+      via_staging.via += "+staging";
+      motion = std::move(via_staging);
+    }
+    if (!motion.solved()) return name + ": " + to_string(motion.status) + ": " + motion.reason;
+    const TimedPath timed = time_parameterize(motion.path, arm.spec.max_velocity,
+                                              arm.spec.max_acceleration, settings_.speed_scale);
+    Motion check;
+    check.arm = arm.spec.name;
+    check.time = timed.time;
+    check.q = timed.q;
+    check.robot_q = stage.end.robot_q;
+    check.holds_board = request.held.held;
+    check.board_in_tcp = request.held.board_in_tcp;
+    check.slip_axis_tcp = request.held.axis_tcp;
+    check.slip_lever_tcp = request.held.lever_tcp;
+    check.theta_c_deg = request.held.theta_c_deg;
+    check.board_world = request.board_world;
+    check.tool_in_hand = stage.end.tool_in_hand;
+    check.tool_world = scene_.tool;
+    check.start_in_contact = request.start_in_contact;
+    if (request.held.held && &arm == &receiving_) {
+      cell_.set_jaw(check.robot_q, arm, request.held.jaw);
+    }
+    PlanStep s;
+    s.validation = validate_motion(world_, validation_data_, check, settings_.validator);
+    if (!s.validation.valid()) {
+      const auto& v = s.validation.violations.front();
+      return name + ": the validator rejected the plan (" + v.kind + ": " + v.detail + ")";
+    }
+    const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();
+    s.name = name;
+    s.arm = arm.spec.name;
+    s.via = motion.via;
+    for (const double t : timed.time) s.time.push_back(clock + t);
+    s.q = timed.q;
+    s.event =
+        start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
+    s.path_length = path_length(motion.path);
+    cell_.set_arm(stage.end.robot_q, arm, motion.path.back());
+    stage.steps.push_back(std::move(s));
+    return "";
+  }
+
+  // The first of `candidates` valid for the planner under `request` in the stage's state.
+  std::optional<Eigen::VectorXd> first_valid(const Stage& stage, ArmMotionPlanner& planner,
+                                             MotionRequest request,
+                                             const std::vector<Eigen::VectorXd>& candidates) {
+    request.robot_q = stage.end.robot_q;
+    request.tool_in_hand = stage.end.tool_in_hand;
+    request.tool_world = scene_.tool;
+    planner.prepare(request);
+    for (const auto& q : candidates) {
+      if (planner.valid(q)) return q;
+    }
+    return std::nullopt;
+  }
+
+  Eigen::VectorXd arm_q(const Stage& stage, const core::Arm& arm) const {
+    return cell_.arm_joints(stage.end.robot_q, arm);
+  }
+
+  // 0. The tool, when it still stands on the table: approach, grasp, lift, home (where the
+  // offline chain home -> pick starts).
+  const Stage& tool() {
+    if (tool_) return *tool_;
+    tool_.emplace();
+    Stage& st = *tool_;
+    st.end = start_;
+    if (st.end.tool_in_hand) return st;
+    auto fail = [&](std::string why) -> const Stage& {
+      st.failure = "tool_pick: " + std::move(why);
+      return st;
+    };
+    const core::Pose tcp = scene_.tool * cell_.spec().suction.handle_in_tcp.inverse();
+    const core::Pose pre = shifted(tcp, -settings_.approach * (tcp.linear() * approach_tcp_));
+    MotionRequest r;
+    r.board_world = board_initial_;
+    const auto at =
+        first_valid(st, suction_planner_, r, solutions(cell_, suction_, tcp, suction_.spec.home));
+    if (!at) return fail("no valid IK at the tool's handle");
+    const auto before = solutions(cell_, suction_, pre, *at);
+    if (before.empty()) return fail("no IK before the handle");
+    MotionRequest approach = r;
+    approach.start = arm_q(st, suction_);
+    approach.goal = before.front();
+    if (auto e = step(st, suction_planner_, suction_, approach, "tool_approach", "", "");
+        !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    MotionRequest in = r;
+    in.start = before.front();
+    in.goal = *at;
+    if (auto e = step(st, suction_planner_, suction_, in, "tool_grasp", "", "tool_grasped");
+        !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    st.end.tool_in_hand = true;
+    cell_.set_jaw(st.end.robot_q, suction_, cell_.spec().suction.handle_width);
+    const auto raised =
+        solutions(cell_, suction_, shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift)), *at);
+    if (raised.empty()) return fail("no IK above the tool's place");
+    MotionRequest lift = r;
+    lift.start = *at;
+    lift.goal = raised.front();
+    lift.start_in_contact = true;  // the cup still stands on the table
+    if (auto e = step(st, suction_planner_, suction_, lift, "tool_lift", "", ""); !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    MotionRequest home = r;
+    home.start = raised.front();
+    home.goal = suction_.spec.home;
+    if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home", "", ""); !e.empty()) {
+      st.failure = e;
+    }
+    return st;
+  }
+
+  HeldBoard on_cup(const db::SuctionGraspRecord& cup) const {
+    HeldBoard h;
+    h.held = true;
+    h.board_in_tcp = world_.stage().cup_in_tcp * cup.cup.inverse();
+    return h;
+  }
+
+  // 1. Suction pick at the detected pose: approach along the cup's axis, pick, lift. A branch
+  // whose approach and lift stay in it (their nearest solutions) and are valid.
+  const Stage& pick(std::int64_t cup_id) {
+    const auto found = picks_.find(cup_id);
+    if (found != picks_.end()) return found->second;
+    Stage& st = picks_[cup_id];
+    st.end = tool().end;
+    const db::SuctionGraspRecord& cup = suction_grasps_.at(cup_id);
+    const core::Pose cup_in_tcp = world_.stage().cup_in_tcp;
+    const core::Pose cup_world = board_initial_ * cup.cup;
+    const core::Pose pick_tcp = cup_world * cup_in_tcp.inverse();
+    const Eigen::Vector3d into = cup_world.linear().col(2);  // z into the part
+    const core::Pose pre_pick = shifted(pick_tcp, -settings_.approach * into);
+    const core::Pose lifted = shifted(pick_tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift));
+    MotionRequest standing;
+    standing.board_world = board_initial_;
+    MotionRequest carry;
+    carry.held = on_cup(cup);
+    const auto transits = stored_edges(
+        "transit", suction_,
+        [&](const auto& n) { return n.kind == "pick" && n.grasp_id == cup_id; },
+        [](const auto&) { return true; });
+    const Eigen::VectorXd* preferred = transits.empty() ? nullptr : &transits.front()->path.back();
+    std::optional<Eigen::VectorXd> at, up, before;
+    const Eigen::VectorXd suction_now = arm_q(st, suction_);
+    for (const auto& q :
+         solutions(cell_, suction_, pick_tcp, preferred ? *preferred : suction_now)) {
+      if (!first_valid(st, suction_planner_, standing, {q})) continue;
+      const auto p = solutions(cell_, suction_, pre_pick, q);
+      const auto l = solutions(cell_, suction_, lifted, q);
+      if (p.empty() || l.empty() || !first_valid(st, suction_planner_, standing, {p.front()}) ||
+          !first_valid(st, suction_planner_, carry, {l.front()})) {
+        continue;
+      }
+      at = q;
+      before = p.front();
+      up = l.front();
+      break;
+    }
+    if (!at) {
+      st.failure =
+          "suction_pick: no IK branch with a valid approach, pick and lift at the detected board "
+          "pose";
+      return st;
+    }
+    MotionRequest r = standing;
+    r.start = suction_now;
+    r.goal = *before;
+    r.hints = paths_of(transits);
+    if (auto e = step(st, suction_planner_, suction_, r, "suction_approach", "", ""); !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    r.hints.clear();
+    r.start = *before;
+    r.goal = *at;
+    if (auto e = step(st, suction_planner_, suction_, r, "suction_pick", "", "suction_on");
+        !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    carry.start = *at;
+    carry.goal = *up;
+    carry.start_in_contact = true;  // the board still rests where it was detected
+    if (auto e = step(st, suction_planner_, suction_, carry, "lift", "", ""); !e.empty()) {
+      st.failure = e;
+    }
+    return st;
+  }
+
+  // 2. To the robot-robot pose through the suction grasp's filtered roadmap.
+  const Stage& transfer(const db::RobotHandoverRecord& rr) {
+    const auto found = transfers_.find(rr.id);
+    if (found != transfers_.end()) return found->second;
+    Stage& st = transfers_[rr.id];
+    st.end = pick(rr.suction_grasp_id).end;
+    st.failure = transfer_steps(st, rr);
+    return st;
+  }
+
+  // The suction arm, holding the board after the lift, to the robot-robot pose.
+  std::string transfer_steps(Stage& st, const db::RobotHandoverRecord& rr) {
+    const db::SuctionGraspRecord& cup = suction_grasps_.at(rr.suction_grasp_id);
+    const core::Pose rr_tcp = rr.board * cup.cup * world_.stage().cup_in_tcp.inverse();
+    const auto stored = stored_edges(
+        "transfer", suction_,
+        [&](const auto& n) { return n.kind == "robot_handover" && n.robot_handover_id == rr.id; },
+        [](const auto&) { return true; });
+    MotionRequest carry;
+    carry.held = on_cup(cup);
+    const Eigen::VectorXd up = arm_q(st, suction_);
+    const auto rr_q =
+        first_valid(st, suction_planner_, carry,
+                    solutions(cell_, suction_, rr_tcp, up,
+                              stored.empty() ? nullptr : &stored.front()->path.back()));
+    if (!rr_q) return "transfer_to_robot_handover: no valid IK at the robot-robot pose";
+    carry.start = up;
+    carry.goal = *rr_q;
+    carry.filter = filter_for("suction", cup.id);
+    carry.hints = paths_of(stored);
+    return step(st, suction_planner_, suction_, carry, "transfer_to_robot_handover", "", "");
+  }
+
+  double jaw_for(const db::RobotGraspRecord& grasp) const {
+    return std::min(cell_.spec().gripper.jaw_max, grasp.jaw_width + settings_.jaw_margin);
+  }
+
+  // 3. The receiving arm's approach and grasp, the board held by the suction arm. The approach
+  // backs off along the gripper's axis as far as the scene lets it (the exchange may be close
+  // to the robot's body), else the arm goes to the grasp directly.
+  const Stage& receive(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp) {
+    const auto key = std::make_pair(rr.id, grasp.id);
+    const auto found = receives_.find(key);
+    if (found != receives_.end()) return found->second;
+    Stage& st = receives_[key];
+    st.end = transfer(rr).end;
+    const core::Pose grasp_tcp = rr.board * grasp.tcp;
+    auto at_exchange = [&](const auto& n) {
+      return n.kind == "robot_handover" && n.grasp_id == grasp.id && n.robot_handover_id == rr.id;
+    };
+    const auto transits =
+        stored_edges("transit", receiving_, at_exchange, [](const auto&) { return true; });
+    // The branch the offline transfer to the human leaves from, else one a transit reaches.
+    const auto onwards = stored_edges(
+        "transfer", receiving_, [](const auto&) { return true; }, at_exchange);
+    const Eigen::VectorXd* preferred = !onwards.empty()    ? &onwards.front()->path.front()
+                                       : !transits.empty() ? &transits.front()->path.back()
+                                                           : nullptr;
+    MotionRequest reach;
+    reach.board_world = rr.board;
+    // Every valid branch at the exchange (the preferred first): an arm about to hold a long
+    // board under a tight theta_c cannot change branch later, and near the robot's body one
+    // branch may be boxed in where another is free. Through the roadmap first, then bridges
+    // for the first few, as offline.
+    std::vector<Eigen::VectorXd> branches;
+    for (const auto& q : solutions(cell_, receiving_, grasp_tcp, receiving_.spec.home, preferred)) {
+      if (first_valid(st, receiving_planner_, reach, {q})) branches.push_back(q);
+    }
+    if (branches.empty()) {
+      st.failure = "receiving_grasp: no valid IK at the robot-robot pose";
+      return st;
+    }
+    const Stage before = st;
+    std::string first_failure;
+    for (const bool bridges : {false, true}) {
+      for (std::size_t b = 0; b < branches.size(); ++b) {
+        if (bridges && static_cast<int>(b) >= settings_.exchange_bridges) break;
+        Stage attempt = before;
+        const std::string failure = reach_exchange(attempt, rr, grasp, branches[b], bridges,
+                                                   bridges ? Hints{} : paths_of(transits));
+        if (failure.empty()) {
+          st = std::move(attempt);
+          cell_.set_jaw(st.end.robot_q, receiving_, jaw_for(grasp));
+          return st;
+        }
+        if (first_failure.empty()) first_failure = failure;
+        if (failure.find("deadline") != std::string::npos) {
+          st.failure = failure;
+          return st;
+        }
+      }
+    }
+    // The board in place blocks every way in: the receiving arm waits at its pre-grasp while
+    // the suction arm is still at the lift, and the board is brought to it.
+    const Stage& lifted = pick(rr.suction_grasp_id);
+    for (std::size_t b = 0; b < branches.size() && lifted.ok(); ++b) {
+      Stage attempt;
+      attempt.end = lifted.end;
+      if (preposition(attempt, rr, grasp, branches[b]).empty()) {
+        st = std::move(attempt);
+        st.supersedes_previous = true;
+        cell_.set_jaw(st.end.robot_q, receiving_, jaw_for(grasp));
+        return st;
+      }
+    }
+    st.failure = first_failure;
+    return st;
+  }
+
+  // From the lift: the receiving arm to its pre-grasp (the board on the suction cup above its
+  // pick pose), the suction arm to the robot-robot pose past it, the grasp.
+  std::string preposition(Stage& st, const db::RobotHandoverRecord& rr,
+                          const db::RobotGraspRecord& grasp, const Eigen::VectorXd& grasp_q) {
+    const core::Pose grasp_tcp = rr.board * grasp.tcp;
+    MotionRequest at_exchange;
+    at_exchange.board_world = rr.board;
+    const std::optional<Eigen::VectorXd> pre_q = pre_grasp(st, at_exchange, grasp_q);
+    if (!pre_q) return "receiving_approach: no pre-grasp to wait at";
+    const db::SuctionGraspRecord& cup = suction_grasps_.at(rr.suction_grasp_id);
+    const core::Pose up_tcp =
+        core::arm_base_in_world(cell_, suction_) * suction_.chain.fk(arm_q(st, suction_));
+    MotionRequest wait;
+    wait.board_world = up_tcp * on_cup(cup).board_in_tcp;
+    wait.start = arm_q(st, receiving_);
+    wait.goal = *pre_q;
+    if (auto e = step(st, receiving_planner_, receiving_, wait, "receiving_approach", "", "");
+        !e.empty()) {
+      return e;
+    }
+    if (auto e = transfer_steps(st, rr); !e.empty()) return e;
+    at_exchange.start = *pre_q;
+    at_exchange.goal = grasp_q;
+    return step(st, receiving_planner_, receiving_, at_exchange, "receiving_grasp", "",
+                "gripper_close");
+  }
+
+  // Where the gripper opens before closing on the board (core::find_pre_grasp, as the offline
+  // exchange check), under `request`; nothing when the grasp can only be reached directly.
+  std::optional<Eigen::VectorXd> pre_grasp(const Stage& st, const MotionRequest& request,
+                                           const Eigen::VectorXd& grasp_q) {
+    first_valid(st, receiving_planner_, request, {});
+    return core::find_pre_grasp(
+        cell_, receiving_, grasp_q, settings_.approach, settings_.validator.resolution,
+        [&](const Eigen::VectorXd& q) { return receiving_planner_.valid(q); });
+  }
+
+  // The receiving arm to `grasp_q` at the exchange: an approach from behind the grasp where the
+  // scene lets it, staging poses when the approach's start is boxed in.
+  std::string reach_exchange(Stage& st, const db::RobotHandoverRecord& rr,
+                             const db::RobotGraspRecord& grasp, const Eigen::VectorXd& grasp_q,
+                             bool bridges, Hints hints) {
+    const core::Pose grasp_tcp = rr.board * grasp.tcp;
+    MotionRequest reach;
+    reach.board_world = rr.board;
+    reach.allow_bridge = bridges;
+    const std::optional<Eigen::VectorXd> pre_q = pre_grasp(st, reach, grasp_q);
+    // Staging poses for the first motion: further back along the gripper's axis, or above.
+    const Eigen::VectorXd& target = pre_q ? *pre_q : grasp_q;
+    const Eigen::Vector3d back = -(grasp_tcp.linear() * approach_tcp_);
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    std::vector<Eigen::VectorXd> stagings;
+    for (const Eigen::Vector3d& offset :
+         {Eigen::Vector3d(0.10 * back), Eigen::Vector3d(0.15 * back),
+          Eigen::Vector3d(0.10 * up + 0.05 * back), Eigen::Vector3d(0.15 * up),
+          Eigen::Vector3d(0.10 * up + 0.10 * back), Eigen::Vector3d(0.20 * back)}) {
+      const auto q = solutions(cell_, receiving_, shifted(grasp_tcp, offset), target);
+      if (!q.empty() && first_valid(st, receiving_planner_, reach, {q.front()}) &&
+          receiving_planner_.segment_valid(q.front(), target)) {
+        stagings.push_back(q.front());
+      }
+    }
+    reach.start = arm_q(st, receiving_);
+    reach.hints = std::move(hints);
+    if (pre_q) {
+      reach.goal = *pre_q;
+      if (auto e = step(st, receiving_planner_, receiving_, reach, "receiving_approach", "", "",
+                        stagings);
+          !e.empty()) {
+        return e;
+      }
+      reach.start = *pre_q;
+      reach.hints.clear();
+      stagings.clear();
+    }
+    reach.goal = grasp_q;
+    return step(st, receiving_planner_, receiving_, reach, "receiving_grasp", "", "gripper_close",
+                stagings);
+  }
+
+  // 4. Suction off; the suction arm backs off along the cup's axis where it can (else it leaves
+  // directly) and goes home.
+  const Stage& release(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp) {
+    const auto key = std::make_pair(rr.id, grasp.id);
+    const auto found = releases_.find(key);
+    if (found != releases_.end()) return found->second;
+    Stage& st = releases_[key];
+    st.end = receive(rr, grasp).end;
+    const db::SuctionGraspRecord& cup = suction_grasps_.at(rr.suction_grasp_id);
+    const Eigen::VectorXd rr_q = arm_q(st, suction_);
+    const core::Pose rr_tcp = rr.board * cup.cup * world_.stage().cup_in_tcp.inverse();
+    const Eigen::Vector3d cup_axis = (rr.board * cup.cup).linear().col(2);
+    const auto back =
+        solutions(cell_, suction_, shifted(rr_tcp, -settings_.approach * cup_axis), rr_q);
+    MotionRequest leave;
+    leave.board_world = rr.board;
+    leave.start = rr_q;
+    bool backed_off = false;
+    if (!back.empty() && first_valid(st, suction_planner_, leave, {back.front()}) &&
+        suction_planner_.segment_valid(rr_q, back.front())) {
+      leave.goal = back.front();
+      if (auto e =
+              step(st, suction_planner_, suction_, leave, "suction_retreat", "suction_off", "");
+          !e.empty()) {
+        st.failure = e;
+        return st;
+      }
+      leave.start = back.front();
+      backed_off = true;
+    }
+    leave.goal = suction_.spec.home;
+    if (auto e = step(st, suction_planner_, suction_, leave, "suction_arm_home",
+                      backed_off ? "" : "suction_off", "");
+        !e.empty()) {
+      st.failure = e;
+    }
+    return st;
+  }
+
+  HeldBoard in_gripper(const db::RobotGraspRecord& grasp) const {
+    HeldBoard h;
+    h.held = true;
+    h.board_in_tcp = grasp.tcp.inverse();
+    h.jaw = jaw_for(grasp);
+    const Eigen::Vector3d axis_part = grasp.tcp.linear() * opening_tcp_;
+    const Eigen::Vector3d lever_part = core::lever_direction(
+        axis_part, 0.5 * (grasp.contact_1 + grasp.contact_2), record_.mass_properties.com);
+    h.axis_tcp = opening_tcp_;
+    h.lever_tcp = grasp.tcp.linear().transpose() * lever_part;
+    h.theta_c_deg = grasp.theta_c_deg;
+    return h;
+  }
+
+  // 5. The slip-constrained transfer to the human.
+  const Stage& present(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp,
+                       const db::HandoverCandidateRecord& goal) {
+    const auto key = std::make_tuple(rr.id, grasp.id, goal.id);
+    const auto found = presents_.find(key);
+    if (found != presents_.end()) return found->second;
+    Stage& st = presents_[key];
+    st.end = release(rr, grasp).end;
+    const auto stored = stored_edges(
+        "transfer", receiving_,
+        [&](const auto& n) {
+          return n.kind == "human_handover" && n.grasp_id == grasp.id && n.candidate_id == goal.id;
+        },
+        [&](const auto& n) { return n.robot_handover_id == rr.id; });
+    MotionRequest present;
+    present.held = in_gripper(grasp);
+    const Eigen::VectorXd grasp_q = arm_q(st, receiving_);
+    const core::Pose rh_tcp = goal.board * grasp.tcp;
+    const auto rh_q =
+        first_valid(st, receiving_planner_, present,
+                    solutions(cell_, receiving_, rh_tcp, grasp_q,
+                              stored.empty() ? nullptr : &stored.front()->path.back()));
+    if (!rh_q) {
+      st.failure = "transfer_to_human: no valid IK at the robot-human pose";
+      return st;
+    }
+    present.start = grasp_q;
+    present.goal = *rh_q;
+    present.filter = filter_for("gripper", grasp.id);
+    present.hints = paths_of(stored);
+    if (auto e = step(st, receiving_planner_, receiving_, present, "transfer_to_human", "",
+                      "wait_for_human");
+        !e.empty()) {
+      st.failure = e;
+    }
+    return st;
+  }
+
+  // 6. The human takes it (wrist F/T): open, back off, home. Once per present stage.
+  const Stage& leave(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp,
+                     const db::HandoverCandidateRecord& goal) {
+    const auto key = std::make_tuple(rr.id, grasp.id, goal.id);
+    const auto found = leaves_.find(key);
+    if (found != leaves_.end()) return found->second;
+    Stage& st = leaves_[key];
+    st.end = present(rr, grasp, goal).end;
+    cell_.set_jaw(st.end.robot_q, receiving_, cell_.spec().gripper.jaw_max);
+    const Eigen::VectorXd rh_q = arm_q(st, receiving_);
+    MotionRequest release;
+    release.board_world = goal.board;
+    // Out the way a gripper would come in (the offline search required one at this pose).
+    const auto away = pre_grasp(st, release, rh_q);
+    if (!away) {
+      st.failure = "release_retreat: no clear way back from the robot-human pose";
+      return st;
+    }
+    release.start = rh_q;
+    release.goal = *away;
+    if (auto e = step(st, receiving_planner_, receiving_, release, "release_retreat",
+                      "gripper_open", "");
+        !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    release.start = *away;
+    release.goal = receiving_.spec.home;
+    // The board is the human's now; it no longer stands where the arm goes home.
+    if (auto e = step(st, receiving_planner_, receiving_, release, "receiving_arm_home", "", "");
+        !e.empty()) {
+      st.failure = e;
+    }
+    return st;
+  }
+
+  const PlannerModel& model_;
+  const core::Cell& cell_;
+  const BoardPlanSettings& settings_;
+  const Scene& scene_;
+  const core::PartSpec& part_;
+  const db::PartRecord& record_;
+  std::chrono::steady_clock::time_point deadline_;
+  World world_;
+  const core::Arm& suction_;
+  const core::Arm& receiving_;
+  ArmMotionPlanner suction_planner_;
+  ArmMotionPlanner receiving_planner_;
+  core::CollisionData validation_data_;
+  core::Pose board_initial_;
+  Eigen::Vector3d opening_tcp_;
+  Eigen::Vector3d approach_tcp_;
+  ArmsState start_;
+
+  std::map<std::int64_t, db::RobotGraspRecord> robot_grasps_;
+  std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps_;
+  std::map<std::int64_t, db::RobotHandoverRecord> handovers_;
+  std::map<std::pair<std::string, std::int64_t>, std::vector<bool>> filters_;
+  std::vector<db::RegraspNodeRecord> nodes_;
+  std::map<std::int64_t, const db::RegraspNodeRecord*> node_by_id_;
+  std::vector<db::RegraspEdgeRecord> edges_;
+
+  std::optional<Stage> tool_;
+  std::map<std::int64_t, Stage> picks_;                              // by suction grasp
+  std::map<std::int64_t, Stage> transfers_;                          // by robot handover
+  std::map<std::pair<std::int64_t, std::int64_t>, Stage> receives_;  // by (handover, grasp)
+  std::map<std::pair<std::int64_t, std::int64_t>, Stage> releases_;
+  std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, Stage> presents_;
+  std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, Stage> leaves_;
+};
+
+}  // namespace
+
 BoardPlanner::BoardPlanner(const PlannerModel& model, const BoardPlanSettings& settings)
     : model_(model), settings_(settings) {}
+
+BoardPlanner::~BoardPlanner() = default;
 
 BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                              std::chrono::steady_clock::time_point deadline) {
@@ -71,11 +830,9 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return result;
   };
-  const core::Cell& cell = model_.cell();
-  const core::ProductSpec& product = model_.product();
   const db::Database& db = model_.database();
   const core::PartSpec* part = nullptr;
-  for (const auto& p : product.parts) {
+  for (const auto& p : model_.product().parts) {
     if (p.name == board) part = &p;
   }
   if (part == nullptr) return finish(BoardPlanStatus::kNoGoal, "unknown board '" + board + "'");
@@ -89,385 +846,21 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (record == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
+  Run run(model_, settings_, scene, *part, *record, deadline, lazy_prm_);
 
-  const World world(cell, product, scene, board);
-  const core::StageScene& stage = world.stage();
-  const core::Arm& suction = cell.arms()[static_cast<std::size_t>(stage.suction_arm)];
-  const core::Arm& receiving = cell.arms()[stage.suction_arm == 0 ? 1u : 0u];
-  ArmMotionPlanner suction_planner(world, model_.roadmap(suction.spec.name), suction.spec.name,
-                                   settings_.motion);
-  ArmMotionPlanner receiving_planner(world, model_.roadmap(receiving.spec.name),
-                                     receiving.spec.name, settings_.motion);
-  core::CollisionData validation_data = world.make_data();
-
-  std::map<std::int64_t, db::RobotGraspRecord> robot_grasps;
-  for (const auto& g : db.robot_grasps(record->id)) robot_grasps[g.id] = g;
-  std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps;
-  for (const auto& g : db.suction_grasps(record->id)) suction_grasps[g.id] = g;
-  std::map<std::int64_t, db::RobotHandoverRecord> handovers;
-  for (const auto& h : db.robot_handovers(record->id)) handovers[h.id] = h;
-  std::map<std::pair<std::string, std::int64_t>, std::vector<bool>> filters;
-  for (const auto& f : db.roadmap_filters(record->id))
-    filters[{f.grasp_kind, f.grasp_id}] = f.edges;
-  auto filter_for = [&](const std::string& kind, std::int64_t id) -> const std::vector<bool>* {
-    const auto it = filters.find({kind, id});
-    return it == filters.end() ? nullptr : &it->second;
-  };
-  // The offline regrasp graph's configurations, as preferred IK branches: its connected
-  // transfers end in them, so the stored roadmap connects them (the scene permitting).
-  const auto nodes = db.regrasp_nodes(record->id);
-  std::map<std::int64_t, const db::RegraspNodeRecord*> node_by_id;
-  for (const auto& n : nodes) node_by_id[n.id] = &n;
-  std::map<std::int64_t, bool> reached;  // nodes a connected transfer or transit ends in
-  for (const auto& e : db.regrasp_edges(record->id)) {
-    if (e.connected) reached[e.to_node] = true;
-  }
-  auto stored = [&](const std::string& kind, const std::string& arm, std::int64_t grasp,
-                    std::int64_t rr, std::int64_t candidate) -> const Eigen::VectorXd* {
-    const Eigen::VectorXd* any = nullptr;
-    for (const auto& n : nodes) {
-      if (n.kind != kind || n.arm != arm || n.grasp_id != grasp ||
-          (rr != 0 && n.robot_handover_id != rr) ||
-          (candidate != 0 && n.candidate_id != candidate)) {
-        continue;
-      }
-      if (reached.count(n.id) != 0) return &n.solutions.front();
-      if (any == nullptr) any = &n.solutions.front();
-    }
-    return any;
-  };
   std::vector<db::HandoverCandidateRecord> goals = db.handover_goals(record->id);
   std::sort(goals.begin(), goals.end(),
             [](const auto& a, const auto& b) { return a.rank < b.rank; });
-
-  Eigen::VectorXd start_q = cell.home_configuration();
-  for (const auto& arm : cell.arms()) {
-    const auto it = scene.robot.find(arm.spec.name);
-    if (it != scene.robot.end()) cell.set_arm(start_q, arm, it->second);
+  if (goals.size() > static_cast<std::size_t>(std::max(0, settings_.goals))) {
+    goals.resize(static_cast<std::size_t>(std::max(0, settings_.goals)));
   }
-  const Eigen::Vector3d opening_tcp = cell.spec().gripper.opening_axis.normalized();
-  const Eigen::Vector3d approach_tcp = cell.spec().gripper.approach_axis.normalized();
-  const core::Pose cup_in_tcp = stage.cup_in_tcp;
-  const core::Pose board_initial = scene.initial_pose(*part);
-
-  // One goal's chain with one shared grasp; the reason when it fails.
-  auto try_chain = [&](const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared,
-                       std::vector<PlanStep>& steps) -> std::string {
-    Eigen::VectorXd robot_q = start_q;
-    bool tool_in_hand = scene.tool_in_hand;
-    std::map<const core::Arm*, Eigen::VectorXd> now;  // each arm's joints as the plan goes
-    for (const core::Arm* arm : {&suction, &receiving}) {
-      const auto it = scene.robot.find(arm->spec.name);
-      now[arm] = it != scene.robot.end() ? it->second : arm->spec.home;
-    }
-    double clock = 0.0;
-    // Plans, times and validates one motion; on success the step is appended and the arm's
-    // joints in robot_q advance to the goal.
-    auto step = [&](ArmMotionPlanner& planner, const core::Arm& arm, MotionRequest request,
-                    const std::string& name, const std::string& start_event,
-                    const std::string& end_event) -> std::string {
-      if (std::chrono::steady_clock::now() >= deadline) return name + ": the deadline passed";
-      request.robot_q = robot_q;
-      request.tool_in_hand = tool_in_hand;
-      request.tool_world = scene.tool;
-      request.deadline = deadline;
-      const MotionResult motion = planner.plan(request);
-      if (!motion.solved()) return name + ": " + to_string(motion.status) + ": " + motion.reason;
-      const TimedPath timed = time_parameterize(motion.path, arm.spec.max_velocity,
-                                                arm.spec.max_acceleration, settings_.speed_scale);
-      Motion check;
-      check.arm = arm.spec.name;
-      check.time = timed.time;
-      check.q = timed.q;
-      check.robot_q = robot_q;
-      check.holds_board = request.held.held;
-      check.board_in_tcp = request.held.board_in_tcp;
-      check.slip_axis_tcp = request.held.axis_tcp;
-      check.slip_lever_tcp = request.held.lever_tcp;
-      check.theta_c_deg = request.held.theta_c_deg;
-      check.board_world = request.board_world;
-      check.tool_in_hand = tool_in_hand;
-      check.tool_world = scene.tool;
-      check.start_in_contact = request.start_in_contact;
-      if (request.held.held && &arm == &receiving)
-        cell.set_jaw(check.robot_q, arm, request.held.jaw);
-      PlanStep s;
-      s.validation = validate_motion(world, validation_data, check, settings_.validator);
-      if (!s.validation.valid()) {
-        const auto& v = s.validation.violations.front();
-        return name + ": the validator rejected the plan (" + v.kind + ": " + v.detail + ")";
-      }
-      s.name = name;
-      s.arm = arm.spec.name;
-      s.via = motion.via;
-      for (const double t : timed.time) s.time.push_back(clock + t);
-      s.q = timed.q;
-      s.event = start_event.empty() ? end_event
-                                    : start_event + (end_event.empty() ? "" : "," + end_event);
-      s.path_length = path_length(motion.path);
-      clock = s.time.back();
-      cell.set_arm(robot_q, arm, motion.path.back());
-      now[&arm] = motion.path.back();
-      steps.push_back(std::move(s));
-      return "";
-    };
-    // The first IK solution valid for the planner under `request` (nullopt: none).
-    auto first_valid =
-        [&](ArmMotionPlanner& planner, MotionRequest request,
-            const std::vector<Eigen::VectorXd>& candidates) -> std::optional<Eigen::VectorXd> {
-      request.robot_q = robot_q;
-      request.tool_in_hand = tool_in_hand;
-      request.tool_world = scene.tool;
-      planner.prepare(request);
-      for (const auto& q : candidates) {
-        if (planner.valid(q)) return q;
-      }
-      return std::nullopt;
-    };
-
-    const auto rr_it = handovers.find(shared.robot_handover_id);
-    const auto sg_it = rr_it == handovers.end()
-                           ? suction_grasps.end()
-                           : suction_grasps.find(rr_it->second.suction_grasp_id);
-    const auto g_it = robot_grasps.find(shared.robot_grasp_id);
-    if (rr_it == handovers.end() || sg_it == suction_grasps.end() || g_it == robot_grasps.end()) {
-      return "the database's shared grasp refers to a missing record";
-    }
-    const db::RobotHandoverRecord& rr = rr_it->second;
-    const db::SuctionGraspRecord& cup = sg_it->second;
-    const db::RobotGraspRecord& grasp = g_it->second;
-
-    // 0. The tool, when it still stands on the table.
-    if (!tool_in_hand) {
-      const core::Pose tcp = scene.tool * cell.spec().suction.handle_in_tcp.inverse();
-      const core::Pose pre = shifted(tcp, -settings_.approach * (tcp.linear() * approach_tcp));
-      MotionRequest r;
-      r.board_world = board_initial;
-      const auto at =
-          first_valid(suction_planner, r, solutions(cell, suction, tcp, suction.spec.home));
-      if (!at) return "tool_pick: no valid IK at the tool's handle";
-      const auto before = solutions(cell, suction, pre, *at);
-      if (before.empty()) return "tool_pick: no IK before the handle";
-      MotionRequest approach = r;
-      approach.start = now[&suction];
-      approach.goal = before.front();
-      if (auto e = step(suction_planner, suction, approach, "tool_approach", "", ""); !e.empty())
-        return e;
-      MotionRequest in = r;
-      in.start = before.front();
-      in.goal = *at;
-      if (auto e = step(suction_planner, suction, in, "tool_grasp", "", "tool_grasped"); !e.empty())
-        return e;
-      tool_in_hand = true;
-      cell.set_jaw(robot_q, suction, cell.spec().suction.handle_width);
-      const auto raised =
-          solutions(cell, suction, shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift)), *at);
-      if (raised.empty()) return "tool_lift: no IK above the tool's place";
-      MotionRequest lift = r;
-      lift.start = *at;
-      lift.goal = raised.front();
-      lift.start_in_contact = true;  // the cup still stands on the table
-      if (auto e = step(suction_planner, suction, lift, "tool_lift", "", ""); !e.empty()) return e;
-      // Home with the tool: where the offline chain (home -> pick) starts.
-      MotionRequest home = r;
-      home.start = raised.front();
-      home.goal = suction.spec.home;
-      if (auto e = step(suction_planner, suction, home, "tool_to_home", "", ""); !e.empty())
-        return e;
-    }
-
-    // 1. Suction pick at the detected pose: approach along the cup's axis, pick, lift.
-    const core::Pose cup_world = board_initial * cup.cup;
-    const core::Pose pick_tcp = cup_world * cup_in_tcp.inverse();
-    const Eigen::Vector3d into = cup_world.linear().col(2);  // z into the part
-    const core::Pose pre_pick = shifted(pick_tcp, -settings_.approach * into);
-    const core::Pose lifted = shifted(pick_tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift));
-    MotionRequest standing;
-    standing.board_world = board_initial;
-    const Eigen::VectorXd suction_now = now[&suction];
-    HeldBoard on_cup;
-    on_cup.held = true;
-    on_cup.board_in_tcp = cup_in_tcp * cup.cup.inverse();
-    MotionRequest carry;
-    carry.held = on_cup;
-    // A pick branch whose approach and lift stay in it (their nearest solutions) and are valid:
-    // the approach with the board standing, the lift with it on the cup.
-    std::optional<Eigen::VectorXd> pick, up;
-    std::vector<Eigen::VectorXd> pre;
-    const Eigen::VectorXd* stored_pick = stored("pick", suction.spec.name, cup.id, 0, 0);
-    for (const auto& q :
-         solutions(cell, suction, pick_tcp, stored_pick ? *stored_pick : suction_now)) {
-      if (!first_valid(suction_planner, standing, {q})) continue;
-      const auto p = solutions(cell, suction, pre_pick, q);
-      const auto l = solutions(cell, suction, lifted, q);
-      if (p.empty() || l.empty() || !first_valid(suction_planner, standing, {p.front()}) ||
-          !first_valid(suction_planner, carry, {l.front()})) {
-        continue;
-      }
-      pick = q;
-      pre = {p.front()};
-      up = l.front();
-      break;
-    }
-    if (!pick) {
-      return "suction_pick: no IK branch with a valid approach, pick and lift at the detected "
-             "board pose";
-    }
-    MotionRequest r = standing;
-    r.start = suction_now;
-    r.goal = pre.front();
-    if (auto e = step(suction_planner, suction, r, "suction_approach", "", ""); !e.empty())
-      return e;
-    r.start = pre.front();
-    r.goal = *pick;
-    if (auto e = step(suction_planner, suction, r, "suction_pick", "", "suction_on"); !e.empty())
-      return e;
-    carry.start = *pick;
-    carry.goal = *up;
-    carry.start_in_contact = true;  // the board still rests where it was detected
-    if (auto e = step(suction_planner, suction, carry, "lift", "", ""); !e.empty()) return e;
-
-    // 2. To the robot-robot pose, through the suction grasp's filtered roadmap.
-    const core::Pose rr_tcp = rr.board * cup.cup * cup_in_tcp.inverse();
-    const auto rr_q =
-        first_valid(suction_planner, carry,
-                    solutions(cell, suction, rr_tcp, *up,
-                              stored("robot_handover", suction.spec.name, cup.id, rr.id, 0)));
-    if (!rr_q) return "transfer_to_robot_handover: no valid IK at the robot-robot pose";
-    carry.start = *up;
-    carry.goal = *rr_q;
-    carry.start_in_contact = false;
-    carry.filter = filter_for("suction", cup.id);
-    if (auto e = step(suction_planner, suction, carry, "transfer_to_robot_handover", "", "");
-        !e.empty())
-      return e;
-
-    // 3. The receiving arm's approach and grasp, the board held by the suction arm.
-    const double jaw =
-        std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + settings_.jaw_margin);
-    const core::Pose grasp_tcp = rr.board * grasp.tcp;
-    MotionRequest reach;
-    reach.board_world = rr.board;
-    const auto grasp_q =
-        first_valid(receiving_planner, reach,
-                    solutions(cell, receiving, grasp_tcp, receiving.spec.home,
-                              stored("robot_handover", receiving.spec.name, grasp.id, rr.id, 0)));
-    if (!grasp_q) return "receiving_grasp: no valid IK at the robot-robot pose";
-    // The approach backs off along the gripper's axis as far as the scene lets it (the exchange
-    // may be close to the robot's body), else the arm goes to the grasp directly.
-    std::optional<Eigen::VectorXd> pre_q;
-    for (const double fraction : {1.0, 0.5, 0.2}) {
-      const auto p = solutions(
-          cell, receiving,
-          shifted(grasp_tcp, -fraction * settings_.approach * (grasp_tcp.linear() * approach_tcp)),
-          *grasp_q);
-      if (p.empty()) continue;
-      reach.robot_q = robot_q;
-      reach.tool_in_hand = tool_in_hand;
-      receiving_planner.prepare(reach);
-      if (receiving_planner.valid(p.front()) &&
-          receiving_planner.segment_valid(p.front(), *grasp_q)) {
-        pre_q = p.front();
-        break;
-      }
-    }
-    reach.start = now[&receiving];
-    if (pre_q) {
-      reach.goal = *pre_q;
-      if (auto e = step(receiving_planner, receiving, reach, "receiving_approach", "", "");
-          !e.empty())
-        return e;
-      reach.start = *pre_q;
-    }
-    reach.goal = *grasp_q;
-    if (auto e = step(receiving_planner, receiving, reach, "receiving_grasp", "", "gripper_close");
-        !e.empty())
-      return e;
-    cell.set_jaw(robot_q, receiving, jaw);
-
-    // 4. Suction off; the suction arm backs off along the cup's axis where it can (else it
-    // leaves directly) and goes home.
-    const Eigen::Vector3d cup_axis = (rr.board * cup.cup).linear().col(2);
-    const auto back =
-        solutions(cell, suction, shifted(rr_tcp, -settings_.approach * cup_axis), *rr_q);
-    MotionRequest leave;
-    leave.board_world = rr.board;
-    leave.start = *rr_q;
-    bool backed_off = false;
-    if (!back.empty()) {
-      leave.robot_q = robot_q;
-      leave.tool_in_hand = tool_in_hand;
-      suction_planner.prepare(leave);
-      if (suction_planner.valid(back.front()) &&
-          suction_planner.segment_valid(*rr_q, back.front())) {
-        leave.goal = back.front();
-        if (auto e = step(suction_planner, suction, leave, "suction_retreat", "suction_off", "");
-            !e.empty())
-          return e;
-        leave.start = back.front();
-        backed_off = true;
-      }
-    }
-    leave.goal = suction.spec.home;
-    if (auto e = step(suction_planner, suction, leave, "suction_arm_home",
-                      backed_off ? "" : "suction_off", "");
-        !e.empty())
-      return e;
-
-    // 5. The slip-constrained transfer to the human.
-    HeldBoard in_gripper;
-    in_gripper.held = true;
-    in_gripper.board_in_tcp = grasp.tcp.inverse();
-    in_gripper.jaw = jaw;
-    const Eigen::Vector3d axis_part = grasp.tcp.linear() * opening_tcp;
-    const Eigen::Vector3d lever_part = core::lever_direction(
-        axis_part, 0.5 * (grasp.contact_1 + grasp.contact_2), record->mass_properties.com);
-    in_gripper.axis_tcp = opening_tcp;
-    in_gripper.lever_tcp = grasp.tcp.linear().transpose() * lever_part;
-    in_gripper.theta_c_deg = grasp.theta_c_deg;
-    MotionRequest present;
-    present.held = in_gripper;
-    const core::Pose rh_tcp = goal.board * grasp.tcp;
-    const auto rh_q =
-        first_valid(receiving_planner, present,
-                    solutions(cell, receiving, rh_tcp, *grasp_q,
-                              stored("human_handover", receiving.spec.name, grasp.id, 0, goal.id)));
-    if (!rh_q) return "transfer_to_human: no valid IK at the robot-human pose";
-    present.start = *grasp_q;
-    present.goal = *rh_q;
-    present.filter = filter_for("gripper", grasp.id);
-    if (auto e =
-            step(receiving_planner, receiving, present, "transfer_to_human", "", "wait_for_human");
-        !e.empty())
-      return e;
-
-    // 6. The human takes it (wrist F/T): open, back off, home.
-    cell.set_jaw(robot_q, receiving, cell.spec().gripper.jaw_max);
-    const auto away =
-        solutions(cell, receiving,
-                  shifted(rh_tcp, -settings_.approach * (rh_tcp.linear() * approach_tcp)), *rh_q);
-    if (away.empty()) return "release_retreat: no IK behind the robot-human pose";
-    MotionRequest release;
-    release.board_world = goal.board;
-    release.start = *rh_q;
-    release.goal = away.front();
-    if (auto e = step(receiving_planner, receiving, release, "release_retreat", "gripper_open", "");
-        !e.empty())
-      return e;
-    release.start = away.front();
-    release.goal = receiving.spec.home;
-    // The board is the human's now; it no longer stands where the arm goes home.
-    if (auto e = step(receiving_planner, receiving, release, "receiving_arm_home", "", "");
-        !e.empty())
-      return e;
-    result.robot_q_after = robot_q;
-    return "";
-  };
-
-  int tried = 0;
   for (const auto& goal : goals) {
-    if (tried++ >= settings_.goals) break;
-    for (const auto& shared : db.shared_grasps(goal.id)) {
+    // The shared grasps the offline regrasp graph connected for this goal first: their stored
+    // paths and IK branches are what the motions re-validate.
+    std::vector<db::SharedGraspRecord> shared = db.shared_grasps(goal.id);
+    std::stable_partition(shared.begin(), shared.end(),
+                          [&](const auto& s) { return run.connected_offline(goal, s); });
+    for (const auto& s : shared) {
       if (std::chrono::steady_clock::now() >= deadline) {
         return finish(BoardPlanStatus::kTimeout, "the deadline passed after " +
                                                      std::to_string(result.attempts.size()) +
@@ -476,33 +869,35 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
       GoalAttempt attempt;
       attempt.rank = goal.rank;
       attempt.candidate_id = goal.id;
-      attempt.robot_grasp_id = shared.robot_grasp_id;
-      attempt.robot_handover_id = shared.robot_handover_id;
+      attempt.robot_grasp_id = s.robot_grasp_id;
+      attempt.robot_handover_id = s.robot_handover_id;
       std::vector<PlanStep> steps;
-      const std::string failure = try_chain(goal, shared, steps);
+      ArmsState end;
+      const std::string failure = run.chain(goal, s, steps, end);
       attempt.outcome = failure.empty() ? "planned" : failure;
       result.attempts.push_back(attempt);
       if (!failure.empty()) continue;
+      const auto& rr = run.handovers().at(s.robot_handover_id);
       result.steps = std::move(steps);
       result.goal_rank = goal.rank;
       result.candidate_id = goal.id;
-      result.robot_grasp_id = shared.robot_grasp_id;
-      result.suction_grasp_id = handovers.at(shared.robot_handover_id).suction_grasp_id;
-      result.theta_c_deg = robot_grasps.at(shared.robot_grasp_id).theta_c_deg;
+      result.robot_grasp_id = s.robot_grasp_id;
+      result.suction_grasp_id = rr.suction_grasp_id;
+      result.theta_c_deg = run.robot_grasps().at(s.robot_grasp_id).theta_c_deg;
       result.quality = goal.quality;
-      result.robot_handover = handovers.at(shared.robot_handover_id).board;
+      result.robot_handover = rr.board;
       result.human_handover = goal.board;
       result.duration = result.steps.back().time.back();
-      for (const auto& s : result.steps) result.path_length += s.path_length;
+      for (const auto& st : result.steps) result.path_length += st.path_length;
       result.validated = true;
+      result.robot_q_after = end.robot_q;
       return finish(BoardPlanStatus::kSolved, "");
     }
   }
   return finish(BoardPlanStatus::kNoGoal,
-                goals.empty()
-                    ? "the database has no handover goal for '" + board + "'"
-                    : "none of the first " + std::to_string(std::min<int>(tried, settings_.goals)) +
-                          " goals could be planned in this scene (see attempts)");
+                goals.empty() ? "the database has no handover goal for '" + board + "'"
+                              : "none of the first " + std::to_string(goals.size()) +
+                                    " goals could be planned in this scene (see attempts)");
 }
 
 }  // namespace hila::online

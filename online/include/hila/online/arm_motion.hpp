@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hila/core/collision.hpp"
+#include "hila/core/lazy_prm.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/db/records.hpp"
 #include "hila/online/world.hpp"
@@ -46,6 +47,11 @@ struct MotionRequest {
   // The start touches by design (a lift: the picked board or the grasped tool still rests on
   // the table): its own collisions are not checked, every later sample is.
   bool start_in_contact = false;
+  // Paths stored offline for this motion (the regrasp graph's, for the nominal scene), tried in
+  // order before the roadmap: each is joined to the start and goal by straight segments within
+  // its first and last few waypoints and re-validated against the scene as it is.
+  std::vector<const std::vector<Eigen::VectorXd>*> hints;
+  bool allow_bridge = true;  // false: roadmap (and stored paths) only, e.g. for a staging try
 };
 
 enum class MotionStatus { kSolved, kInvalidStart, kInvalidGoal, kNoPath, kTimeout };
@@ -55,22 +61,34 @@ struct MotionResult {
   MotionStatus status = MotionStatus::kNoPath;
   std::string reason;                 // why not solved, naming what is in the way
   std::vector<Eigen::VectorXd> path;  // start ... goal, straight segments between waypoints
-  std::string via;                    // "direct", "roadmap" or "bridge"
-  int searches = 0;                   // A* runs (one more after each invalidated edge)
-  int edges_checked = 0;              // roadmap edges validated against the scene
-  int edges_invalidated = 0;          // of those, blocked in the scene
+  // "direct", "stored" (an offline path re-validated), "roadmap", "bridge"; the baselines'
+  // "rrt_connect" or "lazy_prm"
+  std::string via;
+  int searches = 0;           // A* runs (one more after each invalidated edge)
+  int edges_checked = 0;      // roadmap edges validated against the scene
+  int edges_invalidated = 0;  // of those, blocked in the scene
   double seconds = 0.0;
   bool solved() const { return status == MotionStatus::kSolved; }
 };
 
+// What plans a motion: the stored roadmap (hila's planner), or a baseline it is measured
+// against: OMPL RRT-Connect from scratch, OMPL LazyPRM with a roadmap kept between queries.
+// Every one checks the same validity (collisions, held board, slip) at the same resolution.
+enum class MotionPlannerKind { kRoadmap, kRrtConnect, kLazyPrm };
+const char* to_string(MotionPlannerKind kind);
+
 struct MotionSettings {
+  MotionPlannerKind planner = MotionPlannerKind::kRoadmap;
   int attach_neighbours = 12;  // roadmap nodes tried per end
   int attachments = 6;         // valid attachments kept per end
   int max_searches = 200;
   // Segment checks while holding a board: as fine as the validator's (rad), since a long board
   // sweeps far between the roadmap's 0.05 rad samples; the empty arm uses the roadmap's.
   double held_resolution = 0.01;
-  long bridge_checks = 4000;  // a bridge's validity-check budget (also bounded by the deadline)
+  long bridge_checks = 4000;      // a bridge's validity-check budget (also bounded by the deadline)
+  long baseline_checks = 200000;  // the baselines' budget per motion (and the deadline)
+  int join_waypoints = 4;         // a stored path's first / last waypoints tried for the joins
+  long shortcut_checks = 1500;    // validity checks spent shortening a found path
   std::uint64_t seed = 1;
 };
 
@@ -82,8 +100,9 @@ struct MotionSettings {
 // throws on the planning path: failures are statuses with reasons.
 class ArmMotionPlanner {
  public:
+  // `lazy_prm`: the persistent baseline planner for this arm (kLazyPrm only; not owned).
   ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap, const std::string& arm,
-                   const MotionSettings& settings = {});
+                   const MotionSettings& settings = {}, core::LazyPrmPlanner* lazy_prm = nullptr);
 
   MotionResult plan(const MotionRequest& request);
 
@@ -97,6 +116,9 @@ class ArmMotionPlanner {
   enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
   Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
   bool edge_valid(int edge);
+  std::vector<Eigen::VectorXd> follow(const std::vector<Eigen::VectorXd>& hint,
+                                      const Eigen::VectorXd& start, const Eigen::VectorXd& goal);
+  void shorten(std::vector<Eigen::VectorXd>& path);
   std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q);
 
   const World& world_;
@@ -104,6 +126,7 @@ class ArmMotionPlanner {
   const core::Arm& arm_;
   int arm_index_ = 0;
   MotionSettings settings_;
+  core::LazyPrmPlanner* lazy_prm_ = nullptr;
   core::CollisionData data_;
   core::GraphSearchWorkspace search_;
   std::vector<int> moving_;

@@ -3,6 +3,8 @@
 #include <Eigen/Core>
 #include <chrono>
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@ struct BoardPlanSettings {
   double approach = 0.05;     // m: straight approach and retreat along the cup's / gripper's axis
   double lift = 0.15;         // m: straight up from the table after the suction pick
   int goals = 10;             // goals tried in Eq. 8 order
+  int exchange_bridges = 2;   // receiving-arm IK branches at the exchange given a bridge
   double speed_scale = 0.5;   // of the arms' velocity and acceleration limits
   double jaw_margin = 0.005;  // m: the gripper opens this much wider than the board while holding
   MotionSettings motion;
@@ -76,10 +79,14 @@ struct BoardPlan {
 // release and retreat, the slip-constrained transfer to the robot-human pose and the retreat
 // after the human takes it. Goals in Eq. 8 order; each motion through the stored roadmaps
 // repaired for the scene; every step timed and re-checked by the validator: nothing invalid is
-// returned. One per thread (holds the motion planners' state).
+// returned. Failing pieces shared by several goals (a cup's pick, a transfer to a robot-robot
+// pose) are planned once per call. One per thread.
 class BoardPlanner {
  public:
   explicit BoardPlanner(const PlannerModel& model, const BoardPlanSettings& settings = {});
+  ~BoardPlanner();
+  BoardPlanner(const BoardPlanner&) = delete;
+  BoardPlanner& operator=(const BoardPlanner&) = delete;
 
   BoardPlan plan(const Scene& scene, const std::string& board,
                  std::chrono::steady_clock::time_point deadline);
@@ -87,6 +94,8 @@ class BoardPlanner {
  private:
   const PlannerModel& model_;
   BoardPlanSettings settings_;
+  // The LazyPRM baseline's roadmaps, kept between queries (settings.motion.planner kLazyPrm).
+  std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>> lazy_prm_;
 };
 
 }  // namespace hila::online
