@@ -1,0 +1,240 @@
+#include "plan_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <sstream>
+
+#include "hila/core/soft_finger.hpp"
+#include "hila/core/stage_scene.hpp"
+#include "hila/online/validator.hpp"
+#include "hila/online/world.hpp"
+
+namespace hila::bench {
+
+namespace {
+
+// Where an attachment may be off the object: FK of an IK solution is exact to ~1e-9, so
+// anything visible here means the plan grasps something where it is not.
+constexpr double kPositionTolerance = 1e-4;  // m
+constexpr double kAngleTolerance = 1e-3;     // rad
+
+std::string pose_error(const core::Pose& is, const core::Pose& should) {
+  const double dp = (is.translation() - should.translation()).norm();
+  const double da = core::rotation_distance(is.linear(), should.linear());
+  if (dp <= kPositionTolerance && da <= kAngleTolerance) return "";
+  std::ostringstream s;
+  s.precision(3);
+  s << 1e3 * dp << " mm and " << core::rad_to_deg(da) << " deg off";
+  return s.str();
+}
+
+std::vector<std::string> split_events(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string e; std::getline(in, e, ',');) {
+    if (!e.empty()) out.push_back(e);
+  }
+  return out;
+}
+
+// Events that happen as their step starts (the arm lets go, then moves away); every other event
+// happens when its step has arrived (docs/online.md: a step's starting event comes first).
+bool starts_step(const std::string& event) {
+  return event == "suction_off" || event == "gripper_open";
+}
+
+}  // namespace
+
+PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& scene,
+                     const online::BoardPlan& plan, const online::BoardPlanSettings& settings) {
+  PlanCheck out;
+  auto problem = [&](const std::string& where, const std::string& what) {
+    out.problems.push_back(where + ": " + what);
+  };
+  if (!plan.solved()) {
+    problem(plan.board, "not a solved plan");
+    return out;
+  }
+  if (!plan.validated) problem(plan.board, "the planner did not mark it validated");
+  if (plan.steps.empty()) {
+    problem(plan.board, "a solved plan without steps");
+    return out;
+  }
+  const core::Cell& cell = model.cell();
+  const core::ProductSpec& product = model.product();
+  const core::PartSpec& part = product.part(plan.board);
+  const db::Database& db = model.database();
+  const db::PartRecord* record = nullptr;
+  for (const auto& p : db.parts()) {
+    if (p.name == plan.board) record = &p;
+  }
+  std::optional<db::RobotGraspRecord> grasp;
+  std::optional<db::SuctionGraspRecord> cup;
+  if (record != nullptr) {
+    for (const auto& g : db.robot_grasps(record->id)) {
+      if (g.id == plan.robot_grasp_id) grasp = g;
+    }
+    for (const auto& c : db.suction_grasps(record->id)) {
+      if (c.id == plan.suction_grasp_id) cup = c;
+    }
+  }
+  if (!grasp || !cup) {
+    problem(plan.board, "the plan's robot or suction grasp is not in the database");
+    return out;
+  }
+  if (std::abs(grasp->theta_c_deg - plan.theta_c_deg) > 1e-9) {
+    problem(plan.board, "the plan's theta_c is not its grasp's");
+  }
+
+  const online::World world(cell, product, scene, plan.board);
+  core::CollisionData data = world.make_data();
+  const core::StageScene& stage = world.stage();
+  const core::Arm& suction = cell.arms()[static_cast<std::size_t>(stage.suction_arm)];
+  const core::Arm& receiving = cell.arms()[stage.suction_arm == 0 ? 1u : 0u];
+
+  // The board in each hand, and the slip of the gripper's hold (the cup has no slip limit).
+  const core::Pose board_in_cup_tcp = stage.cup_in_tcp * cup->cup.inverse();
+  const core::Pose board_in_gripper_tcp = grasp->tcp.inverse();
+  const Eigen::Vector3d opening = cell.spec().gripper.opening_axis.normalized();
+  const Eigen::Vector3d lever_part = core::lever_direction(
+      grasp->tcp.linear() * opening, 0.5 * (grasp->contact_1 + grasp->contact_2),
+      record->mass_properties.com);
+  const Eigen::Vector3d lever_tcp = grasp->tcp.linear().transpose() * lever_part;
+  const double holding_jaw =
+      std::min(cell.spec().gripper.jaw_max, grasp->jaw_width + settings.jaw_margin);
+
+  // The cell at the scene's start.
+  Eigen::VectorXd robot_q = cell.home_configuration();
+  for (const auto& arm : cell.arms()) {
+    const auto it = scene.robot.find(arm.spec.name);
+    if (it != scene.robot.end()) cell.set_arm(robot_q, arm, it->second);
+  }
+  bool tool_in_hand = scene.tool_in_hand;
+  bool on_cup = false, in_gripper = false, handed_over = false;
+  core::Pose board_world = scene.initial_pose(part);  // while neither hand holds it
+  auto tcp_of = [&](const core::Arm& arm) {
+    return core::arm_base_in_world(cell, arm) * arm.chain.fk(cell.arm_joints(robot_q, arm));
+  };
+  auto board_now = [&]() {
+    if (on_cup) return tcp_of(suction) * board_in_cup_tcp;
+    if (in_gripper) return tcp_of(receiving) * board_in_gripper_tcp;
+    return board_world;
+  };
+
+  double clock = -1e300;
+  bool lifting = false;  // the step after a pick starts with the object still on the table
+  for (const online::PlanStep& step : plan.steps) {
+    ++out.steps;
+    const std::string where = plan.board + ": " + step.name;
+    const core::Arm* arm = step.arm == suction.spec.name     ? &suction
+                           : step.arm == receiving.spec.name ? &receiving
+                                                             : nullptr;
+    if (arm == nullptr || step.q.empty() || step.q.size() != step.time.size()) {
+      problem(where, "expected a known arm and one time per waypoint");
+      return out;
+    }
+    const auto events = split_events(step.event);
+    bool started = true;
+    for (const auto& e : events) {
+      if (!starts_step(e)) {
+        started = false;
+      } else if (!started) {
+        problem(where, "starting event '" + e + "' after an arriving one");
+      }
+    }
+    for (const auto& e : events) {
+      if (e == "suction_off") {
+        if (arm != &suction || !on_cup) problem(where, "suction off without the cup on the board");
+        board_world = board_now();
+        on_cup = false;
+      } else if (e == "gripper_open") {
+        if (arm != &receiving || !in_gripper) problem(where, "gripper opens without the board");
+        board_world = board_now();
+        in_gripper = false;
+        handed_over = true;
+        cell.set_jaw(robot_q, receiving, cell.spec().gripper.jaw_max);
+      }
+    }
+
+    const Eigen::VectorXd now = cell.arm_joints(robot_q, *arm);
+    if (step.q.front().size() != now.size() || (step.q.front() - now).norm() > 1e-6) {
+      problem(where, "starts away from where its arm is");
+    }
+    if (step.time.front() < clock - 1e-9) problem(where, "starts before the previous step ends");
+    clock = step.time.back();
+    if (on_cup && in_gripper) problem(where, "an arm moves while both hold the board");
+
+    online::Motion motion;
+    motion.arm = arm->spec.name;
+    motion.time = step.time;
+    motion.q = step.q;
+    motion.robot_q = robot_q;
+    motion.holds_board = arm == &suction ? on_cup : in_gripper;
+    if (motion.holds_board) {
+      motion.board_in_tcp = arm == &suction ? board_in_cup_tcp : board_in_gripper_tcp;
+      if (arm == &receiving) {
+        motion.slip_axis_tcp = opening;
+        motion.slip_lever_tcp = lever_tcp;
+        motion.theta_c_deg = grasp->theta_c_deg;
+      }
+    } else {
+      motion.board_world = board_now();
+    }
+    motion.tool_in_hand = tool_in_hand;
+    motion.tool_world = scene.tool;
+    motion.start_in_contact = lifting;
+    const online::ValidationReport report =
+        online::validate_motion(world, data, motion, settings.validator);
+    out.samples += report.samples;
+    for (const auto& v : report.violations) {
+      std::ostringstream s;
+      s.precision(3);
+      s << v.kind << " at " << v.time << " s: " << v.detail;
+      problem(where, s.str());
+    }
+    cell.set_arm(robot_q, *arm, step.q.back());
+    lifting = false;
+
+    for (const auto& e : events) {
+      if (starts_step(e)) continue;
+      if (e == "tool_grasped") {
+        if (arm != &suction || tool_in_hand) problem(where, "grasps a tool it cannot");
+        const std::string off =
+            pose_error(tcp_of(suction) * cell.spec().suction.handle_in_tcp, scene.tool);
+        if (!off.empty()) problem(where, "grasps the tool's handle " + off);
+        tool_in_hand = true;
+        cell.set_jaw(robot_q, suction, cell.spec().suction.handle_width);
+        lifting = true;
+      } else if (e == "suction_on") {
+        if (arm != &suction || !tool_in_hand || on_cup || in_gripper || handed_over) {
+          problem(where, "suction on without the tool or with the board already taken");
+        }
+        const std::string off = pose_error(tcp_of(suction) * board_in_cup_tcp, board_world);
+        if (!off.empty()) problem(where, "the cup meets the board " + off + " its detected pose");
+        on_cup = true;
+        lifting = true;
+      } else if (e == "gripper_close") {
+        if (arm != &receiving || !on_cup) problem(where, "closes without the board on the cup");
+        const std::string off = pose_error(tcp_of(receiving) * board_in_gripper_tcp, board_now());
+        if (!off.empty()) problem(where, "the gripper closes " + off + " the board");
+        const std::string at = pose_error(board_now(), plan.robot_handover);
+        if (!at.empty()) problem(where, "the exchange is " + at + " the plan's robot-robot pose");
+        in_gripper = true;
+        cell.set_jaw(robot_q, receiving, holding_jaw);
+      } else if (e == "wait_for_human") {
+        if (!in_gripper || on_cup) problem(where, "waits for the human without the board");
+        const std::string at = pose_error(board_now(), plan.human_handover);
+        if (!at.empty()) problem(where, "presents the board " + at + " the robot-human pose");
+      } else {
+        problem(where, "unknown event '" + e + "'");
+      }
+    }
+  }
+  if (!handed_over || on_cup || in_gripper) {
+    problem(plan.board, "the board does not end with the human");
+  }
+  return out;
+}
+
+}  // namespace hila::bench
