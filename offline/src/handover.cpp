@@ -395,7 +395,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // Receiving-arm IK for grasp g with the board at `board`: the first collision-free solution
   // (nearest to home first) of the receiving arm's bodies against everything else as posed.
   core::UrIkSolutions ik;
-  auto receive = [&](const core::Pose& board, int g, const std::vector<int>& bodies,
+  // `way_in`: the gripper must also have a way in (the robot-robot exchange); at the human's
+  // pose the online planner finds its way out or falls back to the next goal.
+  auto receive = [&](const core::Pose& board, int g, const std::vector<int>& bodies, bool way_in,
                      Receiving& out) {
     const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
     const double slip = slip_at(board, g);
@@ -415,8 +417,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     };
     for (int s = 0; s < n; ++s) {
       const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(s)];
-      if (clear(q) && core::find_pre_grasp(cell, receiving_arm, q, settings.exchange_approach,
-                                           settings.exchange_resolution, within)) {
+      if (clear(q) &&
+          (!way_in || core::find_pre_grasp(cell, receiving_arm, q, settings.exchange_approach,
+                                           settings.exchange_resolution, within))) {
         out.grasp = g;
         out.joints = q;
         out.slip_deg = slip;
@@ -520,8 +523,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       ++examined;
       std::vector<Receiving> received;
       for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+        // A grasp with its rr_per_grasp poses already is not looked at again (only those are
+        // stored): the way-in check makes each look costly.
+        if (static_cast<int>(rr_of_grasp[static_cast<std::size_t>(g)].size()) >=
+            settings.rr_per_grasp) {
+          continue;
+        }
         Receiving r;
-        if (receive(board, g, receiving_bodies, r)) received.push_back(r);
+        if (receive(board, g, receiving_bodies, true, r)) received.push_back(r);
       }
       restore_receiving();
       if (!received.empty()) {
@@ -599,7 +608,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         const auto& poses = rr_of_grasp[static_cast<std::size_t>(g)];
         if (poses.empty()) continue;
         Receiving at_rh;
-        if (!receive(c.board, g, rh_bodies, at_rh)) continue;
+        if (!receive(c.board, g, rh_bodies, false, at_rh)) continue;
         ++shared;
         // One record per rr pose: the regrasp graph takes the next when a pose's suction
         // transfer is cut in the roadmap.
