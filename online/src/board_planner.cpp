@@ -199,6 +199,9 @@ class Run {
     if (!p) {
       core::LazyPrmSettings s;
       s.resolution = 0.01;
+      // Over the whole joint range: the scene's IK solutions may lie anywhere within the limits,
+      // and a persistent roadmap cannot widen its box per query as a bridge does.
+      s.joint_range = 2.0 * M_PI;
       p = std::make_unique<core::LazyPrmPlanner>(arm, s);
     }
     return p.get();

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 
+#include "hila/core/stage_scene.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/online/board_planner.hpp"
 #include "util/test_util.hpp"
@@ -28,14 +30,77 @@ std::chrono::steady_clock::time_point in_seconds(double s) {
   return std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(s * 1e6));
 }
 
+// Everything a solved plan must be: every step validated by the independent validator, each
+// arm continuous from step to step, times increasing, the handover's events in order, both arms
+// home at the end.
+void expect_plan_well_formed(const online::PlannerModel& model, const online::Scene& scene,
+                             const online::BoardPlan& plan) {
+  EXPECT_TRUE(plan.validated);
+  ASSERT_FALSE(plan.attempts.empty());
+  EXPECT_EQ(plan.attempts.back().outcome, "planned");
+  EXPECT_LE(plan.theta_c_deg, 90.0);
+  std::map<std::string, Eigen::VectorXd> at;  // each arm's joints as the plan goes
+  for (const auto& [arm, q] : scene.robot) at[arm] = q;
+  double clock = 0.0;
+  std::string events;
+  for (const auto& step : plan.steps) {
+    ASSERT_FALSE(step.q.empty()) << step.name;
+    EXPECT_TRUE(step.q.front().isApprox(at.at(step.arm), 1e-9)) << step.name << " starts elsewhere";
+    EXPECT_GE(step.time.front(), clock - 1e-12) << step.name;
+    clock = step.time.back();
+    at[step.arm] = step.q.back();
+    if (!step.event.empty()) events += step.event + " ";
+    EXPECT_TRUE(step.validation.valid()) << step.name;
+  }
+  const std::vector<std::string> order{"suction_on", "gripper_close", "suction_off",
+                                       "wait_for_human", "gripper_open"};
+  std::size_t from = 0;
+  for (const auto& e : order) {
+    const auto found = events.find(e, from);
+    EXPECT_NE(found, std::string::npos) << e << " missing or out of order in: " << events;
+    if (found != std::string::npos) from = found;
+  }
+  for (const auto& arm : model.cell().arms()) {
+    EXPECT_LT((at.at(arm.spec.name) - arm.spec.home).norm(), 1e-9) << arm.spec.name;
+  }
+}
+
+void print_plan(const online::BoardPlan& plan) {
+  std::string attempts;
+  for (const auto& a : plan.attempts)
+    attempts += "\n  rank " + std::to_string(a.rank) + ": " + a.outcome;
+  std::printf("%s: %s %s in %.1f ms, %zu steps, %zu attempts%s\n", plan.board.c_str(),
+              online::to_string(plan.status), plan.reason.c_str(), 1e3 * plan.planning_seconds,
+              plan.steps.size(), plan.attempts.size(), attempts.c_str());
+}
+
+online::Scene after(const online::PlannerModel& model, const online::Scene& scene,
+                    const std::string& board) {
+  online::Scene next = scene.with_finished(model.product(), board);
+  next.tool_in_hand = true;
+  for (const auto& arm : model.cell().arms()) next.robot[arm.spec.name] = arm.spec.home;
+  return next;
+}
+
+online::SceneObstacle box_at(const std::string& name, const Eigen::Vector3d& centre, double side) {
+  online::SceneObstacle box;
+  box.name = name;
+  box.pose.translation() = centre;
+  box.box_size = Eigen::Vector3d::Constant(side);
+  return box;
+}
+
 }  // namespace
 
-// Issue 6 asks for all seven boards; at this stage the first four (base with the tool pick,
-// lateral_right, back_lower, shelf_middle) plan and lateral_left does not yet (docs/online.md).
-// Each solved plan is checked here: every step's report from the independent validator,
-// continuity from step to step per arm, increasing times, the handover events in order, both
-// arms home at the end.
-TEST(BoardPlanner, TheFirstCabinetBoardsPlanEndToEndAndEveryStepValidates) {
+// The cabinet in assembly order, each scene following from the last and a board that cannot be
+// planned assembled by hand (as hila plan --all). On this smaller roadmap the first four boards
+// (base with the tool pick, lateral_right, back_lower, shelf_middle) must plan; lateral_left
+// has no connected chain offline (docs/online.md). Every board not planned says why.
+// Then, on lateral_right's scene, the repairs the issue asks for:
+//  - a crate put on the stored path (at the gripper in the middle of the transfer to the human,
+//    so the old motion certainly hits it) is planned around: a different, validated plan;
+//  - a crate at the first goal's robot-human pose makes the planner fall back to a later goal.
+TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) {
   const std::string dir = test::temp_dir("board_planner");
   const auto model =
       online::PlannerModel::load(database(dir), test::cell_path(), test::product_path());
@@ -43,54 +108,67 @@ TEST(BoardPlanner, TheFirstCabinetBoardsPlanEndToEndAndEveryStepValidates) {
   online::Scene scene =
       online::load_scene(test::data_path("cabinet/scene.yaml"), model->cell(), model->product());
   std::vector<std::string> solved;
+  std::map<std::string, online::Scene> scene_of;
+  std::map<std::string, online::BoardPlan> plan_of;
   for (const auto& part : model->product().parts) {
     SCOPED_TRACE(part.name);
-    const online::World world(model->cell(), model->product(), scene, part.name);
     const auto plan = planner.plan(scene, part.name, in_seconds(120.0));  // a bound, not a goal
-    std::string attempts;
-    for (const auto& a : plan.attempts)
-      attempts += "\n  rank " + std::to_string(a.rank) + ": " + a.outcome;
-    std::printf("%s: %s %s in %.1f ms, %zu steps, %zu attempts%s\n", part.name.c_str(),
-                online::to_string(plan.status), plan.reason.c_str(), 1e3 * plan.planning_seconds,
-                plan.steps.size(), plan.attempts.size(), attempts.c_str());
-    if (!plan.solved()) break;
-    solved.push_back(part.name);
-    EXPECT_TRUE(plan.validated);
-    EXPECT_FALSE(plan.attempts.empty());
-    EXPECT_EQ(plan.attempts.back().outcome, "planned");
-    EXPECT_LE(plan.theta_c_deg, 90.0);
-    std::map<std::string, Eigen::VectorXd> at;  // each arm's joints as the plan goes
-    for (const auto& [arm, q] : scene.robot) at[arm] = q;
-    double clock = 0.0;
-    std::string events;
-    for (const auto& step : plan.steps) {
-      ASSERT_FALSE(step.q.empty()) << step.name;
-      EXPECT_TRUE(step.q.front().isApprox(at.at(step.arm), 1e-9))
-          << step.name << " starts elsewhere";
-      EXPECT_GE(step.time.front(), clock - 1e-12) << step.name;
-      clock = step.time.back();
-      at[step.arm] = step.q.back();
-      if (!step.event.empty()) events += step.event + " ";
-      EXPECT_TRUE(step.validation.valid()) << step.name;
+    print_plan(plan);
+    scene_of[part.name] = scene;
+    plan_of[part.name] = plan;
+    if (plan.solved()) {
+      solved.push_back(part.name);
+      expect_plan_well_formed(*model, scene, plan);
+    } else {
+      EXPECT_FALSE(plan.reason.empty());
+      EXPECT_FALSE(plan.attempts.empty());
+      for (const auto& a : plan.attempts) EXPECT_NE(a.outcome, "planned");
+      EXPECT_TRUE(plan.steps.empty()) << "nothing of a failed plan is emitted";
     }
-    // The handover's events in their order.
-    const std::vector<std::string> order{"suction_on", "gripper_close", "suction_off",
-                                         "wait_for_human", "gripper_open"};
-    std::size_t from = 0;
-    for (const auto& e : order) {
-      const auto found = events.find(e, from);
-      EXPECT_NE(found, std::string::npos) << e << " missing or out of order in: " << events;
-      if (found != std::string::npos) from = found;
-    }
-    // Both arms end at home.
-    for (const auto& arm : model->cell().arms()) {
-      EXPECT_LT((at.at(arm.spec.name) - arm.spec.home).norm(), 1e-9) << arm.spec.name;
-    }
-    scene = scene.with_finished(model->product(), part.name);
-    scene.tool_in_hand = true;
-    for (const auto& arm : model->cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
+    scene = after(*model, scene, part.name);
   }
   ASSERT_GE(solved.size(), 4u);
   EXPECT_EQ(solved[0], "base");
+  EXPECT_EQ(solved[1], "lateral_right");
+  EXPECT_EQ(solved[2], "back_lower");
   EXPECT_EQ(solved[3], "shelf_middle");
+
+  // A crate on the path.
+  const std::string board = "lateral_right";
+  const online::BoardPlan& nominal = plan_of.at(board);
+  const auto transfer = std::find_if(nominal.steps.begin(), nominal.steps.end(),
+                                     [](const auto& s) { return s.name == "transfer_to_human"; });
+  ASSERT_NE(transfer, nominal.steps.end());
+  const core::Arm& arm = model->cell().arm(transfer->arm);
+  const Eigen::VectorXd& middle = transfer->q[transfer->q.size() / 2];
+  const Eigen::Vector3d gripper =
+      (core::arm_base_in_world(model->cell(), arm) * arm.chain.fk(middle)).translation();
+  online::Scene crated = scene_of.at(board);
+  crated.obstacles.push_back(box_at("crate", gripper, 0.08));
+  const auto repaired = planner.plan(crated, board, in_seconds(120.0));
+  print_plan(repaired);
+  ASSERT_TRUE(repaired.solved()) << repaired.reason;
+  expect_plan_well_formed(*model, crated, repaired);
+  bool differs = repaired.candidate_id != nominal.candidate_id ||
+                 repaired.steps.size() != nominal.steps.size();
+  for (std::size_t i = 0; !differs && i < repaired.steps.size(); ++i) {
+    differs = repaired.steps[i].q.size() != nominal.steps[i].q.size() ||
+              !repaired.steps[i].q.back().isApprox(nominal.steps[i].q.back()) ||
+              !repaired.steps[i].q[repaired.steps[i].q.size() / 2].isApprox(
+                  nominal.steps[i].q[nominal.steps[i].q.size() / 2]);
+  }
+  EXPECT_TRUE(differs) << "the crate stands where the nominal plan's gripper passes";
+
+  // A crate where the first goal hands the board over.
+  online::Scene blocked = scene_of.at(board);
+  blocked.obstacles.push_back(box_at("crate", nominal.human_handover.translation(), 0.06));
+  const auto fallback = planner.plan(blocked, board, in_seconds(120.0));
+  print_plan(fallback);
+  ASSERT_TRUE(fallback.solved()) << fallback.reason;
+  expect_plan_well_formed(*model, blocked, fallback);
+  EXPECT_GT(fallback.goal_rank, nominal.goal_rank);
+  EXPECT_NE(fallback.candidate_id, nominal.candidate_id);
+  EXPECT_GE(fallback.attempts.size(), 2u);
+  EXPECT_EQ(fallback.attempts.front().rank, nominal.goal_rank);
+  EXPECT_NE(fallback.attempts.front().outcome, "planned");
 }

@@ -79,7 +79,7 @@ const char* to_string(MotionPlannerKind kind);
 
 struct MotionSettings {
   MotionPlannerKind planner = MotionPlannerKind::kRoadmap;
-  int attach_neighbours = 12;  // roadmap nodes tried per end
+  int attach_neighbours = 40;  // roadmap nodes tried per end
   int attachments = 6;         // valid attachments kept per end
   int max_searches = 200;
   // Segment checks while holding a board: as fine as the validator's (rad), since a long board
