@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -216,6 +218,42 @@ TEST(Cli, SameSeedSameDigestWhateverTheJobs) {
   const CommandRun digest1 = run("inspect " + dir + "/a.hila digest");
   ASSERT_EQ(digest1.status, 0);
   EXPECT_EQ(run("inspect " + dir + "/b.hila digest").out, digest1.out);
+}
+
+// tools/demo's --if-outdated: a database from this hila, the same files, settings and seed is
+// kept untouched; another seed or a file that is not a database is rebuilt, with the reason.
+TEST(Cli, BuildIfOutdatedKeepsACurrentDatabaseAndRebuildsAStaleOne) {
+  const std::string dir = test::temp_dir("cli_if_outdated");
+  const std::string db = dir + "/c.hila";
+  const std::string options = " --cell " + test::cell_path() +
+                              " --comfort-samples 20000 --handover-candidates 60"
+                              " --roadmap-nodes 300 --jobs 2 -o " +
+                              db + " --if-outdated";
+  const CommandRun first = run("build " + test::product_path() + options + " --seed 3");
+  ASSERT_LE(first.status, 1) << first.out;
+  EXPECT_NE(first.out.find("it does not exist"), std::string::npos) << first.out;
+  const std::string digest = run("inspect " + db + " digest").out;
+  const auto written = std::filesystem::last_write_time(db);
+
+  const CommandRun kept = run("build " + test::product_path() + options + " --seed 3");
+  EXPECT_EQ(kept.status, 0) << kept.out;
+  EXPECT_NE(kept.out.find("is up to date"), std::string::npos) << kept.out;
+  EXPECT_EQ(std::filesystem::last_write_time(db), written);
+  EXPECT_EQ(run("inspect " + db + " digest").out, digest);
+
+  const CommandRun reseeded = run("build " + test::product_path() + options + " --seed 4");
+  EXPECT_LE(reseeded.status, 1) << reseeded.out;
+  EXPECT_NE(reseeded.out.find("the seed differs"), std::string::npos) << reseeded.out;
+  EXPECT_NE(run("inspect " + db + " digest").out, digest);
+
+  {
+    std::ofstream garbage(db, std::ios::trunc);
+    garbage << "not a database";
+  }
+  const CommandRun repaired = run("build " + test::product_path() + options + " --seed 3");
+  EXPECT_LE(repaired.status, 1) << repaired.out;
+  EXPECT_NE(repaired.out.find("cannot be used"), std::string::npos) << repaired.out;
+  EXPECT_EQ(run("inspect " + db + " digest").out, digest);  // same inputs, same content
 }
 
 TEST(Cli, BuildAndInspectBadInputs) {

@@ -1,10 +1,14 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
 #include "commands.hpp"
+#include "hila/core/product.hpp"
+#include "hila/db/database.hpp"
+#include "hila/db/provenance.hpp"
 #include "hila/offline/build.hpp"
 
 namespace hila::tools {
@@ -21,7 +25,33 @@ struct BuildOptions {
   double comfort_threshold = offline::HandoverSettings{}.comfort_threshold;
   std::string bodies;
   int roadmap_nodes = offline::RoadmapSettings{}.nodes;
+  bool if_outdated = false;
 };
+
+// Why the database at `path` is not what this build would write ("" when it is): missing,
+// unreadable, another schema or hila version, other cell or product files, other settings or
+// seed.
+std::string why_outdated(const std::string& path, const std::string& cell_file,
+                         const std::string& product_file, const offline::BuildSettings& settings) {
+  if (!std::filesystem::exists(path)) return "it does not exist";
+  try {
+    const db::Meta meta = db::Database::open(path).meta();
+    if (meta.hila_version != HILA_VERSION) {
+      return "it was built by hila " + meta.hila_version + ", this is " + HILA_VERSION;
+    }
+    if (meta.cell_hash != db::cell_hash(core::Cell::load(cell_file)->spec())) {
+      return "the cell (" + cell_file + " or its URDFs) changed";
+    }
+    if (meta.product_hash != db::product_hash(core::load_product(product_file))) {
+      return "the product (" + product_file + " or its meshes) changed";
+    }
+    if (meta.settings_hash != offline::settings_hash(settings)) return "the build settings differ";
+    if (meta.seed != settings.seed) return "the seed differs";
+  } catch (const std::exception& e) {
+    return std::string("it cannot be used: ") + e.what();
+  }
+  return "";
+}
 
 int run_build(const BuildOptions& opt) {
   offline::BuildSettings settings;
@@ -33,6 +63,15 @@ int run_build(const BuildOptions& opt) {
   settings.roadmap.nodes = opt.roadmap_nodes;
   if (!opt.bodies.empty())
     settings.human_bodies = offline::parse_human_bodies(opt.bodies, "--bodies");
+  if (opt.if_outdated) {
+    const std::string why = why_outdated(opt.output, opt.cell_file, opt.product_file, settings);
+    if (why.empty()) {
+      std::cout << opt.output
+                << " is up to date (same hila version, cell, product, settings and seed): kept\n";
+      return 0;
+    }
+    std::cout << "building " << opt.output << ": " << why << "\n";
+  }
   // Progress only for a person watching a terminal; logs and pipes stay clean.
   const bool terminal = isatty(fileno(stderr)) != 0;
   offline::BuildProgress progress;
@@ -159,6 +198,9 @@ void add_build_command(CLI::App& app, Action& action) {
                    "PRM milestones per robot arm roadmap (fewer: a faster, sparser build)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  build->add_flag("--if-outdated", opt->if_outdated,
+                  "keep the output when it was built by this hila from the same cell, product, "
+                  "settings and seed; build it otherwise");
   build->add_option("--jobs", opt->jobs, "worker threads over parts")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
