@@ -79,11 +79,27 @@ bool touches_movers(const online::Scene& scene, const core::Cell& cell,
   online::SceneObstacle grown = box;
   grown.box_size += Eigen::Vector3d::Constant(2.0 * margin);
   probe.obstacles.push_back(grown);
+  // The tool's cup stands on the table, a contact by design: 3 mm up it touches nothing, and
+  // the box's margin dwarfs that.
+  probe.tool.translation().z() += 0.003;
   const online::World world(cell, product, probe, board);
   core::CollisionData data = world.make_data();
-  // The box is static: this query pairs it with every moving body (static pairs are never
-  // checked, which is why the finished boards and the stack are kept clear by footprint).
-  return core::in_collision(world.stage().cell.model, data, {world.obstacles().back()});
+  const core::CollisionModel& model = world.stage().cell.model;
+  // The query starts from the moving bodies: given a static body (the box) alone, it would pair
+  // it with the static scene only, where every pair is skipped.
+  std::vector<int> moving;
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    if (model.is_enabled(b) && !model.is_static(b)) moving.push_back(b);
+  }
+  core::CollisionPair pair;
+  if (!core::in_collision(model, data, moving, &pair)) return false;
+  const int box_body = world.obstacles().back();
+  if (pair.body_a != box_body && pair.body_b != box_body) {
+    throw std::runtime_error(
+        "vary_scene: the scene for '" + board +
+        "' is in collision before any box is added: " + core::describe_pair(model, pair));
+  }
+  return true;
 }
 
 }  // namespace
