@@ -69,8 +69,11 @@ std::vector<Eigen::VectorXd> LazyPrmPlanner::plan(
   m.planner->setProblemDefinition(pdef);
   m.valid = &valid;
   m.checks = 0;
+  // The cap bounds this query's growth: the roadmap persists, so a cap on its total size would
+  // stop every query once it is reached.
+  const unsigned long cap = m.planner->milestoneCount() + m.max_vertices;
   const ob::PlannerStatus status = m.planner->solve(ob::PlannerTerminationCondition([&] {
-    return m.checks >= max_checks || m.planner->milestoneCount() >= m.max_vertices ||
+    return m.checks >= max_checks || m.planner->milestoneCount() >= cap ||
            std::chrono::steady_clock::now() >= deadline;
   }));
   m.valid = nullptr;

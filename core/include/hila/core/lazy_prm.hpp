@@ -19,7 +19,7 @@ struct LazyPrmSettings {
   double joint_range = 3.14159265358979323846;  // each joint within this much of home
   std::uint64_t seed = 1;
   // The roadmap grows without validity checks (lazily), so a check budget alone does not bound
-  // a query: it also stops when the roadmap has this many vertices.
+  // a query: it also stops when the roadmap has grown by this many vertices.
   unsigned long max_vertices = 20000;
 };
 
