@@ -561,7 +561,7 @@ class Run {
     for (std::size_t b = 0; b < branches.size() && lifted.ok(); ++b) {
       Stage attempt;
       attempt.end = lifted.end;
-      if (preposition(attempt, rr, grasp, branches[b]).empty()) {
+      if (preposition(attempt, rr, branches[b]).empty()) {
         st = std::move(attempt);
         st.supersedes_previous = true;
         cell_.set_jaw(st.end.robot_q, receiving_, jaw_for(grasp));
@@ -575,8 +575,7 @@ class Run {
   // From the lift: the receiving arm to its pre-grasp (the board on the suction cup above its
   // pick pose), the suction arm to the robot-robot pose past it, the grasp.
   std::string preposition(Stage& st, const db::RobotHandoverRecord& rr,
-                          const db::RobotGraspRecord& grasp, const Eigen::VectorXd& grasp_q) {
-    const core::Pose grasp_tcp = rr.board * grasp.tcp;
+                          const Eigen::VectorXd& grasp_q) {
     MotionRequest at_exchange;
     at_exchange.board_world = rr.board;
     const std::optional<Eigen::VectorXd> pre_q = pre_grasp(st, at_exchange, grasp_q);
@@ -857,12 +856,15 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (goals.size() > static_cast<std::size_t>(std::max(0, settings_.goals))) {
     goals.resize(static_cast<std::size_t>(std::max(0, settings_.goals)));
   }
+  bool any_connected_offline = false;
   for (const auto& goal : goals) {
     // The shared grasps the offline regrasp graph connected for this goal first: their stored
     // paths and IK branches are what the motions re-validate.
     std::vector<db::SharedGraspRecord> shared = db.shared_grasps(goal.id);
-    std::stable_partition(shared.begin(), shared.end(),
-                          [&](const auto& s) { return run.connected_offline(goal, s); });
+    const auto connected = std::stable_partition(shared.begin(), shared.end(), [&](const auto& s) {
+      return run.connected_offline(goal, s);
+    });
+    any_connected_offline = any_connected_offline || connected != shared.begin();
     for (const auto& s : shared) {
       if (std::chrono::steady_clock::now() >= deadline) {
         return finish(BoardPlanStatus::kTimeout, "the deadline passed after " +
@@ -898,9 +900,13 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     }
   }
   return finish(BoardPlanStatus::kNoGoal,
-                goals.empty() ? "the database has no handover goal for '" + board + "'"
-                              : "none of the first " + std::to_string(goals.size()) +
-                                    " goals could be planned in this scene (see attempts)");
+                goals.empty()
+                    ? "the database has no handover goal for '" + board + "'"
+                    : "none of the first " + std::to_string(goals.size()) +
+                          " goals could be planned in this scene (see attempts)" +
+                          (any_connected_offline ? ""
+                                                 : "; the database connects none of their chains "
+                                                   "(hila inspect DB roadmap)"));
 }
 
 }  // namespace hila::online
