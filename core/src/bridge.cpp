@@ -12,6 +12,7 @@
 #include <cmath>
 #include <memory>
 
+#include "hila/core/ompl_state.hpp"
 #include "ompl_joint_space.hpp"
 
 namespace ob = ompl::base;
@@ -48,7 +49,7 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
   long checks = 0;
   si->setStateValidityChecker([&](const ob::State* s) {
     ++checks;
-    return valid(detail::to_vector(s, dof));
+    return valid(to_vector(s, dof));
   });
   si->setStateValidityCheckingResolution(settings.resolution / space->getMaximumExtent());
   si->setup();
@@ -71,7 +72,7 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
   const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
   std::vector<Eigen::VectorXd> raw;
   for (std::size_t i = 0; i < path->getStateCount(); ++i) {
-    raw.push_back(detail::to_vector(path->getState(i), dof));
+    raw.push_back(to_vector(path->getState(i), dof));
   }
   // Greedy shortcuts: from each kept waypoint, the farthest later one a straight segment reaches.
   std::vector<Eigen::VectorXd> out{raw.front()};

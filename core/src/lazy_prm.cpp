@@ -9,6 +9,7 @@
 #include <ompl/util/Console.h>
 
 #include "hila/core/bridge.hpp"
+#include "hila/core/ompl_state.hpp"
 #include "ompl_joint_space.hpp"
 
 namespace ob = ompl::base;
@@ -40,7 +41,7 @@ LazyPrmPlanner::LazyPrmPlanner(const Arm& arm, const LazyPrmSettings& settings)
   Impl* self = impl_.get();
   m.si->setStateValidityChecker([self](const ob::State* s) {
     ++self->checks;
-    return self->valid != nullptr && (*self->valid)(detail::to_vector(s, self->dof));
+    return self->valid != nullptr && (*self->valid)(to_vector(s, self->dof));
   });
   m.si->setStateValidityCheckingResolution(settings.resolution / m.space->getMaximumExtent());
   m.si->setup();
@@ -59,8 +60,8 @@ std::vector<Eigen::VectorXd> LazyPrmPlanner::plan(
   if (!valid(from) || !valid(to)) return {};
   if (segment_valid(valid, from, to, m.resolution)) return {from, to};
   ob::ScopedState<> start(m.space), goal(m.space);
-  detail::from_vector(from, start.get());
-  detail::from_vector(to, goal.get());
+  from_vector(from, start.get());
+  from_vector(to, goal.get());
   if (!m.si->satisfiesBounds(start.get()) || !m.si->satisfiesBounds(goal.get())) return {};
   m.planner->clearQuery();
   m.planner->clearValidity();  // last query's scene is not this one's
@@ -81,7 +82,7 @@ std::vector<Eigen::VectorXd> LazyPrmPlanner::plan(
   const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
   std::vector<Eigen::VectorXd> out;
   for (std::size_t i = 0; i < path->getStateCount(); ++i) {
-    out.push_back(detail::to_vector(path->getState(i), m.dof));
+    out.push_back(to_vector(path->getState(i), m.dof));
   }
   // Re-checked at exactly the documented resolution (OMPL's fraction of the extent rounds).
   for (std::size_t i = 1; i < out.size(); ++i) {

@@ -56,16 +56,4 @@ std::shared_ptr<ob::RealVectorStateSpace> joint_space(const Arm& arm, double joi
   return space;
 }
 
-Eigen::VectorXd to_vector(const ob::State* s, int dof) {
-  const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
-  Eigen::VectorXd q(dof);
-  for (int i = 0; i < dof; ++i) q[i] = v->values[i];
-  return q;
-}
-
-void from_vector(const Eigen::VectorXd& q, ob::State* s) {
-  auto* v = s->as<ob::RealVectorStateSpace::StateType>();
-  for (int i = 0; i < q.size(); ++i) v->values[i] = q[i];
-}
-
 }  // namespace hila::core::detail

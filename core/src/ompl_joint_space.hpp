@@ -38,7 +38,4 @@ std::shared_ptr<ompl::base::RealVectorStateSpace> joint_space(const Arm& arm, do
                                                               const Eigen::VectorXd* include_a,
                                                               const Eigen::VectorXd* include_b);
 
-Eigen::VectorXd to_vector(const ompl::base::State* s, int dof);
-void from_vector(const Eigen::VectorXd& q, ompl::base::State* s);
-
 }  // namespace hila::core::detail

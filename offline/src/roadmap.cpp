@@ -19,6 +19,7 @@
 
 #include "hila/core/collision.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/ompl_state.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
@@ -31,17 +32,8 @@ namespace hila::offline {
 
 namespace {
 
-Eigen::VectorXd to_vector(const ob::State* s, int dof) {
-  const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
-  Eigen::VectorXd q(dof);
-  for (int i = 0; i < dof; ++i) q[i] = v->values[i];
-  return q;
-}
-
-void from_vector(const Eigen::VectorXd& q, ob::State* s) {
-  auto* v = s->as<ob::RealVectorStateSpace::StateType>();
-  for (Eigen::Index i = 0; i < q.size(); ++i) v->values[i] = q[i];
-}
+using core::from_vector;
+using core::to_vector;
 
 // Uniform joint-space samples mixed with IK samples of gripper poses whose opening axis is
 // near vertical (the slip-constrained region, thin in joint space).

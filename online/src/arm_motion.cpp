@@ -61,7 +61,10 @@ ArmMotionPlanner::ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap
       settings_(settings),
       lazy_prm_(lazy_prm),
       data_(world.make_data()),
-      base_(core::arm_base_in_world(world.cell(), arm_)) {}
+      base_(core::arm_base_in_world(world.cell(), arm_)) {
+  // The LazyPRM baseline keeps its roadmap outside the planner: without one it cannot run.
+  assert(settings_.planner != MotionPlannerKind::kLazyPrm || lazy_prm_ != nullptr);
+}
 
 void ArmMotionPlanner::prepare(const MotionRequest& request) {
   const core::Cell& cell = world_.cell();
@@ -291,7 +294,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
       scratch.seed = settings_.seed;
       scratch.deadline = request.deadline;
       r.path = core::plan_bridge(arm_, valid_here, request.start, request.goal, scratch);
-    } else if (lazy_prm_ != nullptr) {
+    } else {
       r.path = lazy_prm_->plan(valid_here, request.start, request.goal, settings_.baseline_checks,
                                request.deadline);
     }

@@ -34,22 +34,24 @@ struct BuildOptions {
 std::string why_outdated(const std::string& path, const std::string& cell_file,
                          const std::string& product_file, const offline::BuildSettings& settings) {
   if (!std::filesystem::exists(path)) return "it does not exist";
+  // Unreadable inputs are the build's own error (exit 2), not a reason to rebuild.
+  const std::string cell_hash = db::cell_hash(core::Cell::load(cell_file)->spec());
+  const std::string product_hash = db::product_hash(core::load_product(product_file));
+  db::Meta meta;
   try {
-    const db::Meta meta = db::Database::open(path).meta();
-    if (meta.hila_version != HILA_VERSION) {
-      return "it was built by hila " + meta.hila_version + ", this is " + HILA_VERSION;
-    }
-    if (meta.cell_hash != db::cell_hash(core::Cell::load(cell_file)->spec())) {
-      return "the cell (" + cell_file + " or its URDFs) changed";
-    }
-    if (meta.product_hash != db::product_hash(core::load_product(product_file))) {
-      return "the product (" + product_file + " or its meshes) changed";
-    }
-    if (meta.settings_hash != offline::settings_hash(settings)) return "the build settings differ";
-    if (meta.seed != settings.seed) return "the seed differs";
+    meta = db::Database::open(path).meta();
   } catch (const std::exception& e) {
     return std::string("it cannot be used: ") + e.what();
   }
+  if (meta.hila_version != HILA_VERSION) {
+    return "it was built by hila " + meta.hila_version + ", this is " + HILA_VERSION;
+  }
+  if (meta.cell_hash != cell_hash) return "the cell (" + cell_file + " or its URDFs) changed";
+  if (meta.product_hash != product_hash) {
+    return "the product (" + product_file + " or its meshes) changed";
+  }
+  if (meta.settings_hash != offline::settings_hash(settings)) return "the build settings differ";
+  if (meta.seed != settings.seed) return "the seed differs";
   return "";
 }
 
