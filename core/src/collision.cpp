@@ -30,6 +30,24 @@ struct BodyModel {
 struct CollisionModelImpl {
   std::vector<BodyModel> bodies;
   std::vector<std::vector<bool>> allowed;
+  // Derived, kept current by every mutation: the enabled moving bodies, and the pairs a query
+  // tests (both enabled, not both static, not allowed) as a flat byte matrix, so that the
+  // planner's hot loop reads bytes instead of vector<bool> bits and skips static bodies.
+  std::vector<int> moving_bodies;
+  std::vector<unsigned char> testable;
+
+  void refresh_pairs() {
+    const std::size_t n = bodies.size();
+    moving_bodies.clear();
+    testable.assign(n * n, 0);
+    for (std::size_t a = 0; a < n; ++a) {
+      if (bodies[a].enabled && !bodies[a].is_static) moving_bodies.push_back(static_cast<int>(a));
+      for (std::size_t b = 0; b < n; ++b) {
+        testable[a * n + b] = a != b && bodies[a].enabled && bodies[b].enabled &&
+                              !(bodies[a].is_static && bodies[b].is_static) && !allowed[a][b];
+      }
+    }
+  }
 };
 
 namespace {
@@ -122,6 +140,7 @@ int CollisionModel::add_body(const std::string& name, const std::vector<Geometry
   impl_->bodies.push_back(std::move(body));
   for (auto& row : impl_->allowed) row.push_back(false);
   impl_->allowed.emplace_back(impl_->bodies.size(), false);
+  impl_->refresh_pairs();
   return num_bodies() - 1;
 }
 
@@ -136,6 +155,9 @@ int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& m
 void CollisionModel::allow(int a, int b) {
   impl_->allowed[a][b] = true;
   impl_->allowed[b][a] = true;
+  const std::size_t n = impl_->bodies.size();
+  impl_->testable[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)] = 0;
+  impl_->testable[static_cast<std::size_t>(b) * n + static_cast<std::size_t>(a)] = 0;
 }
 
 void CollisionModel::allow(const std::string& a, const std::string& b) {
@@ -148,6 +170,7 @@ void CollisionModel::allow(const std::string& a, const std::string& b) {
 
 void CollisionModel::set_enabled(int body, bool enabled) {
   impl_->bodies[body].enabled = enabled;
+  impl_->refresh_pairs();
 }
 int CollisionModel::num_bodies() const {
   return static_cast<int>(impl_->bodies.size());
@@ -193,6 +216,7 @@ struct CollisionDataImpl {
   std::vector<fcl::CollisionObjectd*> changed_moving;
   std::vector<fcl::CollisionObjectd*> changed_static;
   std::vector<char> active_scratch;
+  std::vector<fcl::AABBd> body_boxes;  // each body's shapes' boxes, merged (world)
   bool moving_full_refit = false;
   bool static_full_refit = false;
 };
@@ -220,6 +244,16 @@ CollisionData::CollisionData(const CollisionModel& model)
         (bodies[b].is_static ? static_objects : moving_objects).push_back(object.get());
       }
       impl_->objects.push_back(std::move(object));
+    }
+  }
+  impl_->body_boxes.resize(bodies.size());
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    for (const int o : impl_->body_objects[b]) {
+      if (o == impl_->body_objects[b].front()) {
+        impl_->body_boxes[b] = impl_->objects[o]->getAABB();
+      } else {
+        impl_->body_boxes[b] += impl_->objects[o]->getAABB();
+      }
     }
   }
   impl_->static_manager.registerObjects(static_objects);
@@ -252,6 +286,11 @@ void CollisionData::set_body_pose(int body, const Pose& pose) {
     object.setTransform(pose * offsets[s]);
     object.computeAABB();
     changed.push_back(&object);
+    if (s == 0) {
+      d.body_boxes[body] = object.getAABB();
+    } else {
+      d.body_boxes[body] += object.getAABB();
+    }
   }
 }
 
@@ -363,14 +402,30 @@ bool in_collision(const CollisionModel& model, CollisionData& data, const std::v
   }
   // Against the other moving bodies (and among the active ones, each pair once): AABB test, then
   // the narrow phase.
+  const std::size_t n = m.bodies.size();
   std::vector<char>& active = d.active_scratch;
-  active.assign(m.bodies.size(), 0);
-  for (const int b : bodies) active[b] = 1;
+  active.assign(n, 0);
+  fcl::AABBd reach;  // of the active bodies: most other bodies fail one test against it
+  bool any = false;
   for (const int b : bodies) {
-    if (!m.bodies[b].enabled || m.bodies[b].is_static) continue;
-    for (std::size_t other = 0; other < m.bodies.size(); ++other) {
-      const int ob = static_cast<int>(other);
-      if (m.bodies[ob].is_static || (active[ob] && ob <= b) || skip_pair(m, b, ob)) continue;
+    active[b] = 1;
+    if (d.body_objects[b].empty()) continue;
+    if (any) {
+      reach += d.body_boxes[b];
+    } else {
+      reach = d.body_boxes[b];
+      any = true;
+    }
+  }
+  if (!any) return false;
+  for (const int b : bodies) {
+    if (!m.bodies[b].enabled || m.bodies[b].is_static || d.body_objects[b].empty()) continue;
+    const unsigned char* testable = &m.testable[static_cast<std::size_t>(b) * n];
+    const fcl::AABBd& box_b = d.body_boxes[b];
+    for (const int ob : m.moving_bodies) {
+      if (!testable[ob] || (active[ob] && ob <= b) || d.body_objects[ob].empty()) continue;
+      if (!active[ob] && !d.body_boxes[ob].overlap(reach)) continue;
+      if (!d.body_boxes[ob].overlap(box_b)) continue;
       for (const int o1 : d.body_objects[b]) {
         const auto& box1 = d.objects[o1]->getAABB();
         for (const int o2 : d.body_objects[ob]) {

@@ -253,12 +253,16 @@ TEST(Collision, AllowedStaticAndDisabledPairsAreSkipped) {
   core::CollisionData data(model);
   EXPECT_TRUE(core::in_collision(model, data));  // c overlaps a and b
   model.allow("c", "a");
-  EXPECT_TRUE(core::in_collision(model, data));  // still overlaps b
+  EXPECT_TRUE(core::in_collision(model, data));                       // still overlaps b
+  EXPECT_TRUE(core::in_collision(model, data, std::vector<int>{c}));  // the subset query too
   model.allow("c", "b");
   EXPECT_FALSE(core::in_collision(model, data));
+  EXPECT_FALSE(core::in_collision(model, data, std::vector<int>{c}));
   EXPECT_FALSE(core::in_collision_brute_force(model, data));
+  // Allowed and disabled after the data was made: pairs follow the model as it is now.
   model.set_enabled(c, false);
   EXPECT_FALSE(core::in_collision(model, data));
+  EXPECT_FALSE(core::in_collision(model, data, std::vector<int>{c}));
   EXPECT_TRUE(model.allowed(a, c));
   test::expect_input_error([&] { model.allow("c", "nope"); }, {"nope"});
 }
