@@ -25,6 +25,15 @@ Pose arm_base_in_world(const Cell& cell, const Arm& arm) {
   return poses[static_cast<std::size_t>(cell.robot().link_index(arm.spec.base_link))];
 }
 
+std::vector<PlacedPart> parts_before(const ProductSpec& product, std::size_t index) {
+  std::vector<PlacedPart> out;
+  for (std::size_t i = 0; i < index && i < product.parts.size(); ++i) {
+    const PartSpec& p = product.parts[i];
+    out.push_back({p.name, &p.mesh, product.target_in_world(p)});
+  }
+  return out;
+}
+
 StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
                              const std::vector<PlacedPart>& finished,
                              const std::string& suction_arm) {

@@ -390,6 +390,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     regrasp.lift = settings.handover.pick_lift;
     regrasp.approach = settings.handover.exchange_approach;
     regrasp.approach_resolution = settings.handover.exchange_resolution;
+    regrasp.held_resolution = settings.handover.exchange_resolution;
     regrasp.seed = part_seed(settings.seed, product.parts[i].name, 7);
     r.regrasp =
         plan_regrasp(*cell, product, i, grasps, r.handover, roadmaps[0], roadmaps[1], regrasp);

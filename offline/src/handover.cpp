@@ -149,12 +149,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   const core::Pose target = product.target_in_world(part);
   HandoverResult result;
   auto& stage = result.stage;
-  std::vector<core::PlacedPart> finished;
-  for (std::size_t i = 0; i < index; ++i) {
-    const auto& p = product.parts[i];
-    stage.finished_parts.push_back(p.name);
-    finished.push_back({p.name, &p.mesh, product.target_in_world(p)});
-  }
+  const std::vector<core::PlacedPart> finished = core::parts_before(product, index);
+  for (const auto& p : finished) stage.finished_parts.push_back(p.name);
 
   // --- Scenes -----------------------------------------------------------------------------
   // Screening (Eq. 1 and the human's hands): finished parts, the table taken as solid down to

@@ -28,7 +28,15 @@ struct ArmPlanning {
   core::RoadmapGraph graph;
   ArmWorkspace workspace;
   std::vector<bool> all_edges;
+  double held_resolution = 0.01;  // rad, motions with the board in hand (the online planner's)
 };
+
+// A long held board sweeps centimetres between the roadmap's samples: motions holding it are
+// checked as finely as the online planner and validator check them.
+double check_resolution(const ArmPlanning& arm) {
+  return arm.workspace.holding() ? std::min(arm.held_resolution, arm.roadmap.resolution)
+                                 : arm.roadmap.resolution;
+}
 
 struct Connection {
   bool connected = false;
@@ -52,19 +60,51 @@ struct Endpoint {
 };
 
 Endpoint endpoint(ArmPlanning& arm, const GraspSlip& slip, const Eigen::VectorXd& q, int k) {
-  return {q, attach_configuration(arm.workspace, arm.roadmap, slip, q, k)};
+  return {q, attach_configuration(arm.workspace, arm.roadmap, slip, q, k, check_resolution(arm))};
 }
 
-// Shortest path between two attached configurations over the allowed edges.
-Connection roadmap_path(const ArmPlanning& arm, const std::vector<bool>& allowed,
-                        const Endpoint& from, const Endpoint& to,
-                        core::GraphSearchWorkspace& search) {
+// A roadmap edge valid in the workspace as it holds (the arm and the held board against the
+// board's stage): the roadmap itself was checked in the empty cell, the filters for the held
+// board only.
+bool edge_valid_here(ArmPlanning& arm, int a, int b) {
+  const auto& nodes = arm.roadmap.nodes;
+  for (const auto& q : edge_samples(nodes[static_cast<std::size_t>(a)],
+                                    nodes[static_cast<std::size_t>(b)], check_resolution(arm))) {
+    if (!arm.workspace.valid(q)) return false;
+  }
+  return true;
+}
+
+// Shortest path between two attached configurations over the allowed edges, its edges
+// validated lazily at the board's stage (a blocked edge is dropped and the search repeated).
+Connection roadmap_path(ArmPlanning& arm, std::vector<bool> allowed, const Endpoint& from,
+                        const Endpoint& to, core::GraphSearchWorkspace& search) {
+  constexpr int kMaxSearches = 100;
   Connection c;
   if (from.attached.empty() || to.attached.empty()) return c;
   std::vector<core::GraphEndpoint> in, out;
   for (const auto& a : from.attached) in.push_back({a.node, a.cost});
   for (const auto& a : to.attached) out.push_back({a.node, a.cost});
-  const core::GraphPath path = core::shortest_path(arm.graph, allowed, in, out, search);
+  core::GraphPath path;
+  for (int searches = 0; searches < kMaxSearches; ++searches) {
+    path = core::shortest_path(arm.graph, allowed, in, out, search);
+    if (!path.found) return c;
+    bool clear = true;
+    for (std::size_t i = 1; i < path.nodes.size() && clear; ++i) {
+      const int a = path.nodes[i - 1];
+      const int b = path.nodes[i];
+      for (auto it = arm.graph.neighbours_begin(a); it != arm.graph.neighbours_end(a); ++it) {
+        if (it->node != b || !allowed[static_cast<std::size_t>(it->edge)]) continue;
+        if (!edge_valid_here(arm, a, b)) {
+          allowed[static_cast<std::size_t>(it->edge)] = false;
+          clear = false;
+        }
+        break;
+      }
+    }
+    if (clear) break;
+    path.found = false;
+  }
   if (!path.found) return c;
   c.connected = true;
   c.via = "roadmap";
@@ -86,7 +126,9 @@ Connection bridge_path(ArmPlanning& arm, const GraspSlip& slip, const Eigen::Vec
   auto valid = [&](const Eigen::VectorXd& q) {
     return holds(gravity_in_tcp(arm.workspace.arm(), base_rotation, q)) && arm.workspace.valid(q);
   };
-  c.path = core::plan_bridge(arm.workspace.arm(), valid, from, to, bridge);
+  core::BridgeSettings checked = bridge;
+  checked.resolution = check_resolution(arm);
+  c.path = core::plan_bridge(arm.workspace.arm(), valid, from, to, checked);
   if (c.path.empty()) return c;
   c.connected = true;
   c.via = "bridge";
@@ -129,9 +171,10 @@ std::vector<Eigen::VectorXd> valid_branches(ArmPlanning& arm, const core::Pose& 
 class ExchangeCheck {
  public:
   ExchangeCheck(const core::Cell& cell, const core::TriangleMesh& board,
-                const std::string& suction_arm, const std::string& receiving_arm)
+                const std::vector<core::PlacedPart>& finished, const std::string& suction_arm,
+                const std::string& receiving_arm)
       : cell_(cell),
-        scene_(core::build_stage_scene(cell, board, {}, suction_arm)),
+        scene_(core::build_stage_scene(cell, board, finished, suction_arm)),
         data_(scene_.cell.model),
         suction_(cell.arm(suction_arm)),
         receiving_(cell.arm(receiving_arm)),
@@ -249,16 +292,20 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     }
   }
 
-  ArmPlanning suction{suction_roadmap,
-                      core::RoadmapGraph(suction_roadmap.nodes, suction_roadmap.edges),
-                      ArmWorkspace(cell, settings.suction_arm, settings.suction_arm, &part.mesh),
-                      std::vector<bool>(suction_roadmap.edges.size(), true)};
+  // The board's stage: its chains must not carry it (or the arm) through the parts already
+  // assembled, or the online planner would find every stored transfer blocked in the nominal
+  // sequence and fall back to bridges.
+  const std::vector<core::PlacedPart> finished = core::parts_before(product, index);
+  ArmPlanning suction{
+      suction_roadmap, core::RoadmapGraph(suction_roadmap.nodes, suction_roadmap.edges),
+      ArmWorkspace(cell, settings.suction_arm, settings.suction_arm, &part.mesh, finished),
+      std::vector<bool>(suction_roadmap.edges.size(), true), settings.held_resolution};
   ArmPlanning receiving{
       receiving_roadmap, core::RoadmapGraph(receiving_roadmap.nodes, receiving_roadmap.edges),
-      ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, &part.mesh),
-      std::vector<bool>(receiving_roadmap.edges.size(), true)};
+      ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, &part.mesh, finished),
+      std::vector<bool>(receiving_roadmap.edges.size(), true), settings.held_resolution};
   core::GraphSearchWorkspace search;
-  ExchangeCheck exchange(cell, part.mesh, settings.suction_arm, settings.receiving_arm);
+  ExchangeCheck exchange(cell, part.mesh, finished, settings.suction_arm, settings.receiving_arm);
   std::uint64_t bridges = 0;
   auto bridge = [&] {
     core::BridgeSettings b = settings.bridge;

@@ -162,7 +162,8 @@ Eigen::VectorXd roadmap_upper(const core::Arm& arm, const RoadmapSettings& setti
 
 std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Roadmap& roadmap,
                                              const GraspSlip& grasp, const Eigen::VectorXd& q,
-                                             int k) {
+                                             int k, double resolution) {
+  const double step = resolution > 0.0 ? resolution : roadmap.resolution;
   const Eigen::Matrix3d base_rotation = workspace.base().linear();
   const SlipTest holds(grasp);
   auto ok = [&](const Eigen::VectorXd& x) {
@@ -180,7 +181,7 @@ std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Road
   for (std::size_t j = 0; j < take; ++j) {
     const auto& node = roadmap.nodes[static_cast<std::size_t>(near[j].second)];
     bool free = ok(node);
-    for (const auto& x : edge_samples(q, node, roadmap.resolution)) {
+    for (const auto& x : edge_samples(q, node, step)) {
       if (!free) break;
       free = ok(x);
     }

@@ -6,6 +6,7 @@
 #include "hila/core/cell.hpp"
 #include "hila/core/collision.hpp"
 #include "hila/core/mesh.hpp"
+#include "hila/core/product.hpp"
 
 namespace hila::core {
 
@@ -31,6 +32,10 @@ struct StageScene {
   // The tool is rigid: its link poses relative to the handle, computed once.
   std::vector<Pose> tool_links_in_handle;
 };
+
+// The parts assembled before `index` (product order), at their targets in the product's
+// assembly frame: the nominal stage of the part at `index`.
+std::vector<PlacedPart> parts_before(const ProductSpec& product, std::size_t index);
 
 StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
                              const std::vector<PlacedPart>& finished,

@@ -12,13 +12,16 @@
 namespace hila::offline {
 
 // One arm moving through the static cell (table, robot body, the other arm at home, the human at
-// the stance, the suction tool in the suction arm's hand), optionally holding a board. The
-// roadmaps are built and filtered against this scene. Mutable: one per thread.
+// the stance, the suction tool in the suction arm's hand) and the parts finished at the board's
+// stage, optionally holding a board. The roadmaps are built against the empty cell; the board's
+// filters and regrasp graph against its stage. Mutable: one per thread.
 class ArmWorkspace {
  public:
   // `board`: the mesh a held board has (nullptr: the arm never holds one).
+  // `finished`: parts standing in the cell (static), e.g. core::parts_before(product, index).
   ArmWorkspace(const core::Cell& cell, const std::string& arm, const std::string& suction_arm,
-               const core::TriangleMesh* board = nullptr);
+               const core::TriangleMesh* board = nullptr,
+               const std::vector<core::PlacedPart>& finished = {});
 
   const core::Arm& arm() const { return arm_; }
   int arm_index() const { return arm_index_; }

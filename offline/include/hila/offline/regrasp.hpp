@@ -35,6 +35,9 @@ struct RegraspSettings {
   // HandoverSettings (exchange_approach, exchange_resolution), as the robot-robot poses.
   double approach = 0.05;
   double approach_resolution = 0.01;
+  // Motions holding the board (attachments, roadmap edges, bridges) are checked this finely
+  // (rad; the build takes HandoverSettings::exchange_resolution, the online validator's).
+  double held_resolution = 0.01;
   std::string suction_arm = "right";
   std::string receiving_arm = "left";
 };
@@ -67,9 +70,10 @@ struct RegraspResult {
   double seconds = 0.0;
 };
 
-// Roadmaps: the suction arm's and the receiving arm's (built by build_roadmap over the same
-// cell). The board's stage (finished parts) is not part of the static cell: the online planner
-// validates against the actual assembly.
+// Roadmaps: the suction arm's and the receiving arm's (built by build_roadmap over the empty
+// cell). The filters and the chains are planned at the board's stage (the parts before it
+// finished at their nominal targets); the online planner re-validates against the actual
+// assembly.
 RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& product,
                            std::size_t index, const BoardGrasps& grasps,
                            const HandoverResult& handover, const Roadmap& suction_roadmap,

@@ -110,10 +110,11 @@ struct Attachment {
 
 // Roadmap nodes among the `k` nearest (joint space) that a straight edge from `q` reaches within
 // the grasp's slip limit and valid in the workspace (the arm and, when it holds one, the board)
-// at the roadmap's resolution; `q` itself must satisfy both, else none. Nearest first.
+// at `resolution` (rad; 0: the roadmap's); `q` itself must satisfy both, else none. Nearest
+// first.
 std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Roadmap& roadmap,
                                              const GraspSlip& grasp, const Eigen::VectorXd& q,
-                                             int k);
+                                             int k, double resolution = 0.0);
 
 using core::edge_samples;  // core/bridge.hpp
 
