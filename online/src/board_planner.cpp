@@ -270,8 +270,44 @@ class Run {
       motion = std::move(via_staging);
     }
     if (!motion.solved()) return name + ": " + to_string(motion.status) + ": " + motion.reason;
-    const TimedPath timed = time_parameterize(motion.path, arm.spec.max_velocity,
-                                              arm.spec.max_acceleration, settings_.speed_scale);
+    PlanStep s;
+    TimedPath timed;
+    if (!timed_and_valid(stage, arm, request, motion, timed, s.validation) &&
+        !request.fine_checks && !request.held.held &&
+        s.validation.violations.front().kind == "collision") {
+      // The empty arm's segments are checked at the roadmap's resolution: a thin collision
+      // between its samples is planned around once at the validator's.
+      MotionRequest fine = request;
+      fine.fine_checks = true;
+      MotionResult again = planner.plan(fine);
+      if (again.solved()) {
+        motion = std::move(again);
+        timed_and_valid(stage, arm, request, motion, timed, s.validation);
+      }
+    }
+    if (!s.validation.valid()) {
+      const auto& v = s.validation.violations.front();
+      return name + ": the validator rejected the plan (" + v.kind + ": " + v.detail + ")";
+    }
+    const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();
+    s.name = name;
+    s.arm = arm.spec.name;
+    s.via = motion.via;
+    for (const double t : timed.time) s.time.push_back(clock + t);
+    s.q = timed.q;
+    s.event =
+        start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
+    s.path_length = path_length(motion.path);
+    cell_.set_arm(stage.end.robot_q, arm, motion.path.back());
+    stage.steps.push_back(std::move(s));
+    return "";
+  }
+
+  // Times the motion's path and re-checks it with the validator: whether it passed.
+  bool timed_and_valid(const Stage& stage, const core::Arm& arm, const MotionRequest& request,
+                       const MotionResult& motion, TimedPath& timed, ValidationReport& report) {
+    timed = time_parameterize(motion.path, arm.spec.max_velocity, arm.spec.max_acceleration,
+                              settings_.speed_scale);
     Motion check;
     check.arm = arm.spec.name;
     check.time = timed.time;
@@ -289,24 +325,8 @@ class Run {
     if (request.held.held && &arm == &receiving_) {
       cell_.set_jaw(check.robot_q, arm, request.held.jaw);
     }
-    PlanStep s;
-    s.validation = validate_motion(world_, validation_data_, check, settings_.validator);
-    if (!s.validation.valid()) {
-      const auto& v = s.validation.violations.front();
-      return name + ": the validator rejected the plan (" + v.kind + ": " + v.detail + ")";
-    }
-    const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();
-    s.name = name;
-    s.arm = arm.spec.name;
-    s.via = motion.via;
-    for (const double t : timed.time) s.time.push_back(clock + t);
-    s.q = timed.q;
-    s.event =
-        start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
-    s.path_length = path_length(motion.path);
-    cell_.set_arm(stage.end.robot_q, arm, motion.path.back());
-    stage.steps.push_back(std::move(s));
-    return "";
+    report = validate_motion(world_, validation_data_, check, settings_.validator);
+    return report.valid();
   }
 
   // The first of `candidates` valid for the planner under `request` in the stage's state.

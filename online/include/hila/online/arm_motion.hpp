@@ -52,6 +52,9 @@ struct MotionRequest {
   // its first and last few waypoints and re-validated against the scene as it is.
   std::vector<const std::vector<Eigen::VectorXd>*> hints;
   bool allow_bridge = true;  // false: roadmap (and stored paths) only, e.g. for a staging try
+  // Every segment at MotionSettings::held_resolution even with nothing held: a retry after the
+  // validator found a thin collision between the empty arm's coarser samples.
+  bool fine_checks = false;
 };
 
 enum class MotionStatus { kSolved, kInvalidStart, kInvalidGoal, kNoPath, kTimeout };
