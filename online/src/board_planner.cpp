@@ -9,6 +9,7 @@
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
+#include "hila/online/smoother.hpp"
 #include "hila/online/time_parameterization.hpp"
 
 namespace hila::online {
@@ -272,8 +273,28 @@ class Run {
     if (!motion.solved()) return name + ": " + to_string(motion.status) + ": " + motion.reason;
     PlanStep s;
     TimedPath timed;
-    if (!timed_and_valid(stage, arm, request, motion, timed, s.validation) &&
-        !request.fine_checks && !request.held.held &&
+    // Smoothed (SuiteSparse) under the planner's checks for this request; the found path when
+    // the smoothing fails or the validator rejects it.
+    std::vector<Eigen::VectorXd> path = motion.path;
+    if (settings_.smooth && path.size() > 2 && !request.start_in_contact) {
+      SmoothResult smooth = smooth_path(
+          path,
+          [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+            return planner.segment_valid(a, b);
+          },
+          settings_.smoother);
+      if (smooth.smoothed) {
+        path = std::move(smooth.path);
+        s.smoothed = true;
+      }
+    }
+    bool valid = timed_and_valid(stage, arm, request, path, timed, s.validation);
+    if (!valid && s.smoothed) {
+      path = motion.path;
+      s.smoothed = false;
+      valid = timed_and_valid(stage, arm, request, path, timed, s.validation);
+    }
+    if (!valid && !request.fine_checks && !request.held.held &&
         s.validation.violations.front().kind == "collision") {
       // The empty arm's segments are checked at the roadmap's resolution: a thin collision
       // between its samples is planned around once at the validator's.
@@ -282,7 +303,8 @@ class Run {
       MotionResult again = planner.plan(fine);
       if (again.solved()) {
         motion = std::move(again);
-        timed_and_valid(stage, arm, request, motion, timed, s.validation);
+        path = motion.path;
+        timed_and_valid(stage, arm, request, path, timed, s.validation);
       }
     }
     if (!s.validation.valid()) {
@@ -297,17 +319,18 @@ class Run {
     s.q = timed.q;
     s.event =
         start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
-    s.path_length = path_length(motion.path);
-    cell_.set_arm(stage.end.robot_q, arm, motion.path.back());
+    s.path_length = path_length(path);
+    cell_.set_arm(stage.end.robot_q, arm, path.back());
     stage.steps.push_back(std::move(s));
     return "";
   }
 
   // Times the motion's path and re-checks it with the validator: whether it passed.
   bool timed_and_valid(const Stage& stage, const core::Arm& arm, const MotionRequest& request,
-                       const MotionResult& motion, TimedPath& timed, ValidationReport& report) {
-    timed = time_parameterize(motion.path, arm.spec.max_velocity, arm.spec.max_acceleration,
-                              settings_.speed_scale);
+                       const std::vector<Eigen::VectorXd>& path, TimedPath& timed,
+                       ValidationReport& report) {
+    timed = time_parameterize_through(path, arm.spec.max_velocity, arm.spec.max_acceleration,
+                                      settings_.speed_scale, settings_.timing_step);
     Motion check;
     check.arm = arm.spec.name;
     check.time = timed.time;

@@ -71,4 +71,181 @@ TimedPath time_parameterize(const std::vector<Eigen::VectorXd>& path,
   return out;
 }
 
+namespace {
+
+// The pieces of a path with their directions, lengths and speed limits.
+struct Pieces {
+  std::vector<Eigen::VectorXd> points;  // waypoints, consecutive ones distinct
+  std::vector<Eigen::VectorXd> unit;    // direction of piece i (points[i] -> points[i + 1])
+  std::vector<double> length;
+  std::vector<double> top_speed;  // the velocity limit along the piece
+};
+
+Pieces split(const std::vector<Eigen::VectorXd>& path, const Eigen::VectorXd& vmax,
+             double max_step) {
+  Pieces p;
+  for (const auto& q : path) {
+    if (!p.points.empty() && (q - p.points.back()).norm() <= 1e-12) continue;
+    if (!p.points.empty()) {
+      const Eigen::VectorXd from = p.points.back();
+      const Eigen::VectorXd delta = q - from;
+      const int n = std::max(1, static_cast<int>(std::ceil(delta.norm() / max_step)));
+      for (int k = 1; k < n; ++k) p.points.push_back(from + (static_cast<double>(k) / n) * delta);
+    }
+    p.points.push_back(q);
+  }
+  for (std::size_t i = 0; i + 1 < p.points.size(); ++i) {
+    const Eigen::VectorXd delta = p.points[i + 1] - p.points[i];
+    const double l = delta.norm();
+    p.length.push_back(l);
+    p.unit.push_back(delta / l);
+    double top = std::numeric_limits<double>::infinity();
+    for (Eigen::Index j = 0; j < delta.size(); ++j) {
+      const double u = std::abs(p.unit.back()[j]);
+      if (u > 1e-12) top = std::min(top, vmax[j] / u);
+    }
+    p.top_speed.push_back(top);
+  }
+  return p;
+}
+
+// How far piece `b` at speed sb after piece `a` at speed sa exceeds the acceleration limit: the
+// largest ratio over the joints of |v_b - v_a| to amax * (t_a + t_b) / 2 (<= 1 holds). A piece
+// index of -1 is the robot at rest (no duration).
+double accel_ratio(const Pieces& p, const Eigen::VectorXd& amax, int a, double sa, int b,
+                   double sb) {
+  const double ta = a < 0 ? 0.0 : p.length[static_cast<std::size_t>(a)] / sa;
+  const double tb = b < 0 ? 0.0 : p.length[static_cast<std::size_t>(b)] / sb;
+  const double mean = 0.5 * (ta + tb);
+  double worst = 0.0;
+  for (Eigen::Index j = 0; j < amax.size(); ++j) {
+    const double va = a < 0 ? 0.0 : sa * p.unit[static_cast<std::size_t>(a)][j];
+    const double vb = b < 0 ? 0.0 : sb * p.unit[static_cast<std::size_t>(b)][j];
+    worst = std::max(worst, std::abs(vb - va) / (amax[j] * mean));
+  }
+  return worst;
+}
+
+// The largest speed of piece `next` (up to its cap) reachable from piece `prev` at `speed`.
+double reachable(const Pieces& p, const Eigen::VectorXd& amax, int prev, double speed, int next,
+                 double cap) {
+  auto ok = [&](double s) { return accel_ratio(p, amax, prev, speed, next, s) <= 1.0; };
+  if (ok(cap)) return cap;
+  // The feasible speeds are those near `speed` and, apart from them, tiny ones (a piece that
+  // lasts long enough averages any jump away): step down from the cap to the first feasible
+  // speed, then refine between it and the step above, so the upper interval is found.
+  // Holding the previous speed is feasible unless the direction turns: then the bracket is
+  // between it and the cap.
+  double hi = cap;
+  double lo = speed > 0.0 && speed < cap ? speed : 0.8 * cap;
+  while (lo > 1e-9 * cap && !ok(lo)) {
+    hi = lo;
+    lo *= 0.95;
+  }
+  if (!ok(lo)) return lo;  // not reached: a tiny speed is always feasible
+  for (int it = 0; it < 30; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (ok(mid)) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo;
+}
+
+}  // namespace
+
+TimedPath time_parameterize_through(const std::vector<Eigen::VectorXd>& path,
+                                    const Eigen::VectorXd& max_velocity,
+                                    const Eigen::VectorXd& max_acceleration, double scale,
+                                    double max_step) {
+  TimedPath out;
+  if (path.empty()) return out;
+  const Eigen::VectorXd vmax = scale * max_velocity;
+  const Eigen::VectorXd amax = scale * max_acceleration;
+  const Pieces p = split(path, vmax, max_step);
+  const int n = static_cast<int>(p.length.size());
+  out.time.push_back(0.0);
+  out.q.push_back(p.points.front());
+  if (n == 0) return out;
+  // Each piece's cap: its velocity limit, and the speed at which it can be held through the
+  // turns at its two ends (equal speeds on both sides of a turn by |du| need
+  // s^2 <= amax (L_a + L_b) / (2 |du|) in every joint). Without it a greedy pass could reach a
+  // speed from which only a near stop is feasible at the next turn.
+  std::vector<double> cap = p.top_speed;
+  for (int i = 1; i < n; ++i) {
+    const auto a = static_cast<std::size_t>(i - 1);
+    const auto b = static_cast<std::size_t>(i);
+    const Eigen::VectorXd turn = p.unit[b] - p.unit[a];
+    double hold = std::numeric_limits<double>::infinity();
+    for (Eigen::Index j = 0; j < turn.size(); ++j) {
+      const double du = std::abs(turn[j]);
+      if (du > 1e-12) {
+        hold = std::min(hold, std::sqrt(amax[j] * (p.length[a] + p.length[b]) / (2.0 * du)));
+      }
+    }
+    cap[a] = std::min(cap[a], hold);
+    cap[b] = std::min(cap[b], hold);
+  }
+  // Backward from rest at the end (the fastest speeds from which every later cap can still be
+  // kept), then forward from rest under those bounds.
+  std::vector<double> backward(static_cast<std::size_t>(n));
+  for (int i = n - 1; i >= 0; --i) {
+    const double next = i == n - 1 ? 0.0 : backward[static_cast<std::size_t>(i + 1)];
+    const double own = cap[static_cast<std::size_t>(i)];
+    // Only braking is this pass's job (reversed in time, an acceleration out of the next
+    // piece); speeding up to a faster next piece is left to the forward pass.
+    backward[static_cast<std::size_t>(i)] =
+        own <= next ? own : reachable(p, amax, i + 1 < n ? i + 1 : -1, next, i, own);
+  }
+  std::vector<double> speed(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double previous = i == 0 ? 0.0 : speed[static_cast<std::size_t>(i - 1)];
+    const double bound = backward[static_cast<std::size_t>(i)];
+    // Braking to the bound was planned backward (the previous piece is at most its own
+    // bound, which brakes into this one within limits).
+    speed[static_cast<std::size_t>(i)] =
+        bound <= previous ? bound : reachable(p, amax, i - 1, previous, i, bound);
+  }
+  // The forward pass keeps each pair with its predecessor; a piece held below its backward
+  // bound may still brake too hard into the next. Bring the faster of any violating pair
+  // towards the slower (equal speeds under the caps are always feasible).
+  for (int sweep = 0; sweep < 200; ++sweep) {
+    bool changed = false;
+    for (int i = 0; i <= n; ++i) {
+      const int a = i - 1;
+      const int b = i < n ? i : -1;
+      const double sa = a < 0 ? 0.0 : speed[static_cast<std::size_t>(a)];
+      const double sb = b < 0 ? 0.0 : speed[static_cast<std::size_t>(b)];
+      if (accel_ratio(p, amax, a, sa, b, sb) <= 1.0) continue;
+      const bool a_faster = b < 0 || (a >= 0 && sa > sb);
+      double& faster = speed[static_cast<std::size_t>(a_faster ? a : b)];
+      faster = std::max(a_faster ? sb : sa, 0.9 * faster);
+      if (faster <= 0.0) faster = 1e-6;
+      changed = true;
+    }
+    if (!changed) break;
+  }
+  // Whatever is left (never seen in practice): slowing everything by c scales every
+  // acceleration ratio by c^2.
+  double worst = 0.0;
+  for (int i = 0; i <= n; ++i) {
+    const int a = i - 1;
+    const int b = i < n ? i : -1;
+    worst =
+        std::max(worst, accel_ratio(p, amax, a, a < 0 ? 0.0 : speed[static_cast<std::size_t>(a)], b,
+                                    b < 0 ? 0.0 : speed[static_cast<std::size_t>(b)]));
+  }
+  if (worst > 1.0) {
+    for (double& s : speed) s /= std::sqrt(worst) * 1.0001;
+  }
+  for (int i = 0; i < n; ++i) {
+    out.time.push_back(out.time.back() +
+                       p.length[static_cast<std::size_t>(i)] / speed[static_cast<std::size_t>(i)]);
+    out.q.push_back(p.points[static_cast<std::size_t>(i + 1)]);
+  }
+  return out;
+}
+
 }  // namespace hila::online

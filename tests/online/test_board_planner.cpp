@@ -128,6 +128,13 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
     scene = after(*model, scene, part.name);
   }
   ASSERT_GE(solved.size(), 4u);
+  // The smoother is part of the pipeline: multi-waypoint motions are smoothed (and validated,
+  // above) rather than all falling back to the found paths.
+  int smoothed = 0;
+  for (const auto& [name, plan] : plan_of) {
+    for (const auto& step : plan.steps) smoothed += step.smoothed ? 1 : 0;
+  }
+  EXPECT_GT(smoothed, 0);
   EXPECT_EQ(solved[0], "base");
   EXPECT_EQ(solved[1], "lateral_right");
   EXPECT_EQ(solved[2], "back_lower");

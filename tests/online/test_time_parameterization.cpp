@@ -72,3 +72,112 @@ TEST(TimeParameterization, RandomPathsKeepEveryLimitBetweenSamples) {
     }
   }
 }
+
+namespace {
+
+// Every velocity on each piece and every acceleration between consecutive pieces, measured as
+// the validator measures them, plus from rest into the first piece and out of the last to rest;
+// the largest ratio to its scaled limit.
+double worst_rate_ratio(const online::TimedPath& timed, const Eigen::VectorXd& vmax,
+                        const Eigen::VectorXd& amax) {
+  double worst = 0.0;
+  const std::size_t n = timed.q.size();
+  std::vector<Eigen::VectorXd> v;
+  std::vector<double> dt;
+  for (std::size_t i = 1; i < n; ++i) {
+    dt.push_back(timed.time[i] - timed.time[i - 1]);
+    v.push_back((timed.q[i] - timed.q[i - 1]) / dt.back());
+    worst = std::max(worst, (v.back().array().abs() / vmax.array()).maxCoeff());
+  }
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(vmax.size());
+  for (std::size_t i = 0; i <= v.size(); ++i) {
+    const Eigen::VectorXd& before = i == 0 ? rest : v[i - 1];
+    const Eigen::VectorXd& after = i == v.size() ? rest : v[i];
+    const double mean = 0.5 * ((i == 0 ? 0.0 : dt[i - 1]) + (i == v.size() ? 0.0 : dt[i]));
+    worst = std::max(worst, ((after - before).array().abs() / (amax.array() * mean)).maxCoeff());
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(TimeParameterizationThrough, OneStraightSegmentMatchesTheTrapezoid) {
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(6), b = a;
+  b << 2.0, 1.5, -1.0, 0.5, 0.3, 0.1;
+  const auto rest = online::time_parameterize({a, b}, limits(3.14), limits(2.97), 0.5);
+  const auto through =
+      online::time_parameterize_through({a, b}, limits(3.14), limits(2.97), 0.5, 0.05);
+  // Pieces of 0.05 rad at constant speed approximate the continuous ramp (v^2 = 2 a x).
+  EXPECT_NEAR(through.time.back(), rest.time.back(), 0.02 * rest.time.back());
+  EXPECT_TRUE(through.q.back().isApprox(b, 0.0));
+  EXPECT_LE(worst_rate_ratio(through, 0.5 * limits(3.14), 0.5 * limits(2.97)), 1.0 + 1e-9);
+}
+
+TEST(TimeParameterizationThrough, CollinearWaypointsAreNotStoppedAt) {
+  // Ten waypoints on one line: rest-to-rest stops nine times, through them it does not.
+  std::vector<Eigen::VectorXd> path;
+  for (int i = 0; i <= 9; ++i) path.push_back(Eigen::VectorXd::Constant(6, 0.3 * i));
+  const auto rest = online::time_parameterize(path, limits(3.14), limits(2.97));
+  const auto through = online::time_parameterize_through(path, limits(3.14), limits(2.97));
+  const auto single =
+      online::time_parameterize({path.front(), path.back()}, limits(3.14), limits(2.97));
+  EXPECT_LT(through.time.back(), 0.5 * rest.time.back());
+  EXPECT_NEAR(through.time.back(), single.time.back(), 0.02 * single.time.back());
+}
+
+TEST(TimeParameterizationThrough, ACircularArcRunsAtItsCentripetalLimit) {
+  // q0 = R cos s, q1 = R sin s: each joint's acceleration reaches v^2 / R, so the cruise speed
+  // is sqrt(amax R); the arc's time is at least its length over that and, with the ramps, not
+  // much more.
+  const double radius = 1.0;
+  std::vector<Eigen::VectorXd> path;
+  for (int i = 0; i <= 120; ++i) {
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
+    q[0] = radius * std::cos(0.05 * i);
+    q[1] = radius * std::sin(0.05 * i);
+    path.push_back(q);
+  }
+  const double amax = 1.5;
+  const auto timed = online::time_parameterize_through(path, limits(10.0), limits(amax));
+  double length = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) length += (path[i] - path[i - 1]).norm();
+  const double cruise = length / std::sqrt(amax * radius);
+  EXPECT_GT(timed.time.back(), 0.95 * cruise);
+  EXPECT_LT(timed.time.back(), 1.35 * cruise);
+  EXPECT_LE(worst_rate_ratio(timed, limits(10.0), limits(amax)), 1.0 + 1e-9);
+}
+
+TEST(TimeParameterizationThrough, RandomPathsKeepEveryLimitFromRestToRest) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  Eigen::VectorXd vmax(6), amax(6);
+  vmax << 3.14, 3.14, 3.14, 6.28, 6.28, 6.28;
+  amax << 2.97, 2.97, 2.97, 5.93, 5.93, 5.93;
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<Eigen::VectorXd> path;
+    for (int i = 0; i < 6; ++i) {
+      Eigen::VectorXd q(6);
+      for (int j = 0; j < 6; ++j) q[j] = u(rng);
+      path.push_back(q);
+    }
+    path.push_back(path.back());  // a repeated waypoint is dropped
+    const auto timed = online::time_parameterize_through(path, vmax, amax, 0.5, 0.05);
+    ASSERT_EQ(timed.q.size(), timed.time.size());
+    EXPECT_TRUE(timed.q.front().isApprox(path.front(), 0.0));
+    EXPECT_TRUE(timed.q.back().isApprox(path.back(), 0.0));
+    for (std::size_t i = 1; i < timed.q.size(); ++i) {
+      ASSERT_GT(timed.time[i], timed.time[i - 1]);
+      EXPECT_LE((timed.q[i] - timed.q[i - 1]).norm(), 0.05 + 1e-12);
+    }
+    // Every waypoint is on the timed path (it only adds points between them).
+    std::size_t found = 0;
+    for (const auto& q : timed.q) {
+      if (found < path.size() && q.isApprox(path[found], 1e-12)) ++found;
+    }
+    EXPECT_GE(found, path.size() - 1);
+    EXPECT_LE(worst_rate_ratio(timed, 0.5 * vmax, 0.5 * amax), 1.0 + 1e-9) << "trial " << trial;
+    // Sharp corners need near stops, but never a slower run than stopping at every waypoint.
+    EXPECT_LT(timed.time.back(),
+              1.05 * online::time_parameterize(path, vmax, amax, 0.5).time.back());
+  }
+}

@@ -47,6 +47,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                      {"via", s.via},
                      {"events", s.event},
                      {"path_length_rad", s.path_length},
+                     {"smoothed", s.smoothed},
                      {"validated", s.validation.valid()},
                      {"time_s", s.time},
                      {"joints_rad", q}});

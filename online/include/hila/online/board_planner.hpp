@@ -11,6 +11,7 @@
 #include "hila/online/arm_motion.hpp"
 #include "hila/online/planner_model.hpp"
 #include "hila/online/scene.hpp"
+#include "hila/online/smoother.hpp"
 #include "hila/online/validator.hpp"
 
 namespace hila::online {
@@ -22,6 +23,10 @@ struct BoardPlanSettings {
   int exchange_bridges = 2;   // receiving-arm IK branches at the exchange given a bridge
   double speed_scale = 0.5;   // of the arms' velocity and acceleration limits
   double jaw_margin = 0.005;  // m: the gripper opens this much wider than the board while holding
+  bool smooth = true;         // smooth every found path with more than one segment (smoother.hpp)
+  SmootherSettings smoother;
+  double timing_step =
+      0.05;  // rad: the timed trajectory's longest piece (time_parameterize_through)
   MotionSettings motion;
   ValidatorSettings validator;
 };
@@ -35,7 +40,8 @@ struct PlanStep {
   std::vector<Eigen::VectorXd> q;
   std::string event;  // at the end: "suction_on", "suction_off", "gripper_close", "gripper_open",
                       // "tool_grasped" or ""
-  double path_length = 0.0;  // rad
+  double path_length = 0.0;  // rad, of the executed (smoothed) path
+  bool smoothed = false;     // the found path was smoothed (else executed as found)
   ValidationReport validation;
 };
 

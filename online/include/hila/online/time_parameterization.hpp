@@ -20,4 +20,17 @@ TimedPath time_parameterize(const std::vector<Eigen::VectorXd>& path,
                             const Eigen::VectorXd& max_acceleration, double scale = 1.0,
                             int samples_per_segment = 8);
 
+// Times a path without stopping at its waypoints (a smoothed path's dense waypoints): the path is
+// split into pieces no longer than `max_step` (rad), each traversed at a constant speed, and
+// the speeds are the largest that keep, as the validator measures them, every joint's velocity
+// on each piece and its acceleration between consecutive pieces (their velocity difference over
+// the mean of their durations) within the scaled limits, starting from rest and coming to
+// rest (a virtual piece at zero speed before the first and after the last). A forward and a
+// backward pass bound the speeds; where the two bounds meet, speeds are lowered until every
+// limit holds. Repeated waypoints are dropped.
+TimedPath time_parameterize_through(const std::vector<Eigen::VectorXd>& path,
+                                    const Eigen::VectorXd& max_velocity,
+                                    const Eigen::VectorXd& max_acceleration, double scale = 1.0,
+                                    double max_step = 0.05);
+
 }  // namespace hila::online
