@@ -28,12 +28,29 @@ std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen:
   return out;
 }
 
-bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
-                   const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution) {
-  for (const auto& q : edge_samples(a, b, resolution)) {
-    if (!valid(q)) return false;
+bool all_samples_coarse_to_fine(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                double resolution,
+                                const std::function<bool(const Eigen::VectorXd&)>& visit,
+                                long* visited) {
+  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
+  // Open index intervals (lo, hi), breadth first: each visit splits one at its middle.
+  std::vector<std::pair<int, int>> queue{{0, steps}};
+  const Eigen::VectorXd delta = b - a;
+  for (std::size_t next = 0; next < queue.size(); ++next) {
+    const auto [lo, hi] = queue[next];
+    if (hi - lo < 2) continue;
+    const int mid = lo + (hi - lo) / 2;
+    if (visited != nullptr) ++*visited;
+    if (!visit(a + delta * (static_cast<double>(mid) / steps))) return false;
+    queue.emplace_back(lo, mid);
+    queue.emplace_back(mid, hi);
   }
   return true;
+}
+
+bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
+                   const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution) {
+  return all_samples_coarse_to_fine(a, b, resolution, valid);
 }
 
 std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,

@@ -140,10 +140,8 @@ std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {
 }
 
 bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  for (const auto& q : core::edge_samples(a, b, resolution_)) {
-    if (!valid(q)) return false;
-  }
-  return true;
+  return core::all_samples_coarse_to_fine(a, b, resolution_,
+                                          [this](const Eigen::VectorXd& q) { return valid(q); });
 }
 
 bool ArmMotionPlanner::edge_valid(int edge) {
@@ -209,15 +207,11 @@ void ArmMotionPlanner::shorten(std::vector<Eigen::VectorXd>& path) {
   while (at + 1 < path.size()) {
     std::size_t next = at + 1;
     for (std::size_t j = path.size() - 1; j > at + 1 && budget > 0; --j) {
-      const auto samples = core::edge_samples(path[at], path[j], resolution_);
-      bool clear = true;
-      for (const auto& q : samples) {
-        --budget;
-        if (!valid(q)) {
-          clear = false;
-          break;
-        }
-      }
+      long spent = 0;
+      const bool clear = core::all_samples_coarse_to_fine(
+          path[at], path[j], resolution_, [this](const Eigen::VectorXd& q) { return valid(q); },
+          &spent);
+      budget -= spent;
       if (clear) {
         next = j;
         break;

@@ -284,3 +284,48 @@ TEST(Bridge, SegmentValidChecksInteriorOnly) {
   EXPECT_TRUE(core::segment_valid(counting_ok, a, b, 0.125));
   EXPECT_EQ(calls, 7);
 }
+
+TEST(Bridge, CoarseToFineVisitsEveryEdgeSampleOnceMiddleFirst) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::VectorXd a(6), b(6);
+    for (int j = 0; j < 6; ++j) {
+      a[j] = u(rng);
+      b[j] = u(rng);
+    }
+    const double resolution = trial % 2 == 0 ? 0.01 : 0.05;
+    const auto reference = core::edge_samples(a, b, resolution);
+    std::vector<Eigen::VectorXd> seen;
+    long visited = 0;
+    EXPECT_TRUE(core::all_samples_coarse_to_fine(
+        a, b, resolution,
+        [&](const Eigen::VectorXd& q) {
+          seen.push_back(q);
+          return true;
+        },
+        &visited));
+    ASSERT_EQ(seen.size(), reference.size());
+    EXPECT_EQ(visited, static_cast<long>(reference.size()));
+    // The same samples, each once (matched to the sequential ones).
+    std::vector<bool> used(reference.size(), false);
+    for (const auto& q : seen) {
+      bool matched = false;
+      for (std::size_t i = 0; i < reference.size() && !matched; ++i) {
+        if (!used[i] && q.isApprox(reference[i], 1e-12)) used[i] = matched = true;
+      }
+      EXPECT_TRUE(matched);
+    }
+    if (!reference.empty()) {
+      EXPECT_TRUE(seen.front().isApprox(reference[(reference.size()) / 2], 1e-12) ||
+                  seen.front().isApprox(reference[(reference.size() - 1) / 2], 1e-12));
+    }
+    // Stops at the first rejection: a segment blocked at its middle costs one check.
+    long blocked = 0;
+    if (reference.size() >= 3) {
+      EXPECT_FALSE(core::all_samples_coarse_to_fine(
+          a, b, resolution, [](const Eigen::VectorXd&) { return false; }, &blocked));
+      EXPECT_EQ(blocked, 1);
+    }
+  }
+}

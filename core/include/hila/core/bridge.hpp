@@ -39,8 +39,17 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
                                           double resolution);
 
+// The interior samples of edge_samples(a, b, resolution) visited coarse to fine (the middle,
+// then the quarters, ...) until `visit` returns false: a blocked segment is usually found
+// after a few checks rather than at the blocked sample's place in line. Whether every visit
+// returned true; `visited` (optional) counts the visits.
+bool all_samples_coarse_to_fine(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                double resolution,
+                                const std::function<bool(const Eigen::VectorXd&)>& visit,
+                                long* visited = nullptr);
+
 // Whether the straight segment a -> b is valid at every interior sample (the ends are assumed
-// checked), at the resolution.
+// checked), at the resolution (visited coarse to fine).
 bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
                    const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution);
 
