@@ -5,26 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hila/online/time_parameterization.hpp"
+
 namespace hila::online {
-
-namespace {
-
-// The path's points every `spacing` or less along each segment (repeated waypoints dropped).
-std::vector<Eigen::VectorXd> resample(const std::vector<Eigen::VectorXd>& path, double spacing) {
-  std::vector<Eigen::VectorXd> out;
-  for (const auto& q : path) {
-    if (!out.empty() && (q - out.back()).norm() <= 1e-12) continue;
-    if (!out.empty()) {
-      const Eigen::VectorXd from = out.back();
-      const int n = std::max(1, static_cast<int>(std::ceil((q - from).norm() / spacing)));
-      for (int k = 1; k < n; ++k) out.push_back(from + (static_cast<double>(k) / n) * (q - from));
-    }
-    out.push_back(q);
-  }
-  return out;
-}
-
-}  // namespace
 
 SmoothResult smooth_path(
     const std::vector<Eigen::VectorXd>& path,
@@ -33,7 +16,7 @@ SmoothResult smooth_path(
   SmoothResult result;
   result.path = path;
   if (path.size() < 3 || !(settings.spacing > 0.0)) return result;
-  const std::vector<Eigen::VectorXd> original = resample(path, settings.spacing);
+  const std::vector<Eigen::VectorXd> original = resample_path(path, settings.spacing);
   const int points = static_cast<int>(original.size());
   const int inner = points - 2;  // the unknowns: every point but the ends
   if (inner < 1) return result;

@@ -84,16 +84,7 @@ struct Pieces {
 Pieces split(const std::vector<Eigen::VectorXd>& path, const Eigen::VectorXd& vmax,
              double max_step) {
   Pieces p;
-  for (const auto& q : path) {
-    if (!p.points.empty() && (q - p.points.back()).norm() <= 1e-12) continue;
-    if (!p.points.empty()) {
-      const Eigen::VectorXd from = p.points.back();
-      const Eigen::VectorXd delta = q - from;
-      const int n = std::max(1, static_cast<int>(std::ceil(delta.norm() / max_step)));
-      for (int k = 1; k < n; ++k) p.points.push_back(from + (static_cast<double>(k) / n) * delta);
-    }
-    p.points.push_back(q);
-  }
+  p.points = resample_path(path, max_step);
   for (std::size_t i = 0; i + 1 < p.points.size(); ++i) {
     const Eigen::VectorXd delta = p.points[i + 1] - p.points[i];
     const double l = delta.norm();
@@ -155,6 +146,21 @@ double reachable(const Pieces& p, const Eigen::VectorXd& amax, int prev, double 
 }
 
 }  // namespace
+
+std::vector<Eigen::VectorXd> resample_path(const std::vector<Eigen::VectorXd>& path,
+                                           double max_step) {
+  std::vector<Eigen::VectorXd> out;
+  for (const auto& q : path) {
+    if (!out.empty() && (q - out.back()).norm() <= 1e-12) continue;
+    if (!out.empty()) {
+      const Eigen::VectorXd from = out.back();
+      const int n = std::max(1, static_cast<int>(std::ceil((q - from).norm() / max_step)));
+      for (int k = 1; k < n; ++k) out.push_back(from + (static_cast<double>(k) / n) * (q - from));
+    }
+    out.push_back(q);
+  }
+  return out;
+}
 
 TimedPath time_parameterize_through(const std::vector<Eigen::VectorXd>& path,
                                     const Eigen::VectorXd& max_velocity,

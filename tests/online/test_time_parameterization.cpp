@@ -13,6 +13,19 @@ Eigen::VectorXd limits(double v) {
   return Eigen::VectorXd::Constant(6, v);
 }
 
+// `n` random waypoints in [-1.5, 1.5]^6, the last repeated (a repeated waypoint is dropped).
+std::vector<Eigen::VectorXd> random_path(std::mt19937_64& rng, int n) {
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  std::vector<Eigen::VectorXd> path;
+  for (int i = 0; i < n; ++i) {
+    Eigen::VectorXd q(6);
+    for (int j = 0; j < 6; ++j) q[j] = u(rng);
+    path.push_back(q);
+  }
+  path.push_back(path.back());
+  return path;
+}
+
 }  // namespace
 
 TEST(TimeParameterization, OneLongSegmentTakesTheTrapezoidsClosedFormTime) {
@@ -34,18 +47,11 @@ TEST(TimeParameterization, OneLongSegmentTakesTheTrapezoidsClosedFormTime) {
 
 TEST(TimeParameterization, RandomPathsKeepEveryLimitBetweenSamples) {
   std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(-1.5, 1.5);
   Eigen::VectorXd vmax(6), amax(6);
   vmax << 3.14, 3.14, 3.14, 6.28, 6.28, 6.28;
   amax << 2.97, 2.97, 2.97, 5.93, 5.93, 5.93;
   for (int trial = 0; trial < 50; ++trial) {
-    std::vector<Eigen::VectorXd> path;
-    for (int i = 0; i < 5; ++i) {
-      Eigen::VectorXd q(6);
-      for (int j = 0; j < 6; ++j) q[j] = u(rng);
-      path.push_back(q);
-    }
-    path.push_back(path.back());  // a repeated waypoint is skipped
+    const std::vector<Eigen::VectorXd> path = random_path(rng, 5);
     const double scale = 0.5;
     const auto timed = online::time_parameterize(path, vmax, amax, scale);
     ASSERT_EQ(timed.q.size(), timed.time.size());
@@ -149,18 +155,11 @@ TEST(TimeParameterizationThrough, ACircularArcRunsAtItsCentripetalLimit) {
 
 TEST(TimeParameterizationThrough, RandomPathsKeepEveryLimitFromRestToRest) {
   std::mt19937_64 rng(12);
-  std::uniform_real_distribution<double> u(-1.5, 1.5);
   Eigen::VectorXd vmax(6), amax(6);
   vmax << 3.14, 3.14, 3.14, 6.28, 6.28, 6.28;
   amax << 2.97, 2.97, 2.97, 5.93, 5.93, 5.93;
   for (int trial = 0; trial < 50; ++trial) {
-    std::vector<Eigen::VectorXd> path;
-    for (int i = 0; i < 6; ++i) {
-      Eigen::VectorXd q(6);
-      for (int j = 0; j < 6; ++j) q[j] = u(rng);
-      path.push_back(q);
-    }
-    path.push_back(path.back());  // a repeated waypoint is dropped
+    const std::vector<Eigen::VectorXd> path = random_path(rng, 6);
     const auto timed = online::time_parameterize_through(path, vmax, amax, 0.5, 0.05);
     ASSERT_EQ(timed.q.size(), timed.time.size());
     EXPECT_TRUE(timed.q.front().isApprox(path.front(), 0.0));

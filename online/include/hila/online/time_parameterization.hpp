@@ -20,6 +20,11 @@ TimedPath time_parameterize(const std::vector<Eigen::VectorXd>& path,
                             const Eigen::VectorXd& max_acceleration, double scale = 1.0,
                             int samples_per_segment = 8);
 
+// The path's points with every segment split evenly into pieces no longer than `max_step`
+// (rad), repeated waypoints dropped: what the smoother and time_parameterize_through work on.
+std::vector<Eigen::VectorXd> resample_path(const std::vector<Eigen::VectorXd>& path,
+                                           double max_step);
+
 // Times a path without stopping at its waypoints (a smoothed path's dense waypoints): the path is
 // split into pieces no longer than `max_step` (rad), each traversed at a constant speed, and
 // the speeds are the largest that keep, as the validator measures them, every joint's velocity
