@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "hila/core/joint_box.hpp"
+
 namespace ob = ompl::base;
 
 namespace hila::core::detail {
@@ -38,10 +40,10 @@ std::shared_ptr<ob::RealVectorStateSpace> joint_space(const Arm& arm, double joi
   const int dof = arm.chain.dof();
   auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
   ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
+  const JointBox box = joint_box(arm, joint_range);
   for (int i = 0; i < dof; ++i) {
-    const double home = arm.spec.home[i];
-    double low = std::max(arm.chain.lower_limits()[i], home - joint_range);
-    double high = std::min(arm.chain.upper_limits()[i], home + joint_range);
+    double low = box.lower[i];
+    double high = box.upper[i];
     for (const Eigen::VectorXd* q : {include_a, include_b}) {
       if (q == nullptr) continue;
       low = std::min(low, (*q)[i]);

@@ -31,7 +31,7 @@ class SeededSampler : public ompl::base::StateSampler {
   std::mt19937_64 rng_;
 };
 
-// The arm's joints, each within `joint_range` of home and the limits, widened to include
+// The arm's joints in core::joint_box(arm, joint_range), widened to include
 // `include_a` and `include_b` (valid ends, hence within the limits) when given.
 std::shared_ptr<ompl::base::RealVectorStateSpace> joint_space(const Arm& arm, double joint_range,
                                                               std::uint64_t seed,

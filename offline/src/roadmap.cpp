@@ -19,6 +19,7 @@
 
 #include "hila/core/collision.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/joint_box.hpp"
 #include "hila/core/ompl_state.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/core/soft_finger.hpp"
@@ -147,17 +148,11 @@ class LinearPrm : public og::PRM {
 }  // namespace
 
 Eigen::VectorXd roadmap_lower(const core::Arm& arm, const RoadmapSettings& settings) {
-  return arm.chain.lower_limits()
-      .array()
-      .max(arm.spec.home.array() - settings.joint_range)
-      .matrix();
+  return core::joint_box(arm, settings.joint_range).lower;
 }
 
 Eigen::VectorXd roadmap_upper(const core::Arm& arm, const RoadmapSettings& settings) {
-  return arm.chain.upper_limits()
-      .array()
-      .min(arm.spec.home.array() + settings.joint_range)
-      .matrix();
+  return core::joint_box(arm, settings.joint_range).upper;
 }
 
 std::vector<Attachment> attach_configuration(ArmWorkspace& workspace, const Roadmap& roadmap,

@@ -110,8 +110,11 @@ def arm(side, mount_xyz, mount_r):
     parent = p + "base_link"
     prev_xyz, prev_r = (0, 0, 0), (0, 0, 0)
     for i in range(6):
+        # The elbow cannot pass +-pi (the forearm folds onto the upper arm), so, as in Universal
+        # Robots' own ROS description, its limits are +-pi; the other joints turn twice.
+        turn = math.pi if JOINTS[i] == "elbow_joint" else 2 * math.pi
         out += joint(p + JOINTS[i], "revolute", parent, p + LINKS[i], prev_xyz, prev_r, (0, 0, 1),
-                     (-2 * math.pi, 2 * math.pi, VEL[i], EFFORT[i]))
+                     (-turn, turn, VEL[i], EFFORT[i]))
         out += link(p + LINKS[i], *geoms[i])
         parent = p + LINKS[i]
         prev_xyz, prev_r = (A[i], 0, D[i]), (ALPHA[i], 0, 0)

@@ -19,7 +19,7 @@ struct BridgeSettings {
   // RRT-Connect's step (rad). OMPL's default, a fifth of the space's extent, is several radians
   // for a UR: in a slip- and clearance-constrained space nearly every such step fails.
   double range = 0.4;
-  // Each joint within this much of home (and the limits), as the roadmaps (rad).
+  // Each joint within this much of home (and the limits), as the roadmaps: core::joint_box.
   double joint_range = 3.14159265358979323846;
   // Online queries also stop at a deadline (the check budget keeps offline builds deterministic).
   std::optional<std::chrono::steady_clock::time_point> deadline;

@@ -16,7 +16,7 @@ struct LazyPrmSettings {
   // rad, longest roadmap edge: as long as the stored roadmaps' k-nearest edges (a short one
   // leaves a sparse 6-joint roadmap without edges).
   double range = 3.0;
-  double joint_range = 3.14159265358979323846;  // each joint within this much of home
+  double joint_range = 3.14159265358979323846;  // core::joint_box
   std::uint64_t seed = 1;
   // The roadmap grows without validity checks (lazily), so a check budget alone does not bound
   // a query: it also stops when the roadmap has grown by this many vertices.

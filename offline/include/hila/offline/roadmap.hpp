@@ -27,7 +27,8 @@ struct RoadmapSettings {
   double resolution = 0.05;
   // Each joint's range in the roadmap: within this much of home (and the limits). A UR's +-2 pi
   // joints would otherwise leave the milestones far apart (measured: 28 components, mean edge
-  // 2 rad at 3000 milestones); IK solutions are wrapped nearest home, so goals fall inside.
+  // 2 rad at 3000 milestones); IK solutions are wrapped nearest home, so goals fall inside. A
+  // joint limited to less (the elbow, +-pi) keeps its limits (core::joint_box).
   double joint_range = 3.14159265358979323846;
   std::uint64_t seed = 1;
   // The arm that keeps the suction tool in its hand: the tool moves with it in every check.
@@ -60,7 +61,7 @@ Roadmap build_roadmap(const core::Cell& cell, const std::string& arm,
                       const RoadmapSettings& settings,
                       const std::function<void(int milestones)>& progress = {});
 
-// The joint box the roadmap samples: the limits, narrowed to home +- joint_range.
+// The joint box the roadmap samples (core::joint_box).
 Eigen::VectorXd roadmap_lower(const core::Arm& arm, const RoadmapSettings& settings);
 Eigen::VectorXd roadmap_upper(const core::Arm& arm, const RoadmapSettings& settings);
 
