@@ -97,10 +97,34 @@ GraphPath shortest_path(const RoadmapGraph& graph, const std::vector<bool>& allo
     auto& c = ws.exit_cost[static_cast<std::size_t>(x.node)];
     c = std::min(c, x.cost);
   }
+  const bool same_exits =
+      ws.heuristic_graph == &graph && ws.heuristic.size() == static_cast<std::size_t>(n) &&
+      ws.heuristic_generation != 0 &&
+      std::equal(targets.begin(), targets.end(), ws.heuristic_exits.begin(),
+                 ws.heuristic_exits.end(), [](const GraphEndpoint& a, const GraphEndpoint& b) {
+                   return a.node == b.node && a.cost == b.cost;
+                 });
+  if (!same_exits) {
+    if (ws.heuristic.size() != static_cast<std::size_t>(n)) {
+      ws.heuristic.assign(static_cast<std::size_t>(n), kInfinity);
+      ws.heuristic_stamp.assign(static_cast<std::size_t>(n), 0);
+      ws.heuristic_generation = 0;
+    }
+    if (++ws.heuristic_generation == 0) {  // wrapped
+      std::fill(ws.heuristic_stamp.begin(), ws.heuristic_stamp.end(), 0);
+      ws.heuristic_generation = 1;
+    }
+    ws.heuristic_graph = &graph;
+    ws.heuristic_exits = targets;
+  }
   auto heuristic = [&](int v) {
+    const auto i = static_cast<std::size_t>(v);
+    if (ws.heuristic_stamp[i] == ws.heuristic_generation) return ws.heuristic[i];
     double h = kInfinity;
     const Eigen::VectorXd& q = graph.node(v);
     for (const auto& x : targets) h = std::min(h, (q - graph.node(x.node)).norm() + x.cost);
+    ws.heuristic_stamp[i] = ws.heuristic_generation;
+    ws.heuristic[i] = h;
     return h;
   };
   auto greater = [](const std::pair<double, int>& a, const std::pair<double, int>& b) {

@@ -254,6 +254,56 @@ TEST(RoadmapGraph, ReusedWorkspaceMatchesFreshWorkspace) {
   EXPECT_EQ(compared, 200);
 }
 
+// A lazy planner's loop: the same query searched again after each edge of the found path is
+// dropped, on one workspace (which keeps the heuristic while the exits stay the same), against
+// a fresh workspace and Floyd-Warshall every time; then a second graph of the same size with
+// the same exits on that workspace (its heuristic must not be reused).
+TEST(RoadmapGraph, RepeatedSearchesWithDroppedEdgesMatchFreshSearches) {
+  std::mt19937_64 rng(91);
+  core::GraphSearchWorkspace shared;
+  int searches = 0, dropped = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    SCOPED_TRACE("graph " + std::to_string(trial));
+    Problem p = random_problem(rng);
+    const core::RoadmapGraph graph(p.nodes, p.edges);
+    const Query q = random_query(rng, graph.node_count());
+    for (int round = 0; round < 20; ++round) {
+      core::GraphSearchWorkspace fresh;
+      const auto a = core::shortest_path(graph, p.allowed, q.entries, q.exits, shared);
+      const auto b = core::shortest_path(graph, p.allowed, q.entries, q.exits, fresh);
+      ++searches;
+      ASSERT_EQ(a.found, b.found);
+      ASSERT_EQ(a.found, reference_cost(p, q) < kInf);
+      if (!a.found) break;
+      EXPECT_EQ(a.nodes, b.nodes);
+      EXPECT_EQ(a.expanded, b.expanded);
+      EXPECT_NEAR(a.cost, reference_cost(p, q), 1e-9);
+      if (a.nodes.size() < 2) break;
+      // Drop every allowed edge joining the path's middle pair, as an invalidated edge.
+      const std::size_t i = a.nodes.size() / 2;
+      const std::pair<int, int> hop{a.nodes[i - 1], a.nodes[i]};
+      for (std::size_t e = 0; e < p.edges.size(); ++e) {
+        if (p.edges[e] == hop || p.edges[e] == std::make_pair(hop.second, hop.first)) {
+          dropped += p.allowed[e] ? 1 : 0;
+          p.allowed[e] = false;
+        }
+      }
+    }
+    // Same node count, same exits, other coordinates.
+    Problem moved = p;
+    for (auto& q_node : moved.nodes) q_node *= -2.0;
+    const core::RoadmapGraph other(moved.nodes, moved.edges);
+    core::GraphSearchWorkspace fresh;
+    const auto a = core::shortest_path(other, moved.allowed, q.entries, q.exits, shared);
+    const auto b = core::shortest_path(other, moved.allowed, q.entries, q.exits, fresh);
+    ASSERT_EQ(a.found, b.found);
+    EXPECT_EQ(a.nodes, b.nodes);
+    EXPECT_EQ(a.expanded, b.expanded);
+  }
+  EXPECT_GT(searches, 100);
+  EXPECT_GT(dropped, 50);
+}
+
 TEST(RoadmapGraph, NeverUsesDisallowedEdge) {
   // A square 0-1-2-3 with the diagonal 0-2 short-cutting it; the diagonal is disallowed, so the
   // path must go around (length 2) instead of across (sqrt 2).

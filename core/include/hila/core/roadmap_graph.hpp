@@ -69,6 +69,14 @@ class GraphSearchWorkspace {
   std::vector<std::uint32_t> closed;
   std::vector<std::pair<double, int>> heap;
   std::uint32_t generation = 0;
+  // The heuristic per node, kept while the exits stay the same: a lazy planner searches the
+  // same query again after each invalidated edge, and the nearest-exit distance over dozens of
+  // exits is most of a search's time otherwise.
+  std::vector<double> heuristic;
+  std::vector<std::uint32_t> heuristic_stamp;
+  std::uint32_t heuristic_generation = 0;
+  const RoadmapGraph* heuristic_graph = nullptr;  // graphs never change once built
+  std::vector<GraphEndpoint> heuristic_exits;
 };
 
 // A* over the edges whose `allowed` bit is set (size edge_count), from any entry to any exit,
