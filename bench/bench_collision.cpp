@@ -7,6 +7,7 @@
 
 #include <random>
 
+#include "hila/core/arm_poser.hpp"
 #include "hila/core/cell.hpp"
 #include "hila/core/collision.hpp"
 #include "hila/core/generic_ik.hpp"
@@ -71,6 +72,23 @@ void BM_FullArmCheckColliding(benchmark::State& state) {
   check_loop(state, problem().colliding_configs, arm_query);
 }
 BENCHMARK(BM_FullArmCheckColliding);
+
+// The same query with only the moving arm re-posed (core::ArmPoser), as the online planner and
+// validator check each sample: the other arm, the torso and the human stay where they are.
+void BM_ArmPoserCheckFree(benchmark::State& state) {
+  const auto& p = problem();
+  core::CollisionData data(p.scene.model);
+  core::set_cell_state(*p.cell, p.scene, data, p.cell->home_configuration(),
+                       p.cell->human_neutral());
+  core::ArmPoser poser(*p.cell, p.scene, p.cell->arm("left"));
+  poser.pose_robot(data, p.cell->home_configuration());
+  std::size_t i = 0;
+  for (auto _ : state) {
+    poser.pose_arm(data, p.free_configs[i++ % p.free_configs.size()]);
+    benchmark::DoNotOptimize(arm_query(data));
+  }
+}
+BENCHMARK(BM_ArmPoserCheckFree);
 
 // Every pair in the scene (both arms, human static) through the broad-phase trees.
 void BM_WholeSceneCheckFree(benchmark::State& state) {

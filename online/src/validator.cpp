@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "hila/core/arm_poser.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 
@@ -103,6 +104,9 @@ ValidationReport validate_motion(const World& world, core::CollisionData& data,
   if (!motion.holds_board) data.set_body_pose(stage.board, motion.board_world);
   // In the resting arm's hand (posed once) or on the table; a moving tool follows each sample.
   world.place_tool(data, robot_q, motion.tool_in_hand, motion.tool_world);
+  // The rest of the robot stands still: each sample moves this arm's links only.
+  core::ArmPoser poser(cell, stage.cell, *arm);
+  poser.pose_robot(data, robot_q);
   const Eigen::Vector3d down(0.0, 0.0, -1.0);
   auto check = [&](const Eigen::VectorXd& q, double t) {
     ++report.samples;
@@ -110,7 +114,7 @@ ValidationReport validate_motion(const World& world, core::CollisionData& data,
       violation.add("joint_limit", t, "outside the arm's joint limits");
     }
     cell.set_arm(robot_q, *arm, q);
-    core::set_robot_state(cell, stage.cell, data, robot_q);
+    poser.pose_arm(data, robot_q);
     const core::Pose tcp = base * arm->chain.fk(q);
     if (moves_tool) core::set_tool_held(cell, stage, data, tcp);
     if (motion.holds_board) {

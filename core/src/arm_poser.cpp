@@ -1,0 +1,47 @@
+#include "hila/core/arm_poser.hpp"
+
+#include <algorithm>
+#include <cassert>
+
+namespace hila::core {
+
+ArmPoser::ArmPoser(const Cell& cell, const CellScene& scene, const Arm& arm)
+    : robot_(cell.robot()), bodies_(scene.robot) {
+  std::vector<int> stack{robot_.link_index(arm.spec.base_link)};
+  while (!stack.empty()) {
+    const int link = stack.back();
+    stack.pop_back();
+    for (const int j : robot_.links()[static_cast<std::size_t>(link)].child_joints) {
+      joints_.push_back(j);
+      const int child = robot_.joints()[static_cast<std::size_t>(j)].child_link;
+      if (bodies_.link_to_body[static_cast<std::size_t>(child)] >= 0) {
+        link_bodies_.emplace_back(child, bodies_.link_to_body[static_cast<std::size_t>(child)]);
+      }
+      stack.push_back(child);
+    }
+  }
+  // The model's joint order has every parent before its children (RobotModel::link_poses).
+  std::sort(joints_.begin(), joints_.end());
+}
+
+void ArmPoser::pose_robot(CollisionData& data, const Eigen::VectorXd& robot_q) {
+  robot_.link_poses(robot_q, poses_);
+  set_robot_pose(data, bodies_, poses_);
+}
+
+void ArmPoser::pose_arm(CollisionData& data, const Eigen::VectorXd& robot_q) {
+  assert(poses_.size() == robot_.links().size());  // pose_robot() first
+  for (const int j : joints_) {
+    const Joint& joint = robot_.joints()[static_cast<std::size_t>(j)];
+    Pose child = poses_[static_cast<std::size_t>(joint.parent_link)] * joint.origin;
+    if (joint.type != JointType::Fixed) {
+      child = child * joint_motion(joint, robot_.joint_value(robot_q, j));
+    }
+    poses_[static_cast<std::size_t>(joint.child_link)] = child;
+  }
+  for (const auto& [link, body] : link_bodies_) {
+    data.set_body_pose(body, poses_[static_cast<std::size_t>(link)]);
+  }
+}
+
+}  // namespace hila::core
