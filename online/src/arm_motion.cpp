@@ -61,6 +61,7 @@ ArmMotionPlanner::ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap
       settings_(settings),
       lazy_prm_(lazy_prm),
       data_(world.make_data()),
+      poser_(world.cell(), world.stage().cell, arm_),
       base_(core::arm_base_in_world(world.cell(), arm_)) {
   // The LazyPRM baseline keeps its roadmap outside the planner: without one it cannot run.
   assert(settings_.planner != MotionPlannerKind::kLazyPrm || lazy_prm_ != nullptr);
@@ -80,18 +81,41 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   if (moves_tool_)
     moving_.insert(moving_.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
   if (held_.held) moving_.push_back(stage.board);
-  core::set_robot_state(cell, stage.cell, data_, robot_q_);
+  poser_.pose_robot(data_, robot_q_);
   world_.place_tool(data_, robot_q_, request.tool_in_hand, request.tool_world);
   if (!held_.held) data_.set_body_pose(stage.board, request.board_world);
-  // No filter: every edge (a held board's slip and clearance are then checked lazily, as all).
+  // The verdicts found so far hold while everything validity depends on is posed the same.
+  std::vector<double> context(robot_q_.data(), robot_q_.data() + robot_q_.size());
+  auto append_pose = [&context](const core::Pose& p) {
+    context.insert(context.end(), p.matrix().data(), p.matrix().data() + 16);
+  };
+  context.insert(context.end(), {held_.held ? 1.0 : 0.0, moves_tool_ ? 1.0 : 0.0, resolution_});
+  if (held_.held) {
+    append_pose(held_.board_in_tcp);
+    context.insert(context.end(), {held_.jaw, held_.theta_c_deg});
+    context.insert(context.end(), held_.axis_tcp.data(), held_.axis_tcp.data() + 3);
+    context.insert(context.end(), held_.lever_tcp.data(), held_.lever_tcp.data() + 3);
+  } else {
+    append_pose(request.board_world);
+  }
+  context.push_back(request.tool_in_hand ? 1.0 : 0.0);
+  if (!request.tool_in_hand) append_pose(request.tool_world);
   const std::size_t edges = roadmap_.record.edges.size();
+  if (context != context_ || edge_state_.size() != edges) {
+    context_ = std::move(context);
+    node_state_.assign(roadmap_.record.nodes.size(), -1);
+    edge_state_.assign(edges, -1);
+  }
+  // No filter: every edge (a held board's slip and clearance are then checked lazily, as all).
   assert(request.filter == nullptr || request.filter->size() == edges);
   if (request.filter != nullptr) {
     allowed_ = *request.filter;
   } else {
     allowed_.assign(edges, true);
   }
-  node_state_.assign(roadmap_.record.nodes.size(), -1);
+  for (std::size_t e = 0; e < edges; ++e) {
+    if (edge_state_[e] == 0) allowed_[e] = false;
+  }
   checked_ = 0;
   invalidated_ = 0;
 }
@@ -116,7 +140,7 @@ ArmMotionPlanner::Verdict ArmMotionPlanner::check(const Eigen::VectorXd& q,
   const core::Cell& cell = world_.cell();
   const core::StageScene& stage = world_.stage();
   cell.set_arm(robot_q_, arm_, q);
-  core::set_robot_state(cell, stage.cell, data_, robot_q_);
+  poser_.pose_arm(data_, robot_q_);
   if (moves_tool_) core::set_tool_held(cell, stage, data_, tcp);
   if (held_.held) data_.set_body_pose(stage.board, tcp * held_.board_in_tcp);
   return core::in_collision(stage.cell.model, data_, moving_, pair) ? Verdict::kCollides
@@ -145,15 +169,21 @@ bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::Vect
 }
 
 bool ArmMotionPlanner::edge_valid(int edge) {
+  auto& verdict = edge_state_[static_cast<std::size_t>(edge)];
+  if (verdict >= 0) return verdict == 1;
   const auto [u, v] = roadmap_.record.edges[static_cast<std::size_t>(edge)];
+  verdict = 0;
   for (const int n : {u, v}) {
     auto& state = node_state_[static_cast<std::size_t>(n)];
     if (state < 0) state = valid(roadmap_.record.nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
     if (state == 0) return false;
   }
   ++checked_;
-  return segment_valid(roadmap_.record.nodes[static_cast<std::size_t>(u)],
-                       roadmap_.record.nodes[static_cast<std::size_t>(v)]);
+  verdict = segment_valid(roadmap_.record.nodes[static_cast<std::size_t>(u)],
+                          roadmap_.record.nodes[static_cast<std::size_t>(v)])
+                ? 1
+                : 0;
+  return verdict == 1;
 }
 
 // The stored path re-validated for the scene, joined to the start and goal by straight segments
@@ -319,7 +349,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   // the roadmap is entered from the goal side only when the direct segment failed.
   const auto entries = attach(request.start);
   const auto exits = entries.empty() ? std::vector<core::GraphEndpoint>{} : attach(request.goal);
-  while (!entries.empty() && !exits.empty() && r.searches < settings_.max_searches) {
+  const int max_searches = request.max_searches > 0 ? request.max_searches : settings_.max_searches;
+  while (!entries.empty() && !exits.empty() && r.searches < max_searches) {
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the search");
     ++r.searches;
     const core::GraphPath path =

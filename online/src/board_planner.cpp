@@ -264,6 +264,7 @@ class Run {
       MotionRequest staged = request;
       staged.goal = stagings[i];
       staged.allow_bridge = false;
+      staged.max_searches = settings_.motion.staging_searches;
       MotionResult via_staging = planner.plan(staged);
       if (!via_staging.solved() || !planner.segment_valid(stagings[i], request.goal)) continue;
       via_staging.path.push_back(request.goal);

@@ -162,3 +162,61 @@ TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
     EXPECT_TRUE(result.path.empty());
   }
 }
+
+// The planner keeps the edges it found blocked while the scene is posed the same: a second
+// request finds the same path without invalidating them again, and a request posing the rest
+// of the robot differently starts over (matching a fresh planner).
+TEST(ArmMotion, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame) {
+  const auto& cell = *test::reference_cell();
+  const online::Scene nominal = online::nominal_scene(cell, cabinet());
+  const online::World nominal_world(cell, cabinet(), nominal, "top");
+  online::ArmMotionPlanner probe(nominal_world, left_roadmap(), "left");
+  online::MotionResult before;
+  Eigen::VectorXd a, b;
+  for (const auto& pair : far_pairs(20)) {
+    before = probe.plan(request(pair.first, pair.second));
+    if (before.solved() && before.via == "roadmap" && before.path.size() >= 4) {
+      a = pair.first;
+      b = pair.second;
+      break;
+    }
+  }
+  ASSERT_TRUE(before.solved() && before.via == "roadmap");
+  const core::Arm& left = cell.arm("left");
+  const core::Pose tcp =
+      core::arm_base_in_world(cell, left) * left.chain.fk(before.path[before.path.size() / 2]);
+  online::Scene blocked = nominal;
+  blocked.obstacles.push_back(crate_at(tcp.translation(), 0.08));
+  const online::World world(cell, cabinet(), blocked, "top");
+
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  const auto first = planner.plan(request(a, b));
+  ASSERT_TRUE(first.solved()) << first.reason;
+  ASSERT_EQ(first.via, "roadmap") << "the crate should cut single edges, not the roadmap";
+  ASSERT_GT(first.edges_invalidated, 0);
+  const auto again = planner.plan(request(a, b));
+  ASSERT_TRUE(again.solved());
+  EXPECT_EQ(again.edges_invalidated, 0);
+  EXPECT_LT(again.searches, first.searches);
+  ASSERT_EQ(again.path.size(), first.path.size());
+  for (std::size_t i = 0; i < again.path.size(); ++i) {
+    EXPECT_TRUE(again.path[i].isApprox(first.path[i], 0.0)) << "waypoint " << i;
+  }
+
+  // The right arm elsewhere: a different scene for the left arm's checks.
+  online::MotionRequest moved = request(a, b);
+  Eigen::VectorXd right_q = cell.arm("right").spec.home;
+  right_q[0] += 0.3;
+  cell.set_arm(moved.robot_q, cell.arm("right"), right_q);
+  const auto relearned = planner.plan(moved);
+  online::ArmMotionPlanner fresh(world, left_roadmap(), "left");
+  const auto reference = fresh.plan(moved);
+  ASSERT_EQ(relearned.status, reference.status);
+  EXPECT_GT(reference.edges_invalidated, 0) << "the crate still cuts edges";
+  EXPECT_EQ(relearned.edges_invalidated, reference.edges_invalidated);
+  EXPECT_EQ(relearned.searches, reference.searches);
+  ASSERT_EQ(relearned.path.size(), reference.path.size());
+  for (std::size_t i = 0; i < relearned.path.size(); ++i) {
+    EXPECT_TRUE(relearned.path[i].isApprox(reference.path[i], 0.0)) << "waypoint " << i;
+  }
+}

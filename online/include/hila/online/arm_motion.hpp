@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "hila/core/arm_poser.hpp"
 #include "hila/core/collision.hpp"
 #include "hila/core/lazy_prm.hpp"
 #include "hila/core/roadmap_graph.hpp"
@@ -55,6 +56,9 @@ struct MotionRequest {
   // Every segment at MotionSettings::held_resolution even with nothing held: a retry after the
   // validator found a thin collision between the empty arm's coarser samples.
   bool fine_checks = false;
+  // A* runs allowed (0: MotionSettings::max_searches), e.g. fewer for a staging try, where a
+  // bridge is the better tool once the roadmap around the goal proves this blocked.
+  int max_searches = 0;
 };
 
 enum class MotionStatus { kSolved, kInvalidStart, kInvalidGoal, kNoPath, kTimeout };
@@ -85,6 +89,7 @@ struct MotionSettings {
   int attach_neighbours = 40;  // roadmap nodes tried per end
   int attachments = 6;         // valid attachments kept per end
   int max_searches = 200;
+  int staging_searches = 20;  // per staging try (MotionRequest::max_searches)
   // Segment checks while holding a board: as fine as the validator's (rad), since a long board
   // sweeps far between the roadmap's 0.05 rad samples; the empty arm uses the roadmap's.
   double held_resolution = 0.01;
@@ -131,6 +136,7 @@ class ArmMotionPlanner {
   MotionSettings settings_;
   core::LazyPrmPlanner* lazy_prm_ = nullptr;
   core::CollisionData data_;
+  core::ArmPoser poser_;
   core::GraphSearchWorkspace search_;
   std::vector<int> moving_;
   core::Pose base_;
@@ -139,7 +145,13 @@ class ArmMotionPlanner {
   bool moves_tool_ = false;
   double resolution_ = 0.05;  // segment checks for the current request
   std::vector<bool> allowed_;
-  std::vector<signed char> node_state_;  // -1 unknown, 0 blocked, 1 clear (this request)
+  // Verdicts of roadmap nodes and edges: -1 unknown, 0 blocked, 1 clear. They depend only on
+  // what prepare() poses (the rest of the robot, what is held, the tool, the board, the
+  // resolution), so they are kept across requests that pose the same: the retries of one
+  // motion (stagings, other goals sharing a stage) do not re-learn the same blocked edges.
+  std::vector<signed char> node_state_;
+  std::vector<signed char> edge_state_;
+  std::vector<double> context_;  // what the verdicts were found under
   int checked_ = 0;
   int invalidated_ = 0;
 };
