@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <optional>
 #include <tuple>
 
@@ -114,10 +115,13 @@ class Run {
                          settings.motion, baseline(lazy_prm, suction_)),
         receiving_planner_(world_, model.roadmap(receiving_.spec.name), receiving_.spec.name,
                            settings.motion, baseline(lazy_prm, receiving_)),
-        validation_data_(world_.make_data()),
         board_initial_(scene.initial_pose(part)),
         opening_tcp_(cell_.spec().gripper.opening_axis.normalized()),
         approach_tcp_(cell_.spec().gripper.approach_axis.normalized()) {
+    for (int t = 0; t < std::max(1, settings.validation_threads); ++t) {
+      validation_data_.push_back(std::make_unique<core::CollisionData>(world_.make_data()));
+      validation_threads_.push_back(validation_data_.back().get());
+    }
     const db::Database& db = model.database();
     for (const auto& g : db.robot_grasps(record.id)) robot_grasps_[g.id] = g;
     for (const auto& g : db.suction_grasps(record.id)) suction_grasps_[g.id] = g;
@@ -349,7 +353,7 @@ class Run {
     if (request.held.held && &arm == &receiving_) {
       cell_.set_jaw(check.robot_q, arm, request.held.jaw);
     }
-    report = validate_motion(world_, validation_data_, check, settings_.validator);
+    report = validate_motion(world_, validation_threads_, check, settings_.validator);
     return report.valid();
   }
 
@@ -834,7 +838,8 @@ class Run {
   const core::Arm& receiving_;
   ArmMotionPlanner suction_planner_;
   ArmMotionPlanner receiving_planner_;
-  core::CollisionData validation_data_;
+  std::vector<std::unique_ptr<core::CollisionData>> validation_data_;  // one per thread
+  std::vector<core::CollisionData*> validation_threads_;
   core::Pose board_initial_;
   Eigen::Vector3d opening_tcp_;
   Eigen::Vector3d approach_tcp_;

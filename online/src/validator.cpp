@@ -1,8 +1,11 @@
 #include "hila/online/validator.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <sstream>
+#include <system_error>
+#include <thread>
 
 #include "hila/core/arm_poser.hpp"
 #include "hila/core/soft_finger.hpp"
@@ -33,10 +36,93 @@ std::string joint_text(int joint, double value, double limit, const char* unit) 
   return s.str();
 }
 
+struct Sample {
+  Eigen::VectorXd q;
+  double time = 0.0;
+};
+
+// What one thread finds in its samples: the first violation of each kind.
+struct SampleFindings {
+  std::vector<Violation> violations;
+  double worst_slip_deg = 0.0;
+};
+
+// Below this many samples per thread a second thread costs more than it saves.
+constexpr std::size_t kSamplesPerThread = 64;
+
+int sample_kind_order(const std::string& kind) {
+  return kind == "joint_limit" ? 0 : kind == "slip" ? 1 : 2;
+}
+
+// The whole robot posed by FK with the tool and the board (held or standing) at samples
+// [begin, end), everything moving checked against everything else, and a held board's slip.
+void check_samples(const World& world, core::CollisionData& data, const Motion& motion,
+                   const ValidatorSettings& settings, const core::Arm& arm, std::size_t arm_index,
+                   const std::vector<Sample>& samples, std::size_t begin, std::size_t end,
+                   SampleFindings& found) {
+  ValidationReport local;
+  Reporter violation(local);
+  const core::Cell& cell = world.cell();
+  const core::StageScene& stage = world.stage();
+  const bool moves_tool = motion.tool_in_hand && static_cast<int>(arm_index) == stage.suction_arm;
+  std::vector<int> moving = stage.cell.arm_bodies[arm_index];
+  if (moves_tool) moving.insert(moving.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
+  if (motion.holds_board) moving.push_back(stage.board);
+  const core::Pose base = core::arm_base_in_world(cell, arm);
+  Eigen::VectorXd robot_q = motion.robot_q.size() == 0 ? cell.home_configuration() : motion.robot_q;
+  if (!motion.holds_board) data.set_body_pose(stage.board, motion.board_world);
+  // In the resting arm's hand (posed once) or on the table; a moving tool follows each sample.
+  world.place_tool(data, robot_q, motion.tool_in_hand, motion.tool_world);
+  // The rest of the robot stands still: each sample moves this arm's links only.
+  core::ArmPoser poser(cell, stage.cell, arm);
+  poser.pose_robot(data, robot_q);
+  const Eigen::Vector3d down(0.0, 0.0, -1.0);
+  for (std::size_t i = begin; i < end; ++i) {
+    const Eigen::VectorXd& q = samples[i].q;
+    const double t = samples[i].time;
+    if (!arm.chain.within_limits(q, settings.limit_tolerance)) {
+      violation.add("joint_limit", t, "outside the arm's joint limits");
+    }
+    cell.set_arm(robot_q, arm, q);
+    poser.pose_arm(data, robot_q);
+    const core::Pose tcp = base * arm.chain.fk(q);
+    if (moves_tool) core::set_tool_held(cell, stage, data, tcp);
+    if (motion.holds_board) {
+      data.set_body_pose(stage.board, tcp * motion.board_in_tcp);
+      if (motion.theta_c_deg < 90.0) {
+        const double slip = core::slip_angle_deg(tcp.linear() * motion.slip_axis_tcp,
+                                                 tcp.linear() * motion.slip_lever_tcp, down);
+        found.worst_slip_deg = std::max(found.worst_slip_deg, slip);
+        if (slip > motion.theta_c_deg + settings.slip_tolerance_deg) {
+          std::ostringstream s;
+          s.precision(4);
+          s << "slip angle " << slip << " deg against theta_c " << motion.theta_c_deg << " deg";
+          violation.add("slip", t, s.str());
+        }
+      }
+    }
+    core::CollisionPair pair;
+    const bool contact_allowed = motion.start_in_contact && i == 0;
+    if (!contact_allowed && core::in_collision(stage.cell.model, data, moving, &pair)) {
+      violation.add("collision", t,
+                    stage.cell.model.body_name(pair.body_a) + " vs " +
+                        stage.cell.model.body_name(pair.body_b));
+    }
+  }
+  found.violations = std::move(local.violations);
+}
+
 }  // namespace
 
 ValidationReport validate_motion(const World& world, core::CollisionData& data,
                                  const Motion& motion, const ValidatorSettings& settings) {
+  std::vector<core::CollisionData*> one{&data};
+  return validate_motion(world, one, motion, settings);
+}
+
+ValidationReport validate_motion(const World& world, const std::vector<core::CollisionData*>& data,
+                                 const Motion& motion, const ValidatorSettings& settings) {
+  assert(!data.empty());
   ValidationReport report;
   Reporter violation(report);
   const core::Cell& cell = world.cell();
@@ -93,53 +179,8 @@ ValidationReport validate_motion(const World& world, core::CollisionData& data,
     previous_velocity = v;
   }
 
-  // Dense samples: full-robot FK, the tool and the board, everything moving checked.
-  const core::StageScene& stage = world.stage();
-  const bool moves_tool = motion.tool_in_hand && static_cast<int>(arm_index) == stage.suction_arm;
-  std::vector<int> moving = stage.cell.arm_bodies[arm_index];
-  if (moves_tool) moving.insert(moving.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
-  if (motion.holds_board) moving.push_back(stage.board);
-  const core::Pose base = core::arm_base_in_world(cell, *arm);
-  Eigen::VectorXd robot_q = motion.robot_q.size() == 0 ? cell.home_configuration() : motion.robot_q;
-  if (!motion.holds_board) data.set_body_pose(stage.board, motion.board_world);
-  // In the resting arm's hand (posed once) or on the table; a moving tool follows each sample.
-  world.place_tool(data, robot_q, motion.tool_in_hand, motion.tool_world);
-  // The rest of the robot stands still: each sample moves this arm's links only.
-  core::ArmPoser poser(cell, stage.cell, *arm);
-  poser.pose_robot(data, robot_q);
-  const Eigen::Vector3d down(0.0, 0.0, -1.0);
-  auto check = [&](const Eigen::VectorXd& q, double t) {
-    ++report.samples;
-    if (!arm->chain.within_limits(q, settings.limit_tolerance)) {
-      violation.add("joint_limit", t, "outside the arm's joint limits");
-    }
-    cell.set_arm(robot_q, *arm, q);
-    poser.pose_arm(data, robot_q);
-    const core::Pose tcp = base * arm->chain.fk(q);
-    if (moves_tool) core::set_tool_held(cell, stage, data, tcp);
-    if (motion.holds_board) {
-      data.set_body_pose(stage.board, tcp * motion.board_in_tcp);
-      if (motion.theta_c_deg < 90.0) {
-        const double slip = core::slip_angle_deg(tcp.linear() * motion.slip_axis_tcp,
-                                                 tcp.linear() * motion.slip_lever_tcp, down);
-        report.worst_slip_deg = std::max(report.worst_slip_deg, slip);
-        if (slip > motion.theta_c_deg + settings.slip_tolerance_deg) {
-          std::ostringstream s;
-          s.precision(4);
-          s << "slip angle " << slip << " deg against theta_c " << motion.theta_c_deg << " deg";
-          violation.add("slip", t, s.str());
-        }
-      }
-    }
-    core::CollisionPair pair;
-    const bool contact_allowed = motion.start_in_contact && report.samples == 1;
-    if (!contact_allowed && core::in_collision(stage.cell.model, data, moving, &pair)) {
-      violation.add("collision", t,
-                    stage.cell.model.body_name(pair.body_a) + " vs " +
-                        stage.cell.model.body_name(pair.body_b));
-    }
-  };
-  check(motion.q.front(), motion.time.front());
+  // Dense samples (time order): no farther apart than the resolution.
+  std::vector<Sample> samples{{motion.q.front(), motion.time.front()}};
   for (std::size_t i = 1; i < n; ++i) {
     const Eigen::VectorXd& a = motion.q[i - 1];
     const Eigen::VectorXd& b = motion.q[i];
@@ -147,9 +188,46 @@ ValidationReport validate_motion(const World& world, core::CollisionData& data,
         std::max(1, static_cast<int>(std::ceil((b - a).norm() / settings.resolution)));
     for (int k = 1; k <= steps; ++k) {
       const double s = static_cast<double>(k) / steps;
-      check(a + s * (b - a), motion.time[i - 1] + s * (motion.time[i] - motion.time[i - 1]));
+      samples.push_back(
+          {a + s * (b - a), motion.time[i - 1] + s * (motion.time[i] - motion.time[i - 1])});
     }
   }
+  report.samples = static_cast<int>(samples.size());
+
+  // Split over the workspaces' threads; each part is checked whole, so the merged report does
+  // not depend on the split.
+  const std::size_t threads = samples.size() < kSamplesPerThread
+                                  ? 1
+                                  : std::min(data.size(), samples.size() / kSamplesPerThread);
+  std::vector<SampleFindings> found(threads);
+  auto part = [&](std::size_t t) {
+    const std::size_t begin = samples.size() * t / threads;
+    const std::size_t end = samples.size() * (t + 1) / threads;
+    check_samples(world, *data[t], motion, settings, *arm, arm_index, samples, begin, end,
+                  found[t]);
+  };
+  std::vector<std::thread> workers;
+  for (std::size_t t = 1; t < threads; ++t) {
+    try {
+      workers.emplace_back(part, t);
+    } catch (const std::system_error&) {
+      part(t);  // no thread to be had: this one does it
+    }
+  }
+  part(0);
+  for (auto& w : workers) w.join();
+  std::vector<Violation> at_samples;
+  for (const auto& f : found) {
+    at_samples.insert(at_samples.end(), f.violations.begin(), f.violations.end());
+    report.worst_slip_deg = std::max(report.worst_slip_deg, f.worst_slip_deg);
+  }
+  // As a single pass meets them: by time, and within a sample limits, slip, then collision.
+  std::stable_sort(
+      at_samples.begin(), at_samples.end(), [](const Violation& a, const Violation& b) {
+        return a.time < b.time ||
+               (a.time == b.time && sample_kind_order(a.kind) < sample_kind_order(b.kind));
+      });
+  for (const auto& v : at_samples) violation.add(v.kind, v.time, v.detail);
   return report;
 }
 

@@ -45,10 +45,18 @@ struct Fixture {
   online::Scene scene = online::nominal_scene(*cell, cabinet());
   const core::Arm& left = cell->arm("left");
 
+  // One thread's report, checked against the same validation split over two threads.
   online::ValidationReport run(const online::Motion& m, const online::Scene& s) const {
     const online::World world(*cell, cabinet(), s, "top");
     core::CollisionData data = world.make_data();
-    return online::validate_motion(world, data, m);
+    const online::ValidationReport one = online::validate_motion(world, data, m);
+    core::CollisionData a = world.make_data();
+    core::CollisionData b = world.make_data();
+    const online::ValidationReport two = online::validate_motion(world, {&a, &b}, m);
+    EXPECT_EQ(describe(two), describe(one)) << "two threads";
+    EXPECT_EQ(two.samples, one.samples);
+    EXPECT_EQ(two.worst_slip_deg, one.worst_slip_deg);
+    return one;
   }
   online::ValidationReport run(const online::Motion& m) const { return run(m, scene); }
 
@@ -91,6 +99,24 @@ TEST(Validator, AMotionPushedIntoTheTableIsACollisionWithTheTable) {
     if (v.kind == "collision") detail = v.detail;
   }
   EXPECT_NE(detail.find("table"), std::string::npos) << detail;
+}
+
+// A long motion (split over two threads by run()) that reaches into the table in its second
+// half: both splits report the same first contact, after the clear first half.
+TEST(Validator, ALongMotionSplitOverThreadsReportsTheSameFirstContact) {
+  Fixture f;
+  const Eigen::VectorXd above = f.left_at({0.40, 0.20, 1.30});
+  const Eigen::VectorXd inside = f.left_at({0.40, 0.20, 1.084});
+  const online::Motion m = slow_motion("left", {f.left.spec.home, above, inside, above});
+  const auto report = f.run(m);
+  ASSERT_GE(report.samples, 256) << "long enough for two threads";
+  ASSERT_TRUE(has(report, "collision")) << describe(report);
+  for (const auto& v : report.violations) {
+    if (v.kind == "collision") {
+      EXPECT_GT(v.time, m.time[1]);
+      EXPECT_LT(v.time, m.time[2]);
+    }
+  }
 }
 
 TEST(Validator, AJointJumpIsAVelocityViolation) {

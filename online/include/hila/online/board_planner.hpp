@@ -29,6 +29,8 @@ struct BoardPlanSettings {
       0.05;  // rad: the timed trajectory's longest piece (time_parameterize_through)
   MotionSettings motion;
   ValidatorSettings validator;
+  // The validator's dense pass is split over this many threads (the same report as one).
+  int validation_threads = 2;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.

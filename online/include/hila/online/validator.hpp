@@ -54,8 +54,12 @@ struct ValidationReport {
 // waypoints) against the arm's limits, and at samples no farther apart than the resolution the
 // whole robot posed by FK with the tool and the board (held or standing), checked for collision
 // against everything in the world, and a held board's slip angle against theta_c. `data` is the
-// caller's (World::make_data()); it is left posed at the last sample.
+// caller's (World::make_data()).
 ValidationReport validate_motion(const World& world, core::CollisionData& data,
+                                 const Motion& motion, const ValidatorSettings& settings = {});
+// The same, its samples split over one thread per CollisionData (each the caller's, from
+// World::make_data(), none shared with another thread): the same report as one thread's.
+ValidationReport validate_motion(const World& world, const std::vector<core::CollisionData*>& data,
                                  const Motion& motion, const ValidatorSettings& settings = {});
 
 }  // namespace hila::online
