@@ -17,6 +17,16 @@ namespace og = ompl::geometric;
 
 namespace hila::core {
 
+namespace {
+
+// Thrown by the validity checker once a query is out of checks or time. OMPL's LazyPRM only
+// tests its termination condition between roadmap growth steps; its loop of search, lazy
+// check and removal runs to the end however long that takes (it overran a 10 s deadline by
+// minutes), and it checks validity on every turn of that loop, so that is where it is stopped.
+struct QueryBudgetSpent {};
+
+}  // namespace
+
 struct LazyPrmPlanner::Impl {
   int dof = 0;
   double resolution = 0.05;
@@ -26,6 +36,8 @@ struct LazyPrmPlanner::Impl {
   // The current query's validity; the checker OMPL holds calls through it.
   const std::function<bool(const Eigen::VectorXd&)>* valid = nullptr;
   long checks = 0;
+  long max_checks = 0;
+  std::chrono::steady_clock::time_point deadline;
   unsigned long max_vertices = 20000;
 };
 
@@ -40,6 +52,9 @@ LazyPrmPlanner::LazyPrmPlanner(const Arm& arm, const LazyPrmSettings& settings)
   m.si = std::make_shared<ob::SpaceInformation>(m.space);
   Impl* self = impl_.get();
   m.si->setStateValidityChecker([self](const ob::State* s) {
+    if (self->checks >= self->max_checks || std::chrono::steady_clock::now() >= self->deadline) {
+      throw QueryBudgetSpent{};
+    }
     ++self->checks;
     return self->valid != nullptr && (*self->valid)(to_vector(s, self->dof));
   });
@@ -70,13 +85,23 @@ std::vector<Eigen::VectorXd> LazyPrmPlanner::plan(
   m.planner->setProblemDefinition(pdef);
   m.valid = &valid;
   m.checks = 0;
+  m.max_checks = max_checks;
+  m.deadline = deadline;
   // The cap bounds this query's growth: the roadmap persists, so a cap on its total size would
   // stop every query once it is reached.
   const unsigned long cap = m.planner->milestoneCount() + m.max_vertices;
-  const ob::PlannerStatus status = m.planner->solve(ob::PlannerTerminationCondition([&] {
-    return m.checks >= max_checks || m.planner->milestoneCount() >= cap ||
-           std::chrono::steady_clock::now() >= deadline;
-  }));
+  ob::PlannerStatus status = ob::PlannerStatus::TIMEOUT;
+  try {
+    status = m.planner->solve(ob::PlannerTerminationCondition([&] {
+      return m.checks >= max_checks || m.planner->milestoneCount() >= cap ||
+             std::chrono::steady_clock::now() >= deadline;
+    }));
+  } catch (const QueryBudgetSpent&) {
+    // Stopped inside LazyPRM's search loop: its graph may be half-updated, so it starts over.
+    m.valid = nullptr;
+    m.planner->clear();
+    return {};
+  }
   m.valid = nullptr;
   if (status != ob::PlannerStatus::EXACT_SOLUTION) return {};
   const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();

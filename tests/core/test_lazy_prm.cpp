@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 #include "hila/core/lazy_prm.hpp"
@@ -79,4 +80,28 @@ TEST(LazyPrm, InvalidEndsAndExhaustedBudgetGiveNothing) {
   // Straight when the straight motion is clear.
   const test::Validity free = [](const Eigen::VectorXd&) { return true; };
   EXPECT_EQ(planner.plan(free, s.from, s.to, 10, far_future()).size(), 2u);
+}
+
+// The check budget holds inside LazyPRM's own search-check-remove loop too (OMPL tests the
+// termination condition only between growth steps): with a wall to find a way around, a query
+// calls the validity at most the budget plus its own pre-checks of the ends and the straight
+// segment, and the planner answers the next query as before.
+TEST(LazyPrm, TheCheckBudgetHoldsInsideTheLazySearch) {
+  const core::Arm& arm = test::left_arm();
+  const test::Scenario s = lazy_scenario();
+  const test::Validity wall = test::validity_of(s.wall);
+  core::LazyPrmPlanner planner(arm);
+  for (const long budget : {5L, 10L, 20L}) {
+    long calls = 0;
+    const test::Validity counted = [&](const Eigen::VectorXd& q) {
+      ++calls;
+      return wall(q);
+    };
+    planner.plan(counted, s.from, s.to, budget, far_future());
+    const long pre_checks = 2 + static_cast<long>(std::ceil((s.to - s.from).norm() / 0.05));
+    EXPECT_LE(calls, budget + pre_checks) << "budget " << budget;
+  }
+  const auto path = planner.plan(wall, s.from, s.to, 200000, far_future());
+  ASSERT_FALSE(path.empty());
+  test::expect_path_valid(path, wall, 0.05);
 }

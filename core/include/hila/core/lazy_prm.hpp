@@ -37,7 +37,8 @@ class LazyPrmPlanner {
 
   // A path from `from` to `to` (waypoints, straight segments valid at the resolution), or
   // nothing within `max_checks` validity checks or the deadline. Ends outside the joint box
-  // give nothing.
+  // give nothing. A query stopped inside LazyPRM's own search loop (out of checks or time)
+  // clears the roadmap: OMPL may have left it half-updated.
   std::vector<Eigen::VectorXd> plan(const std::function<bool(const Eigen::VectorXd&)>& valid,
                                     const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                                     long max_checks,
