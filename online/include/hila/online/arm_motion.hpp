@@ -93,7 +93,10 @@ struct MotionSettings {
   // Segment checks while holding a board: as fine as the validator's (rad), since a long board
   // sweeps far between the roadmap's 0.05 rad samples; the empty arm uses the roadmap's.
   double held_resolution = 0.01;
-  long bridge_checks = 4000;      // a bridge's validity-check budget (also bounded by the deadline)
+  // A bridge's validity-check budget (also bounded by the deadline). 4000 left the arm unable to
+  // go home from beside the human's hands on back_lower and shelf_middle (the whole goal was then
+  // abandoned after every other motion was planned); 10000 bridges them.
+  long bridge_checks = 10000;
   long baseline_checks = 200000;  // the baselines' budget per motion (and the deadline)
   int join_waypoints = 4;         // a stored path's first / last waypoints tried for the joins
   long shortcut_checks = 1500;    // validity checks spent shortening a found path
