@@ -897,8 +897,6 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (record == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
-  Run run(model_, settings_, scene, *part, *record, deadline, lazy_prm_);
-
   std::vector<db::HandoverCandidateRecord> goals = db.handover_goals(record->id);
   std::sort(goals.begin(), goals.end(),
             [](const auto& a, const auto& b) { return a.rank < b.rank; });
@@ -906,47 +904,66 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     goals.resize(static_cast<std::size_t>(std::max(0, settings_.goals)));
   }
   bool any_connected_offline = false;
-  for (const auto& goal : goals) {
-    // The shared grasps the offline regrasp graph connected for this goal first: their stored
-    // paths and IK branches are what the motions re-validate.
-    std::vector<db::SharedGraspRecord> shared = db.shared_grasps(goal.id);
-    const auto connected = std::stable_partition(shared.begin(), shared.end(), [&](const auto& s) {
-      return run.connected_offline(goal, s);
-    });
-    any_connected_offline = any_connected_offline || connected != shared.begin();
-    for (const auto& s : shared) {
-      if (std::chrono::steady_clock::now() >= deadline) {
-        return finish(BoardPlanStatus::kTimeout, "the deadline passed after " +
-                                                     std::to_string(result.attempts.size()) +
-                                                     " goal attempts");
+  // Every goal in order under `settings`; true when one is planned (result filled in).
+  auto try_goals = [&](const BoardPlanSettings& settings, const std::string& round) {
+    Run run(model_, settings, scene, *part, *record, deadline, lazy_prm_);
+    for (const auto& goal : goals) {
+      // The shared grasps the offline regrasp graph connected for this goal first: their
+      // stored paths and IK branches are what the motions re-validate.
+      std::vector<db::SharedGraspRecord> shared = db.shared_grasps(goal.id);
+      const auto connected =
+          std::stable_partition(shared.begin(), shared.end(),
+                                [&](const auto& s) { return run.connected_offline(goal, s); });
+      any_connected_offline = any_connected_offline || connected != shared.begin();
+      for (const auto& s : shared) {
+        if (std::chrono::steady_clock::now() >= deadline) return false;
+        GoalAttempt attempt;
+        attempt.rank = goal.rank;
+        attempt.candidate_id = goal.id;
+        attempt.robot_grasp_id = s.robot_grasp_id;
+        attempt.robot_handover_id = s.robot_handover_id;
+        std::vector<PlanStep> steps;
+        ArmsState end;
+        const std::string failure = run.chain(goal, s, steps, end);
+        attempt.outcome = failure.empty() ? "planned" : round + failure;
+        result.attempts.push_back(attempt);
+        if (!failure.empty()) continue;
+        const auto& rr = run.handovers().at(s.robot_handover_id);
+        result.steps = std::move(steps);
+        result.goal_rank = goal.rank;
+        result.candidate_id = goal.id;
+        result.robot_grasp_id = s.robot_grasp_id;
+        result.suction_grasp_id = rr.suction_grasp_id;
+        result.theta_c_deg = run.robot_grasps().at(s.robot_grasp_id).theta_c_deg;
+        result.quality = goal.quality;
+        result.robot_handover = rr.board;
+        result.human_handover = goal.board;
+        result.duration = result.steps.back().time.back();
+        for (const auto& st : result.steps) result.path_length += st.path_length;
+        result.validated = true;
+        result.robot_q_after = end.robot_q;
+        return true;
       }
-      GoalAttempt attempt;
-      attempt.rank = goal.rank;
-      attempt.candidate_id = goal.id;
-      attempt.robot_grasp_id = s.robot_grasp_id;
-      attempt.robot_handover_id = s.robot_handover_id;
-      std::vector<PlanStep> steps;
-      ArmsState end;
-      const std::string failure = run.chain(goal, s, steps, end);
-      attempt.outcome = failure.empty() ? "planned" : failure;
-      result.attempts.push_back(attempt);
-      if (!failure.empty()) continue;
-      const auto& rr = run.handovers().at(s.robot_handover_id);
-      result.steps = std::move(steps);
-      result.goal_rank = goal.rank;
-      result.candidate_id = goal.id;
-      result.robot_grasp_id = s.robot_grasp_id;
-      result.suction_grasp_id = rr.suction_grasp_id;
-      result.theta_c_deg = run.robot_grasps().at(s.robot_grasp_id).theta_c_deg;
-      result.quality = goal.quality;
-      result.robot_handover = rr.board;
-      result.human_handover = goal.board;
-      result.duration = result.steps.back().time.back();
-      for (const auto& st : result.steps) result.path_length += st.path_length;
-      result.validated = true;
-      result.robot_q_after = end.robot_q;
+    }
+    return false;
+  };
+  if (try_goals(settings_, "")) return finish(BoardPlanStatus::kSolved, "");
+  // Every goal failed within the cheap budgets and time is left: once more with bridges as
+  // large as the baselines' from-scratch budget, where the roadmap is cut.
+  if (settings_.motion.planner == MotionPlannerKind::kRoadmap &&
+      settings_.motion.escalated_bridge_checks > settings_.motion.bridge_checks && !goals.empty() &&
+      std::chrono::steady_clock::now() < deadline) {
+    BoardPlanSettings escalated = settings_;
+    escalated.motion.bridge_checks = settings_.motion.escalated_bridge_checks;
+    if (try_goals(escalated, "(larger bridges) ")) {
+      result.larger_bridges = true;
       return finish(BoardPlanStatus::kSolved, "");
     }
+  }
+  if (std::chrono::steady_clock::now() >= deadline) {
+    return finish(
+        BoardPlanStatus::kTimeout,
+        "the deadline passed after " + std::to_string(result.attempts.size()) + " goal attempts");
   }
   return finish(BoardPlanStatus::kNoGoal,
                 goals.empty()

@@ -140,6 +140,32 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
   EXPECT_EQ(solved[2], "back_lower");
   EXPECT_EQ(solved[3], "shelf_middle");
 
+  // A board whose nominal plan needs a bridge, planned again with no bridge budget at first and
+  // only its nearest goal: every chain of that goal fails in the first round (on this database
+  // each needs a bridge), and the second round, with bridges as large as the baselines' budget,
+  // plans it (the escalation). A plan with a bridge can only come from that round.
+  auto bridged = [](const online::BoardPlan& plan) {
+    return std::any_of(plan.steps.begin(), plan.steps.end(),
+                       [](const auto& step) { return step.via.find("bridge") == 0; });
+  };
+  const auto needs_bridge = std::find_if(plan_of.begin(), plan_of.end(),
+                                         [&](const auto& kv) { return bridged(kv.second); });
+  ASSERT_NE(needs_bridge, plan_of.end()) << "some board of the cabinet needs a bridge";
+  online::BoardPlanSettings no_bridges;
+  no_bridges.motion.bridge_checks = 0;
+  no_bridges.goals = 1;
+  online::BoardPlanner escalating(*model, no_bridges);
+  const auto escalated =
+      escalating.plan(scene_of.at(needs_bridge->first), needs_bridge->first, in_seconds(120.0));
+  print_plan(escalated);
+  ASSERT_TRUE(escalated.solved()) << needs_bridge->first << ": " << escalated.reason;
+  expect_plan_well_formed(*model, scene_of.at(needs_bridge->first), escalated);
+  EXPECT_TRUE(escalated.larger_bridges || !bridged(escalated)) << needs_bridge->first;
+  EXPECT_TRUE(escalated.larger_bridges) << needs_bridge->first;
+  EXPECT_EQ(escalated.goal_rank, 0);
+  EXPECT_NE(escalated.attempts.front().outcome.find("no path"), std::string::npos)
+      << escalated.attempts.front().outcome;
+
   // A crate on the path.
   const std::string board = "lateral_right";
   const online::BoardPlan& nominal = plan_of.at(board);

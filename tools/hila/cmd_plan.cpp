@@ -69,6 +69,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
     j["duration_s"] = plan.duration;
     j["path_length_rad"] = plan.path_length;
     j["validated"] = plan.validated;
+    j["larger_bridges"] = plan.larger_bridges;
     j["steps"] = steps;
   }
   return j;

@@ -97,6 +97,9 @@ struct MotionSettings {
   // go home from beside the human's hands on back_lower and shelf_middle (the whole goal was then
   // abandoned after every other motion was planned); 10000 bridges them.
   long bridge_checks = 10000;
+  // A board whose every goal failed within bridge_checks is tried once more, time permitting,
+  // with bridges this large (the baselines' from-scratch budget).
+  long escalated_bridge_checks = 200000;
   long baseline_checks = 200000;  // the baselines' budget per motion (and the deadline)
   int join_waypoints = 4;         // a stored path's first / last waypoints tried for the joins
   long shortcut_checks = 1500;    // validity checks spent shortening a found path

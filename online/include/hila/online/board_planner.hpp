@@ -74,9 +74,12 @@ struct BoardPlan {
   std::vector<PlanStep> steps;
   std::vector<GoalAttempt> attempts;
   double planning_seconds = 0.0;
-  double duration = 0.0;          // s, the robot's motion
-  double path_length = 0.0;       // rad, both arms
-  bool validated = false;         // every step passed the validator
+  double duration = 0.0;     // s, the robot's motion
+  double path_length = 0.0;  // rad, both arms
+  bool validated = false;    // every step passed the validator
+  // Planned in the second round, with MotionSettings::escalated_bridge_checks per bridge (every
+  // goal had failed within the cheaper budget).
+  bool larger_bridges = false;
   Eigen::VectorXd robot_q_after;  // the robot when the board has been taken
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };
