@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <random>
 
 #include "hila/core/product.hpp"
@@ -76,6 +77,32 @@ online::SceneObstacle crate_at(const Eigen::Vector3d& p, double size) {
   return crate;
 }
 
+// A roadmap path with interior nodes in the nominal scene, between far node pairs `a` and `b`,
+// and the scene with a crate at the TCP of its middle waypoint (nothing when no pair plans so).
+struct CratedPath {
+  Eigen::VectorXd a, b;
+  online::MotionResult before;  // in the nominal scene
+  online::Scene blocked;
+};
+
+std::optional<CratedPath> crate_on_a_roadmap_path() {
+  const auto& cell = *test::reference_cell();
+  const online::Scene nominal = online::nominal_scene(cell, cabinet());
+  const online::World nominal_world(cell, cabinet(), nominal, "top");
+  online::ArmMotionPlanner planner(nominal_world, left_roadmap(), "left");
+  for (const auto& pair : far_pairs(20)) {
+    online::MotionResult before = planner.plan(request(pair.first, pair.second));
+    if (!before.solved() || before.via != "roadmap" || before.path.size() < 4) continue;
+    const core::Arm& left = cell.arm("left");
+    const core::Pose tcp =
+        core::arm_base_in_world(cell, left) * left.chain.fk(before.path[before.path.size() / 2]);
+    online::Scene blocked = nominal;
+    blocked.obstacles.push_back(crate_at(tcp.translation(), 0.08));
+    return CratedPath{pair.first, pair.second, std::move(before), std::move(blocked)};
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 TEST(ArmMotion, SolvedMotionsPassTheIndependentValidator) {
@@ -101,27 +128,9 @@ TEST(ArmMotion, SolvedMotionsPassTheIndependentValidator) {
 
 TEST(ArmMotion, AnObstacleOnTheStoredPathIsRepairedAround) {
   const auto& cell = *test::reference_cell();
-  const online::Scene nominal = online::nominal_scene(cell, cabinet());
-  const online::World nominal_world(cell, cabinet(), nominal, "top");
-  online::ArmMotionPlanner planner(nominal_world, left_roadmap(), "left");
-  // A roadmap path with interior nodes.
-  online::MotionResult before;
-  Eigen::VectorXd a, b;
-  for (const auto& pair : far_pairs(20)) {
-    before = planner.plan(request(pair.first, pair.second));
-    if (before.solved() && before.via == "roadmap" && before.path.size() >= 4) {
-      a = pair.first;
-      b = pair.second;
-      break;
-    }
-  }
-  ASSERT_TRUE(before.solved() && before.via == "roadmap");
-  // A crate at the TCP of the path's middle waypoint.
-  const core::Arm& left = cell.arm("left");
-  const Eigen::VectorXd& middle = before.path[before.path.size() / 2];
-  const core::Pose tcp = core::arm_base_in_world(cell, left) * left.chain.fk(middle);
-  online::Scene blocked = nominal;
-  blocked.obstacles.push_back(crate_at(tcp.translation(), 0.08));
+  const auto crated = crate_on_a_roadmap_path();
+  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
+  const auto& [a, b, before, blocked] = *crated;
   const online::World world(cell, cabinet(), blocked, "top");
   core::CollisionData data = world.make_data();
   const auto old =
@@ -168,25 +177,9 @@ TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
 // of the robot differently starts over (matching a fresh planner).
 TEST(ArmMotion, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame) {
   const auto& cell = *test::reference_cell();
-  const online::Scene nominal = online::nominal_scene(cell, cabinet());
-  const online::World nominal_world(cell, cabinet(), nominal, "top");
-  online::ArmMotionPlanner probe(nominal_world, left_roadmap(), "left");
-  online::MotionResult before;
-  Eigen::VectorXd a, b;
-  for (const auto& pair : far_pairs(20)) {
-    before = probe.plan(request(pair.first, pair.second));
-    if (before.solved() && before.via == "roadmap" && before.path.size() >= 4) {
-      a = pair.first;
-      b = pair.second;
-      break;
-    }
-  }
-  ASSERT_TRUE(before.solved() && before.via == "roadmap");
-  const core::Arm& left = cell.arm("left");
-  const core::Pose tcp =
-      core::arm_base_in_world(cell, left) * left.chain.fk(before.path[before.path.size() / 2]);
-  online::Scene blocked = nominal;
-  blocked.obstacles.push_back(crate_at(tcp.translation(), 0.08));
+  const auto crated = crate_on_a_roadmap_path();
+  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
+  const auto& [a, b, before, blocked] = *crated;
   const online::World world(cell, cabinet(), blocked, "top");
 
   online::ArmMotionPlanner planner(world, left_roadmap(), "left");
