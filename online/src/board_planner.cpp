@@ -143,6 +143,23 @@ class Run {
   const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps() const { return robot_grasps_; }
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
 
+  // Bridges of `checks` from now on. The stages that failed are forgotten so that they are
+  // planned again; those that were planned stand (a larger budget finds the same or more).
+  void escalate(long checks) {
+    suction_planner_.set_bridge_checks(checks);
+    receiving_planner_.set_bridge_checks(checks);
+    if (tool_ && !tool_->ok()) tool_.reset();
+    auto forget_failed = [](auto& stages) {
+      std::erase_if(stages, [](const auto& entry) { return !entry.second.ok(); });
+    };
+    forget_failed(picks_);
+    forget_failed(transfers_);
+    forget_failed(receives_);
+    forget_failed(releases_);
+    forget_failed(presents_);
+    forget_failed(leaves_);
+  }
+
   // Whether the offline regrasp graph connected this goal with this shared grasp.
   bool connected_offline(const db::HandoverCandidateRecord& goal,
                          const db::SharedGraspRecord& shared) const {
@@ -905,8 +922,8 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   }
   bool any_connected_offline = false;
   // Every goal in order under `settings`; true when one is planned (result filled in).
-  auto try_goals = [&](const BoardPlanSettings& settings, const std::string& round) {
-    Run run(model_, settings, scene, *part, *record, deadline, lazy_prm_);
+  Run run(model_, settings_, scene, *part, *record, deadline, lazy_prm_);
+  auto try_goals = [&](const std::string& round) {
     for (const auto& goal : goals) {
       // The shared grasps the offline regrasp graph connected for this goal first: their
       // stored paths and IK branches are what the motions re-validate.
@@ -947,15 +964,14 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     }
     return false;
   };
-  if (try_goals(settings_, "")) return finish(BoardPlanStatus::kSolved, "");
+  if (try_goals("")) return finish(BoardPlanStatus::kSolved, "");
   // Every goal failed within the cheap budgets and time is left: once more with bridges as
   // large as the baselines' from-scratch budget, where the roadmap is cut.
   if (settings_.motion.planner == MotionPlannerKind::kRoadmap &&
       settings_.motion.escalated_bridge_checks > settings_.motion.bridge_checks && !goals.empty() &&
       std::chrono::steady_clock::now() < deadline) {
-    BoardPlanSettings escalated = settings_;
-    escalated.motion.bridge_checks = settings_.motion.escalated_bridge_checks;
-    if (try_goals(escalated, "(larger bridges) ")) {
+    run.escalate(settings_.motion.escalated_bridge_checks);
+    if (try_goals("(larger bridges) ")) {
       result.larger_bridges = true;
       return finish(BoardPlanStatus::kSolved, "");
     }

@@ -126,6 +126,9 @@ class ArmMotionPlanner {
   std::string why_invalid(const Eigen::VectorXd& q);
   bool segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
 
+  // A bridge's check budget from the next request on (MotionSettings::bridge_checks).
+  void set_bridge_checks(long checks) { settings_.bridge_checks = checks; }
+
  private:
   enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
   Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
