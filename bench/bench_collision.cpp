@@ -1,7 +1,7 @@
 // One full-arm collision check against the cell: FK of every robot link, pose update of the
-// moving bodies, FCL broad phase + narrow phase. Configurations are seeded random left-arm poses
-// that are collision-free (the common case while planning), and ones that collide.
-// Run: build/release/bench/bench_collision --benchmark_repetitions=5
+// moving bodies, box tests (world, then oriented) + FCL's narrow phase. Configurations are seeded
+// random left-arm poses that are collision-free (the common case while planning), and ones that
+// collide. Run: build/release/bench/bench_collision --benchmark_repetitions=5
 // --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 

@@ -6,6 +6,7 @@
 #include <fcl/geometry/shape/convex.h>
 #include <fcl/geometry/shape/cylinder.h>
 #include <fcl/geometry/shape/sphere.h>
+#include <fcl/math/bv/OBB.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
 
@@ -34,14 +35,19 @@ struct CollisionModelImpl {
   // tests (both enabled, not both static, not allowed) as a flat byte matrix, so that the
   // planner's hot loop reads bytes instead of vector<bool> bits and skips static bodies.
   std::vector<int> moving_bodies;
+  std::vector<int> shaped_bodies;  // enabled, with at least one shape
   std::vector<unsigned char> testable;
 
   void refresh_pairs() {
     const std::size_t n = bodies.size();
     moving_bodies.clear();
+    shaped_bodies.clear();
     testable.assign(n * n, 0);
     for (std::size_t a = 0; a < n; ++a) {
       if (bodies[a].enabled && !bodies[a].is_static) moving_bodies.push_back(static_cast<int>(a));
+      if (bodies[a].enabled && !bodies[a].geometries.empty()) {
+        shaped_bodies.push_back(static_cast<int>(a));
+      }
       for (std::size_t b = 0; b < n; ++b) {
         testable[a * n + b] = a != b && bodies[a].enabled && bodies[b].enabled &&
                               !(bodies[a].is_static && bodies[b].is_static) && !allowed[a][b];
@@ -200,9 +206,53 @@ std::optional<int> CollisionModel::find_body(const std::string& name) const {
 
 // --- per-thread data -----------------------------------------------------------------------
 
+namespace {
+
+// A world axis-aligned box, compared inline: the subset query's loops test thousands per call,
+// where fcl::AABB::overlap is an out-of-line call into the library.
+struct WorldBox {
+  double lo[3] = {0.0, 0.0, 0.0};
+  double hi[3] = {0.0, 0.0, 0.0};
+};
+
+inline WorldBox to_world_box(const fcl::AABBd& box) {
+  return {{box.min_[0], box.min_[1], box.min_[2]}, {box.max_[0], box.max_[1], box.max_[2]}};
+}
+
+inline void merge(WorldBox& into, const WorldBox& box) {
+  for (int k = 0; k < 3; ++k) {
+    into.lo[k] = std::min(into.lo[k], box.lo[k]);
+    into.hi[k] = std::max(into.hi[k], box.hi[k]);
+  }
+}
+
+// Touching boxes overlap, as in FCL.
+inline bool overlap(const WorldBox& a, const WorldBox& b) {
+  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
+         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+}
+
 struct ShapeTag {
   int body;
+  int object;  // index into CollisionDataImpl::objects / obbs
 };
+
+// Each shape's local bounding box (FCL's, in the shape's frame) carried by the shape's pose: an
+// oriented box that encloses the shape. Far tighter than the world AABB of a rotated cylinder or
+// board, and two of them are told apart in a few dozen flops, where FCL's narrow phase runs GJK.
+// Grown by a margin larger than GJK's tolerance, so that a pair the boxes separate is one FCL
+// would report separate too: the verdicts are FCL's.
+constexpr double kObbMargin = 1e-5;
+
+void fit_obb(const fcl::CollisionObjectd& object, fcl::OBBd& obb) {
+  const fcl::Transform3d& tf = object.getTransform();
+  const fcl::AABBd& local = object.collisionGeometry()->aabb_local;
+  obb.axis = tf.linear();
+  obb.To = tf * local.center();
+  obb.extent = 0.5 * (local.max_ - local.min_) + Eigen::Vector3d::Constant(kObbMargin);
+}
+
+}  // namespace
 
 struct CollisionDataImpl {
   const CollisionModelImpl* model = nullptr;
@@ -210,13 +260,16 @@ struct CollisionDataImpl {
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
   std::vector<std::vector<int>> body_objects;
   std::vector<ShapeTag> tags;
+  std::vector<fcl::OBBd> obbs;         // per object, kept with its pose
+  std::vector<WorldBox> object_boxes;  // per object: its FCL world AABB
   fcl::DynamicAABBTreeCollisionManagerd static_manager;
   fcl::DynamicAABBTreeCollisionManagerd moving_manager;
   // Objects whose pose changed since the last query: only these are re-fitted in the trees.
   std::vector<fcl::CollisionObjectd*> changed_moving;
   std::vector<fcl::CollisionObjectd*> changed_static;
   std::vector<char> active_scratch;
-  std::vector<fcl::AABBd> body_boxes;  // each body's shapes' boxes, merged (world)
+  std::vector<int> near_scratch;
+  std::vector<WorldBox> body_boxes;  // each body's shapes' boxes, merged (world)
   bool moving_full_refit = false;
   bool static_full_refit = false;
 };
@@ -237,7 +290,9 @@ CollisionData::CollisionData(const CollisionModel& model)
       auto object = std::make_unique<fcl::CollisionObjectd>(
           bodies[b].geometries[s], bodies[b].initial_pose * bodies[b].offsets[s]);
       object->computeAABB();
-      impl_->tags.push_back({static_cast<int>(b)});
+      impl_->tags.push_back({static_cast<int>(b), static_cast<int>(impl_->objects.size())});
+      fit_obb(*object, impl_->obbs.emplace_back());
+      impl_->object_boxes.push_back(to_world_box(object->getAABB()));
       object->setUserData(&impl_->tags.back());
       impl_->body_objects[b].push_back(static_cast<int>(impl_->objects.size()));
       if (bodies[b].enabled) {
@@ -250,9 +305,9 @@ CollisionData::CollisionData(const CollisionModel& model)
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     for (const int o : impl_->body_objects[b]) {
       if (o == impl_->body_objects[b].front()) {
-        impl_->body_boxes[b] = impl_->objects[o]->getAABB();
+        impl_->body_boxes[b] = impl_->object_boxes[o];
       } else {
-        impl_->body_boxes[b] += impl_->objects[o]->getAABB();
+        merge(impl_->body_boxes[b], impl_->object_boxes[o]);
       }
     }
   }
@@ -285,11 +340,14 @@ void CollisionData::set_body_pose(int body, const Pose& pose) {
     auto& object = *d.objects[objs[s]];
     object.setTransform(pose * offsets[s]);
     object.computeAABB();
+    fit_obb(object, d.obbs[static_cast<std::size_t>(objs[s])]);
+    const WorldBox& box = d.object_boxes[static_cast<std::size_t>(objs[s])] =
+        to_world_box(object.getAABB());
     changed.push_back(&object);
     if (s == 0) {
-      d.body_boxes[body] = object.getAABB();
+      d.body_boxes[body] = box;
     } else {
-      d.body_boxes[body] += object.getAABB();
+      merge(d.body_boxes[body], box);
     }
   }
 }
@@ -303,6 +361,7 @@ namespace {
 struct QueryContext {
   const CollisionModelImpl* model;
   CollisionPair* pair;
+  const std::vector<fcl::OBBd>* obbs = nullptr;  // the oriented-box test first, when given
   bool hit = false;
   double min_distance = std::numeric_limits<double>::infinity();
 };
@@ -314,11 +373,18 @@ inline bool skip_pair(const CollisionModelImpl& m, int a, int b) {
   return m.allowed[a][b];
 }
 
-bool collide_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* raw) {
-  auto* ctx = static_cast<QueryContext*>(raw);
-  const int a = static_cast<ShapeTag*>(o1->getUserData())->body;
-  const int b = static_cast<ShapeTag*>(o2->getUserData())->body;
-  if (skip_pair(*ctx->model, a, b)) return false;
+// The narrow phase of two shapes of a testable pair of bodies (a, b): their oriented boxes when
+// the context has them, then FCL.
+bool narrow_phase(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, int a, int b,
+                  QueryContext* ctx) {
+  if (ctx->obbs != nullptr) {
+    const auto& obbs = *ctx->obbs;
+    const int i1 = static_cast<ShapeTag*>(o1->getUserData())->object;
+    const int i2 = static_cast<ShapeTag*>(o2->getUserData())->object;
+    if (!obbs[static_cast<std::size_t>(i1)].overlap(obbs[static_cast<std::size_t>(i2)])) {
+      return false;
+    }
+  }
   fcl::CollisionRequestd request;
   fcl::CollisionResultd result;
   if (fcl::collide(o1, o2, request, result) > 0) {
@@ -327,6 +393,14 @@ bool collide_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void
     return true;  // stop at the first contact
   }
   return false;
+}
+
+bool collide_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* raw) {
+  auto* ctx = static_cast<QueryContext*>(raw);
+  const int a = static_cast<ShapeTag*>(o1->getUserData())->body;
+  const int b = static_cast<ShapeTag*>(o2->getUserData())->body;
+  if (skip_pair(*ctx->model, a, b)) return false;
+  return narrow_phase(o1, o2, a, b, ctx);
 }
 
 bool distance_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* raw,
@@ -376,7 +450,7 @@ void refresh(CollisionDataImpl& d) {
 bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPair* first) {
   auto& d = data.impl();
   refresh(d);
-  QueryContext ctx{&model.impl(), first};
+  QueryContext ctx{&model.impl(), first, &d.obbs};
   d.moving_manager.collide(&ctx, collide_callback);
   if (!ctx.hit) d.moving_manager.collide(&d.static_manager, &ctx, collide_callback);
   return ctx.hit;
@@ -386,51 +460,42 @@ bool in_collision(const CollisionModel& model, CollisionData& data, const std::v
                   CollisionPair* first) {
   auto& d = data.impl();
   const auto& m = model.impl();
-  if (d.static_full_refit || !d.changed_static.empty()) {
-    d.static_manager.update();
-    d.static_full_refit = false;
-    d.changed_static.clear();
-  }
-  QueryContext ctx{&m, first};
-  // Against the static scene: one tree query per shape of the active bodies.
-  for (const int b : bodies) {
-    if (!m.bodies[b].enabled) continue;
-    for (const int o : d.body_objects[b]) {
-      d.static_manager.collide(d.objects[o].get(), &ctx, collide_callback);
-      if (ctx.hit) return true;
-    }
-  }
-  // Against the other moving bodies (and among the active ones, each pair once): AABB test, then
-  // the narrow phase.
+  QueryContext ctx{&m, first, &d.obbs};
+  // No broad-phase tree: a cell has tens of bodies, and most fail one inline box test against
+  // the active set's reach, which leaves a handful per active body.
   const std::size_t n = m.bodies.size();
   std::vector<char>& active = d.active_scratch;
   active.assign(n, 0);
-  fcl::AABBd reach;  // of the active bodies: most other bodies fail one test against it
+  WorldBox reach;
   bool any = false;
   for (const int b : bodies) {
+    if (!m.bodies[b].enabled || d.body_objects[b].empty()) continue;
     active[b] = 1;
-    if (d.body_objects[b].empty()) continue;
     if (any) {
-      reach += d.body_boxes[b];
+      merge(reach, d.body_boxes[b]);
     } else {
       reach = d.body_boxes[b];
       any = true;
     }
   }
   if (!any) return false;
+  std::vector<int>& near = d.near_scratch;
+  near.clear();
+  for (const int ob : m.shaped_bodies) {
+    if (active[ob] || overlap(d.body_boxes[ob], reach)) near.push_back(ob);
+  }
   for (const int b : bodies) {
-    if (!m.bodies[b].enabled || m.bodies[b].is_static || d.body_objects[b].empty()) continue;
+    if (!active[b]) continue;
     const unsigned char* testable = &m.testable[static_cast<std::size_t>(b) * n];
-    const fcl::AABBd& box_b = d.body_boxes[b];
-    for (const int ob : m.moving_bodies) {
-      if (!testable[ob] || (active[ob] && ob <= b) || d.body_objects[ob].empty()) continue;
-      if (!active[ob] && !d.body_boxes[ob].overlap(reach)) continue;
-      if (!d.body_boxes[ob].overlap(box_b)) continue;
+    const WorldBox& box_b = d.body_boxes[b];
+    for (const int ob : near) {
+      // Pairs of active bodies once each.
+      if (!testable[ob] || (active[ob] && ob <= b) || !overlap(d.body_boxes[ob], box_b)) continue;
       for (const int o1 : d.body_objects[b]) {
-        const auto& box1 = d.objects[o1]->getAABB();
+        const WorldBox& box1 = d.object_boxes[static_cast<std::size_t>(o1)];
         for (const int o2 : d.body_objects[ob]) {
-          if (!box1.overlap(d.objects[o2]->getAABB())) continue;
-          if (collide_callback(d.objects[o1].get(), d.objects[o2].get(), &ctx)) return true;
+          if (!overlap(box1, d.object_boxes[static_cast<std::size_t>(o2)])) continue;
+          if (narrow_phase(d.objects[o1].get(), d.objects[o2].get(), b, ob, &ctx)) return true;
         }
       }
     }

@@ -26,6 +26,23 @@ core::GeometrySpec sphere(double r) {
   return g;
 }
 
+core::GeometrySpec cylinder(double r, double length) {
+  core::GeometrySpec g;
+  g.type = core::GeometrySpec::Type::Cylinder;
+  g.radius = r;
+  g.length = length;
+  return g;
+}
+
+core::Pose random_rotation(std::mt19937_64& rng, const Eigen::Vector3d& at) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
+  core::Pose p = core::Pose::Identity();
+  p.linear() = q.normalized().toRotationMatrix();
+  p.translation() = at;
+  return p;
+}
+
 struct Fixture {
   std::shared_ptr<const core::Cell> cell = test::reference_cell();
   core::CellScene scene = core::build_cell_scene(*cell, {.human_moves = true});
@@ -229,6 +246,49 @@ TEST(Collision, HeldBoardFollowsTheGripperAndHitsTheTable) {
       core::in_collision(scene.model, data, scene.arm_bodies[0]));  // the arm alone is free
   EXPECT_EQ(core::in_collision(scene.model, data),
             core::in_collision_brute_force(scene.model, data));
+}
+
+// The subset query settles most pairs with oriented boxes around the shapes before FCL's narrow
+// phase: near contact, where the world boxes of rotated shapes overlap but the shapes may not,
+// its verdicts must still be FCL's own (the brute-force query runs FCL on every pair).
+TEST(Collision, OrientedBoxMidPhaseKeepsFclVerdictsNearContact) {
+  core::CollisionModel model;
+  std::mt19937_64 rng(57);
+  // Static shapes of every kind the cell uses, turned arbitrarily: a board (convex mesh), a
+  // plate, a cylinder and a ball.
+  model.add_mesh_body("board", core::make_box_mesh({0.6, 0.3, 0.018}), true,
+                      random_rotation(rng, {0.0, 0.0, 0.0}));
+  model.add_body("plate", {box(0.4, 0.02, 0.3)}, true, random_rotation(rng, {0.5, 0.0, 0.0}));
+  model.add_body("post", {cylinder(0.04, 0.5)}, true, random_rotation(rng, {0.0, 0.5, 0.0}));
+  model.add_body("ball", {sphere(0.08)}, true, core::make_pose({0.5, 0.5, 0.0}));
+  // A moving link: a cylinder with a box beside it (two shapes of one body, as on the UR3).
+  core::GeometrySpec side = box(0.06, 0.1, 0.085);
+  side.origin = core::make_pose({0.0, 0.0, 0.15});
+  const int link = model.add_body("link", {cylinder(0.032, 0.2), side}, false);
+  core::CollisionData data(model);
+  std::uniform_real_distribution<double> coord(-0.35, 0.85);
+  std::uniform_real_distribution<double> height(-0.25, 0.25);
+  int colliding = 0;
+  int near_miss = 0;  // free, yet within 2 cm of a static shape
+  for (int i = 0; i < 4000; ++i) {
+    data.set_body_pose(link, random_rotation(rng, {coord(rng), coord(rng), height(rng)}));
+    core::CollisionPair fast_pair;
+    const bool fast = core::in_collision(model, data, std::vector<int>{link}, &fast_pair);
+    const bool slow = core::in_collision_brute_force(model, data, std::vector<int>{link});
+    ASSERT_EQ(fast, slow) << "pose " << i << ": subset query says "
+                          << core::describe_pair(model, fast_pair);
+    // The whole-scene query (broad-phase trees, the same mid phase) agrees as well.
+    ASSERT_EQ(core::in_collision(model, data), slow) << "pose " << i;
+    if (fast) {
+      ++colliding;
+      EXPECT_EQ(fast_pair.body_b, link);
+    } else if (core::min_distance(model, data) < 0.02) {
+      ++near_miss;
+    }
+  }
+  // Both verdicts, and many free poses close enough that rotated world boxes overlap.
+  EXPECT_GT(colliding, 400);
+  EXPECT_GT(near_miss, 200);
 }
 
 TEST(Collision, DistanceBetweenPrimitivesMatchesClosedForm) {

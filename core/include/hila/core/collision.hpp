@@ -72,13 +72,15 @@ struct CollisionPair {
 };
 
 // Any collision between enabled bodies, except static-static and allowed pairs. Broad-phase
-// (FCL dynamic AABB trees) over the static and the moving bodies. Stops at the first contact and
+// (FCL dynamic AABB trees) over the static and the moving bodies; each candidate pair of shapes
+// then goes through their oriented bounding boxes (fcl::OBB, the shape's local box carried by its
+// pose) before FCL's narrow phase, which leaves the verdict FCL's. Stops at the first contact and
 // reports its pair.
 bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPair* first = nullptr);
 // Collisions involving at least one of `bodies` (against every other enabled body, static or
 // moving, and among themselves). This is the planner's query when one arm (with what it holds)
-// moves and the rest of the scene is unchanged; it needs no broad-phase tree update for the
-// moving set.
+// moves and the rest of the scene is unchanged. No tree: inline world-box tests against the
+// moving set's reach, then per body, per shape, the oriented boxes, then FCL's narrow phase.
 bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
                   CollisionPair* first = nullptr);
 // The same answer by testing every candidate pair with FCL's narrow phase (reference for tests).
