@@ -188,38 +188,47 @@ bool ArmMotionPlanner::edge_valid(int edge) {
 
 // The stored path re-validated for the scene, joined to the start and goal by straight segments
 // (the stored ends are the offline scene's: the board's nominal pose, a neighbouring IK
-// solution); empty when any piece is blocked.
+// solution); empty when any piece is blocked. Then `pieces` keeps what did hold: the start
+// joined to the stored path's valid beginning, and its valid end joined to the goal.
 std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::VectorXd>& hint,
                                                       const Eigen::VectorXd& start,
-                                                      const Eigen::VectorXd& goal) {
+                                                      const Eigen::VectorXd& goal,
+                                                      StoredPieces& pieces) {
+  pieces = {};
   const int n = static_cast<int>(hint.size());
   if (n < 2 || hint.front().size() != start.size()) return {};
+  const auto at = [&](int i) -> const Eigen::VectorXd& {
+    return hint[static_cast<std::size_t>(i)];
+  };
   const int tries = std::max(1, settings_.join_waypoints);
   int first = -1;
   for (int i = 0; i < std::min(n, tries) && first < 0; ++i) {
-    if (valid(hint[static_cast<std::size_t>(i)]) &&
-        segment_valid(start, hint[static_cast<std::size_t>(i)])) {
-      first = i;
+    if (valid(at(i)) && segment_valid(start, at(i))) first = i;
+  }
+  if (first >= 0) {
+    int reach = first;
+    while (reach + 1 < n && valid(at(reach + 1)) && segment_valid(at(reach), at(reach + 1))) {
+      ++reach;
     }
-  }
-  if (first < 0) return {};
-  int last = -1;
-  for (int j = n - 1; j >= std::max(first, n - tries) && last < 0; --j) {
-    if ((j == first || valid(hint[static_cast<std::size_t>(j)])) &&
-        segment_valid(hint[static_cast<std::size_t>(j)], goal)) {
-      last = j;
+    for (int j = reach; j >= std::max(first, n - tries); --j) {
+      if (!segment_valid(at(j), goal)) continue;
+      std::vector<Eigen::VectorXd> path{start};
+      for (int i = first; i <= j; ++i) path.push_back(at(i));
+      path.push_back(goal);
+      return path;
     }
+    pieces.lead.push_back(start);
+    for (int i = first; i <= reach; ++i) pieces.lead.push_back(at(i));
   }
-  if (last < 0) return {};
-  for (int i = first + 1; i <= last; ++i) {
-    const auto& a = hint[static_cast<std::size_t>(i - 1)];
-    const auto& b = hint[static_cast<std::size_t>(i)];
-    if ((i != last && !valid(b)) || !segment_valid(a, b)) return {};
+  for (int j = n - 1; j >= std::max(0, n - tries); --j) {
+    if (!valid(at(j)) || !segment_valid(at(j), goal)) continue;
+    int back = j;
+    while (back > 0 && valid(at(back - 1)) && segment_valid(at(back - 1), at(back))) --back;
+    for (int i = back; i <= j; ++i) pieces.tail.push_back(at(i));
+    pieces.tail.push_back(goal);
+    break;
   }
-  std::vector<Eigen::VectorXd> path{start};
-  for (int i = first; i <= last; ++i) path.push_back(hint[static_cast<std::size_t>(i)]);
-  path.push_back(goal);
-  return path;
+  return {};
 }
 
 // Greedy shortcuts within a check budget: from each kept waypoint, the farthest later one a
@@ -330,13 +339,18 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(late() ? MotionStatus::kTimeout : MotionStatus::kNoPath,
                   std::string(to_string(settings_.planner)) + " found no path within its budget");
   }
+  // What held of the stored paths when none did whole: the longest valid beginning and end.
+  StoredPieces stored;
   for (const auto* hint : request.hints) {
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed on a stored path");
-    r.path = follow(*hint, request.start, request.goal);
+    StoredPieces pieces;
+    r.path = follow(*hint, request.start, request.goal, pieces);
     if (!r.path.empty()) {
       r.via = "stored";
       return finish(MotionStatus::kSolved, "");
     }
+    if (pieces.lead.size() > stored.lead.size()) stored.lead = std::move(pieces.lead);
+    if (pieces.tail.size() > stored.tail.size()) stored.tail = std::move(pieces.tail);
   }
   std::string direct_blocker;  // what stops the straight motion, for the reason
   for (const auto& q :
@@ -347,8 +361,20 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   // Through the roadmap, lazily validated.
   // A start in contact leaves straight up first (its lift is the request's goal, in practice):
   // the roadmap is entered from the goal side only when the direct segment failed.
-  const auto entries = attach(request.start);
-  const auto exits = entries.empty() ? std::vector<core::GraphEndpoint>{} : attach(request.goal);
+  auto entries = attach(request.start);
+  // An end wedged where no straight segment reaches a roadmap node (a held board beside the
+  // other arm's load, say) enters the roadmap where a stored path that held from it leads.
+  std::vector<Eigen::VectorXd> lead{request.start};
+  if (entries.empty() && stored.lead.size() > 1) {
+    entries = attach(stored.lead.back());
+    if (!entries.empty()) lead = stored.lead;
+  }
+  auto exits = entries.empty() ? std::vector<core::GraphEndpoint>{} : attach(request.goal);
+  std::vector<Eigen::VectorXd> tail{request.goal};
+  if (!entries.empty() && exits.empty() && stored.tail.size() > 1) {
+    exits = attach(stored.tail.front());
+    if (!exits.empty()) tail = stored.tail;
+  }
   const int max_searches = request.max_searches > 0 ? request.max_searches : settings_.max_searches;
   while (!entries.empty() && !exits.empty() && r.searches < max_searches) {
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the search");
@@ -372,11 +398,11 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
       }
     }
     if (!clear) continue;
-    r.path.push_back(request.start);
+    r.path = lead;
     for (const int n : path.nodes)
       r.path.push_back(roadmap_.record.nodes[static_cast<std::size_t>(n)]);
-    r.path.push_back(request.goal);
-    r.via = "roadmap";
+    r.path.insert(r.path.end(), tail.begin(), tail.end());
+    r.via = lead.size() > 1 || tail.size() > 1 ? "stored+roadmap" : "roadmap";
     return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed before a bridge");

@@ -213,3 +213,62 @@ TEST(ArmMotion, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame) {
     EXPECT_TRUE(relearned.path[i].isApprox(reference.path[i], 0.0)) << "waypoint " << i;
   }
 }
+
+// A start from which no straight segment reaches the roadmap, while a stored path still leads
+// from it: the roadmap is entered where the stored path, re-validated, takes the arm. The
+// roadmap here is the tail of a shortened roadmap path (greedy shortcuts: no waypoint past the
+// next one is in straight reach), without its first two waypoints; the stored path goes halfway
+// to the first node the start left for, then to it.
+TEST(ArmMotion, AWedgedStartEntersTheRoadmapAlongAStoredPath) {
+  const auto& cell = *test::reference_cell();
+  const online::World world(cell, cabinet(), online::nominal_scene(cell, cabinet()), "top");
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  core::CollisionData data = world.make_data();
+  for (const auto& [a, b] : far_pairs(20)) {
+    const auto before = planner.plan(request(a, b));
+    if (!before.solved() || before.path.size() < 4) continue;
+    const auto& p = before.path;
+    // A stored path that holds from the start but stops short of the goal: halfway to p[1], p[1].
+    const std::vector<Eigen::VectorXd> stored{a + 0.5 * (p[1] - a), p[1]};
+    bool wedged = true;  // nothing after p[1] in straight reach of a, b out of the stored path's
+    for (std::size_t k = 2; k < p.size(); ++k) wedged = wedged && !planner.segment_valid(a, p[k]);
+    wedged = wedged && !planner.segment_valid(stored[0], b) && !planner.segment_valid(p[1], b);
+    if (!wedged) continue;
+
+    db::RoadmapRecord tail = left_roadmap().record;
+    tail.nodes.assign(p.begin() + 2, p.end());
+    tail.node_gravity.assign(tail.nodes.size(), Eigen::Vector3d::UnitZ());
+    tail.node_inclination_deg.assign(tail.nodes.size(), 0.0);
+    tail.edges.clear();
+    tail.edge_length.clear();
+    tail.edge_max_inclination_deg.clear();
+    for (int i = 0; i + 1 < static_cast<int>(tail.nodes.size()); ++i) {
+      tail.edges.emplace_back(i, i + 1);
+      tail.edge_length.push_back(
+          (tail.nodes[static_cast<std::size_t>(i + 1)] - tail.nodes[static_cast<std::size_t>(i)])
+              .norm());
+      tail.edge_max_inclination_deg.push_back(0.0);
+    }
+    const online::ArmRoadmap roadmap(tail);
+    online::ArmMotionPlanner cut(world, roadmap, "left");
+    online::MotionRequest r = request(a, b);
+    r.allow_bridge = false;
+    const auto alone = cut.plan(r);
+    EXPECT_FALSE(alone.solved()) << "the start attaches to no node of the roadmap: " << alone.via;
+
+    r.hints = {&stored};
+    const auto led = cut.plan(r);
+    ASSERT_TRUE(led.solved()) << led.reason;
+    EXPECT_EQ(led.via, "stored+roadmap");
+    ASSERT_GE(led.path.size(), 3u);
+    EXPECT_TRUE(led.path.front().isApprox(a, 0.0));
+    // Through the stored path's end (its halfway point shortcut away).
+    EXPECT_TRUE(led.path[1].isApprox(p[1], 0.0));
+    EXPECT_TRUE(led.path.back().isApprox(b, 0.0));
+    const auto report =
+        online::validate_motion(world, data, timed(led.path, cabinet().part("top").initial));
+    EXPECT_TRUE(report.valid()) << describe(report);
+    return;
+  }
+  FAIL() << "no far node pair gave a roadmap path of four waypoints with a wedged start";
+}

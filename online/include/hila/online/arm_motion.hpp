@@ -68,7 +68,8 @@ struct MotionResult {
   MotionStatus status = MotionStatus::kNoPath;
   std::string reason;                 // why not solved, naming what is in the way
   std::vector<Eigen::VectorXd> path;  // start ... goal, straight segments between waypoints
-  // "direct", "stored" (an offline path re-validated), "roadmap", "bridge"; the baselines'
+  // "direct", "stored" (an offline path re-validated), "roadmap", "stored+roadmap" (the roadmap
+  // entered or left along the part of a stored path that holds), "bridge"; the baselines'
   // "rrt_connect" or "lazy_prm"
   std::string via;
   int searches = 0;           // A* runs (one more after each invalidated edge)
@@ -86,8 +87,11 @@ const char* to_string(MotionPlannerKind kind);
 
 struct MotionSettings {
   MotionPlannerKind planner = MotionPlannerKind::kRoadmap;
-  int attach_neighbours = 40;  // roadmap nodes tried per end
-  int attachments = 6;         // valid attachments kept per end
+  // Roadmap nodes tried per end, nearest first, until `attachments` valid ones: with 40, the
+  // staging poses of lateral_left's exchange attached in too few scene variations (19/20
+  // planned, median 1.33 s; with 150, 20/20 and 0.73 s).
+  int attach_neighbours = 150;
+  int attachments = 6;  // valid attachments kept per end
   int max_searches = 200;
   int staging_searches = 20;  // per staging try (MotionRequest::max_searches)
   // Segment checks while holding a board: as fine as the validator's (rad), since a long board
@@ -133,8 +137,15 @@ class ArmMotionPlanner {
   enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
   Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
   bool edge_valid(int edge);
+  // A stored path's parts that hold in the scene when the whole does not: the start joined to
+  // its valid beginning (start first), and its valid end joined to the goal (goal last).
+  struct StoredPieces {
+    std::vector<Eigen::VectorXd> lead;
+    std::vector<Eigen::VectorXd> tail;
+  };
   std::vector<Eigen::VectorXd> follow(const std::vector<Eigen::VectorXd>& hint,
-                                      const Eigen::VectorXd& start, const Eigen::VectorXd& goal);
+                                      const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
+                                      StoredPieces& pieces);
   void shorten(std::vector<Eigen::VectorXd>& path);
   std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q);
 
