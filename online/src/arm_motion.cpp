@@ -352,12 +352,15 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     if (pieces.lead.size() > stored.lead.size()) stored.lead = std::move(pieces.lead);
     if (pieces.tail.size() > stored.tail.size()) stored.tail = std::move(pieces.tail);
   }
-  std::string direct_blocker;  // what stops the straight motion, for the reason
-  for (const auto& q :
-       core::edge_samples(request.start, request.goal, roadmap_.record.resolution)) {
-    direct_blocker = why_invalid(q);
-    if (!direct_blocker.empty()) break;
-  }
+  // What stops the straight motion, for the reason when everything fails (looked up then only:
+  // a successful search would have spent these checks for nothing).
+  const auto direct_blocker = [&] {
+    for (const auto& q :
+         core::edge_samples(request.start, request.goal, roadmap_.record.resolution)) {
+      if (std::string why = why_invalid(q); !why.empty()) return why;
+    }
+    return std::string("nothing at the roadmap's resolution");
+  };
   // Through the roadmap, lazily validated.
   // A start in contact leaves straight up first (its lift is the request's goal, in practice):
   // the roadmap is entered from the goal side only when the direct segment failed.
@@ -428,7 +431,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
           ? "the goal attaches to no roadmap node and no bridge was found"
           : "the roadmap is cut between start and goal (" + std::to_string(invalidated_) +
                 " edges blocked in the scene) and no bridge was found; the straight motion meets " +
-                direct_blocker);
+                direct_blocker());
 }
 
 }  // namespace hila::online
