@@ -72,9 +72,10 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   const core::StageScene& stage = world_.stage();
   robot_q_ = request.robot_q.size() == 0 ? cell.home_configuration() : request.robot_q;
   held_ = request.held;
-  resolution_ = held_.held || request.fine_checks
-                    ? std::min(settings_.held_resolution, roadmap_.record.resolution)
-                    : roadmap_.record.resolution;
+  resolution_ = std::min(request.fine_checks ? settings_.fine_resolution
+                         : held_.held         ? settings_.held_resolution
+                                              : roadmap_.record.resolution,
+                         roadmap_.record.resolution);
   if (held_.held && arm_index_ != stage.suction_arm) cell.set_jaw(robot_q_, arm_, held_.jaw);
   moves_tool_ = request.tool_in_hand && arm_index_ == stage.suction_arm;
   moving_ = stage.cell.arm_bodies[static_cast<std::size_t>(arm_index_)];

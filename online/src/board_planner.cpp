@@ -316,9 +316,11 @@ class Run {
       s.smoothed = false;
       valid = timed_and_valid(stage, arm, request, path, timed, s.validation);
     }
-    if (!valid && !request.fine_checks && !request.held.held &&
-        s.validation.violations.front().kind == "collision") {
-      // The empty arm's segments are checked at the roadmap's resolution: a thin collision
+    if (!valid && !request.fine_checks &&
+        (s.validation.violations.front().kind == "collision" ||
+         s.validation.violations.front().kind == "slip")) {
+      // The planner checks coarser than the validator (the roadmap's resolution with the arm
+      // empty, MotionSettings::held_resolution with a board): a thin collision or a slip peak
       // between its samples is planned around once at the validator's.
       MotionRequest fine = request;
       fine.fine_checks = true;

@@ -53,8 +53,8 @@ struct MotionRequest {
   // its first and last few waypoints and re-validated against the scene as it is.
   std::vector<const std::vector<Eigen::VectorXd>*> hints;
   bool allow_bridge = true;  // false: roadmap (and stored paths) only, e.g. for a staging try
-  // Every segment at MotionSettings::held_resolution even with nothing held: a retry after the
-  // validator found a thin collision between the empty arm's coarser samples.
+  // Every segment at MotionSettings::fine_resolution (the validator's): a retry after the
+  // validator found a thin collision between the planner's coarser samples.
   bool fine_checks = false;
   // A* runs allowed (0: MotionSettings::max_searches), e.g. fewer for a staging try, where a
   // bridge is the better tool once the roadmap around the goal proves this blocked.
@@ -94,9 +94,11 @@ struct MotionSettings {
   int attachments = 6;  // valid attachments kept per end
   int max_searches = 200;
   int staging_searches = 20;  // per staging try (MotionRequest::max_searches)
-  // Segment checks while holding a board: as fine as the validator's (rad), since a long board
-  // sweeps far between the roadmap's 0.05 rad samples; the empty arm uses the roadmap's.
-  double held_resolution = 0.01;
+  // Segment checks while holding a board (rad): finer than the roadmap's 0.05, since a long
+  // board sweeps far between those samples; the empty arm uses the roadmap's.
+  double held_resolution = 0.02;
+  // A fine retry's (MotionRequest::fine_checks): the validator's 0.01.
+  double fine_resolution = 0.01;
   // A bridge's validity-check budget (also bounded by the deadline). 4000 left the arm unable to
   // go home from beside the human's hands on back_lower and shelf_middle (the whole goal was then
   // abandoned after every other motion was planned); 10000 bridges them.
