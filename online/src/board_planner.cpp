@@ -112,9 +112,9 @@ class Run {
         suction_(cell_.arms()[static_cast<std::size_t>(world_.stage().suction_arm)]),
         receiving_(cell_.arms()[world_.stage().suction_arm == 0 ? 1u : 0u]),
         suction_planner_(world_, model.roadmap(suction_.spec.name), suction_.spec.name,
-                         settings.motion, baseline(lazy_prm, suction_)),
+                         settings.motion, baseline(lazy_prm, suction_, settings.motion)),
         receiving_planner_(world_, model.roadmap(receiving_.spec.name), receiving_.spec.name,
-                           settings.motion, baseline(lazy_prm, receiving_)),
+                           settings.motion, baseline(lazy_prm, receiving_, settings.motion)),
         board_initial_(scene.initial_pose(part)),
         opening_tcp_(cell_.spec().gripper.opening_axis.normalized()),
         approach_tcp_(cell_.spec().gripper.approach_axis.normalized()) {
@@ -214,13 +214,13 @@ class Run {
 
  private:
   static core::LazyPrmPlanner* baseline(
-      std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>>& lazy_prm,
-      const core::Arm& arm) {
-    // Checked every 0.01 rad like held-board motions here: the baseline gets the same checks.
+      std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>>& lazy_prm, const core::Arm& arm,
+      const MotionSettings& motion) {
+    // Checked as finely as held-board motions here: the baseline gets the same checks.
     auto& p = lazy_prm[arm.spec.name];
     if (!p) {
       core::LazyPrmSettings s;
-      s.resolution = 0.01;
+      s.resolution = motion.held_resolution;
       // Over the whole joint range: the scene's IK solutions may lie anywhere within the limits,
       // and a persistent roadmap cannot widen its box per query as a bridge does.
       s.joint_range = 2.0 * M_PI;
