@@ -73,8 +73,8 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   robot_q_ = request.robot_q.size() == 0 ? cell.home_configuration() : request.robot_q;
   held_ = request.held;
   resolution_ = std::min(request.fine_checks ? settings_.fine_resolution
-                         : held_.held         ? settings_.held_resolution
-                                              : roadmap_.record.resolution,
+                         : held_.held        ? settings_.held_resolution
+                                             : roadmap_.record.resolution,
                          roadmap_.record.resolution);
   if (held_.held && arm_index_ != stage.suction_arm) cell.set_jaw(robot_q_, arm_, held_.jaw);
   moves_tool_ = request.tool_in_hand && arm_index_ == stage.suction_arm;
@@ -366,8 +366,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   // A start in contact leaves straight up first (its lift is the request's goal, in practice):
   // the roadmap is entered from the goal side only when the direct segment failed.
   auto entries = attach(request.start);
-  // An end wedged where no straight segment reaches a roadmap node (a held board beside the
-  // other arm's load, say) enters the roadmap where a stored path that held from it leads.
+  // An end wedged where no straight segment reaches a roadmap node (a held board out where the
+  // slip-filtered roadmap does not go, say) enters it where a stored path that held leads.
   std::vector<Eigen::VectorXd> lead{request.start};
   if (entries.empty() && stored.lead.size() > 1) {
     entries = attach(stored.lead.back());
