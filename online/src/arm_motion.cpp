@@ -189,13 +189,11 @@ bool ArmMotionPlanner::edge_valid(int edge) {
 
 // The stored path re-validated for the scene, joined to the start and goal by straight segments
 // (the stored ends are the offline scene's: the board's nominal pose, a neighbouring IK
-// solution); empty when any piece is blocked. Then `pieces` keeps what did hold: the start
-// joined to the stored path's valid beginning, and its valid end joined to the goal.
+// solution); empty when any piece is blocked. The goal join is tried before the path is walked:
+// where the scene moved the goal, that fails after a few checks.
 std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::VectorXd>& hint,
                                                       const Eigen::VectorXd& start,
-                                                      const Eigen::VectorXd& goal,
-                                                      StoredPieces& pieces) {
-  pieces = {};
+                                                      const Eigen::VectorXd& goal) {
   const int n = static_cast<int>(hint.size());
   if (n < 2 || hint.front().size() != start.size()) return {};
   const auto at = [&](int i) -> const Eigen::VectorXd& {
@@ -206,30 +204,69 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::V
   for (int i = 0; i < std::min(n, tries) && first < 0; ++i) {
     if (valid(at(i)) && segment_valid(start, at(i))) first = i;
   }
-  if (first >= 0) {
+  if (first < 0) return {};
+  int last = -1;
+  for (int j = n - 1; j >= std::max(first, n - tries) && last < 0; --j) {
+    if ((j == first || valid(at(j))) && segment_valid(at(j), goal)) last = j;
+  }
+  if (last < 0) return {};
+  for (int i = first + 1; i <= last; ++i) {
+    if ((i != last && !valid(at(i))) || !segment_valid(at(i - 1), at(i))) return {};
+  }
+  std::vector<Eigen::VectorXd> path{start};
+  for (int i = first; i <= last; ++i) path.push_back(at(i));
+  path.push_back(goal);
+  return path;
+}
+
+// For an end no straight segment joins to the roadmap (looked up only then): the start joined
+// to the longest valid beginning of a stored path (start first), or the longest valid end of
+// one joined to the goal (goal last); a single point when no stored path joins.
+std::vector<Eigen::VectorXd> ArmMotionPlanner::stored_lead(const Hints& hints,
+                                                           const Eigen::VectorXd& start) {
+  std::vector<Eigen::VectorXd> best{start};
+  for (const auto* hint : hints) {
+    const auto& h = *hint;
+    const int n = static_cast<int>(h.size());
+    if (n < 2 || h.front().size() != start.size()) continue;
+    const auto at = [&](int i) -> const Eigen::VectorXd& { return h[static_cast<std::size_t>(i)]; };
+    int first = -1;
+    for (int i = 0; i < std::min(n, std::max(1, settings_.join_waypoints)) && first < 0; ++i) {
+      if (valid(at(i)) && segment_valid(start, at(i))) first = i;
+    }
+    if (first < 0) continue;
     int reach = first;
     while (reach + 1 < n && valid(at(reach + 1)) && segment_valid(at(reach), at(reach + 1))) {
       ++reach;
     }
-    for (int j = reach; j >= std::max(first, n - tries); --j) {
-      if (!segment_valid(at(j), goal)) continue;
-      std::vector<Eigen::VectorXd> path{start};
-      for (int i = first; i <= j; ++i) path.push_back(at(i));
-      path.push_back(goal);
-      return path;
+    if (reach - first + 2 <= static_cast<int>(best.size())) continue;
+    best.assign(1, start);
+    for (int i = first; i <= reach; ++i) best.push_back(at(i));
+  }
+  return best;
+}
+
+std::vector<Eigen::VectorXd> ArmMotionPlanner::stored_tail(const Hints& hints,
+                                                           const Eigen::VectorXd& goal) {
+  std::vector<Eigen::VectorXd> best{goal};
+  for (const auto* hint : hints) {
+    const auto& h = *hint;
+    const int n = static_cast<int>(h.size());
+    if (n < 2 || h.front().size() != goal.size()) continue;
+    const auto at = [&](int i) -> const Eigen::VectorXd& { return h[static_cast<std::size_t>(i)]; };
+    int last = -1;
+    for (int j = n - 1; j >= std::max(0, n - std::max(1, settings_.join_waypoints)) && last < 0;
+         --j) {
+      if (valid(at(j)) && segment_valid(at(j), goal)) last = j;
     }
-    pieces.lead.push_back(start);
-    for (int i = first; i <= reach; ++i) pieces.lead.push_back(at(i));
-  }
-  for (int j = n - 1; j >= std::max(0, n - tries); --j) {
-    if (!valid(at(j)) || !segment_valid(at(j), goal)) continue;
-    int back = j;
+    if (last < 0) continue;
+    int back = last;
     while (back > 0 && valid(at(back - 1)) && segment_valid(at(back - 1), at(back))) --back;
-    for (int i = back; i <= j; ++i) pieces.tail.push_back(at(i));
-    pieces.tail.push_back(goal);
-    break;
+    if (last - back + 2 <= static_cast<int>(best.size())) continue;
+    best.assign(h.begin() + back, h.begin() + last + 1);
+    best.push_back(goal);
   }
-  return {};
+  return best;
 }
 
 // Greedy shortcuts within a check budget: from each kept waypoint, the farthest later one a
@@ -340,18 +377,13 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(late() ? MotionStatus::kTimeout : MotionStatus::kNoPath,
                   std::string(to_string(settings_.planner)) + " found no path within its budget");
   }
-  // What held of the stored paths when none did whole: the longest valid beginning and end.
-  StoredPieces stored;
   for (const auto* hint : request.hints) {
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed on a stored path");
-    StoredPieces pieces;
-    r.path = follow(*hint, request.start, request.goal, pieces);
+    r.path = follow(*hint, request.start, request.goal);
     if (!r.path.empty()) {
       r.via = "stored";
       return finish(MotionStatus::kSolved, "");
     }
-    if (pieces.lead.size() > stored.lead.size()) stored.lead = std::move(pieces.lead);
-    if (pieces.tail.size() > stored.tail.size()) stored.tail = std::move(pieces.tail);
   }
   // What stops the straight motion, for the reason when everything fails (looked up then only:
   // a successful search would have spent these checks for nothing).
@@ -369,15 +401,17 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   // An end wedged where no straight segment reaches a roadmap node (a held board out where the
   // slip-filtered roadmap does not go, say) enters it where a stored path that held leads.
   std::vector<Eigen::VectorXd> lead{request.start};
-  if (entries.empty() && stored.lead.size() > 1) {
-    entries = attach(stored.lead.back());
-    if (!entries.empty()) lead = stored.lead;
+  if (entries.empty() && !request.hints.empty()) {
+    auto stored = stored_lead(request.hints, request.start);
+    if (stored.size() > 1) entries = attach(stored.back());
+    if (!entries.empty()) lead = std::move(stored);
   }
   auto exits = entries.empty() ? std::vector<core::GraphEndpoint>{} : attach(request.goal);
   std::vector<Eigen::VectorXd> tail{request.goal};
-  if (!entries.empty() && exits.empty() && stored.tail.size() > 1) {
-    exits = attach(stored.tail.front());
-    if (!exits.empty()) tail = stored.tail;
+  if (!entries.empty() && exits.empty() && !request.hints.empty()) {
+    auto stored = stored_tail(request.hints, request.goal);
+    if (stored.size() > 1) exits = attach(stored.front());
+    if (!exits.empty()) tail = std::move(stored);
   }
   const int max_searches = request.max_searches > 0 ? request.max_searches : settings_.max_searches;
   while (!entries.empty() && !exits.empty() && r.searches < max_searches) {

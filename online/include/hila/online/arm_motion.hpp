@@ -139,15 +139,11 @@ class ArmMotionPlanner {
   enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
   Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
   bool edge_valid(int edge);
-  // A stored path's parts that hold in the scene when the whole does not: the start joined to
-  // its valid beginning (start first), and its valid end joined to the goal (goal last).
-  struct StoredPieces {
-    std::vector<Eigen::VectorXd> lead;
-    std::vector<Eigen::VectorXd> tail;
-  };
+  using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
   std::vector<Eigen::VectorXd> follow(const std::vector<Eigen::VectorXd>& hint,
-                                      const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
-                                      StoredPieces& pieces);
+                                      const Eigen::VectorXd& start, const Eigen::VectorXd& goal);
+  std::vector<Eigen::VectorXd> stored_lead(const Hints& hints, const Eigen::VectorXd& start);
+  std::vector<Eigen::VectorXd> stored_tail(const Hints& hints, const Eigen::VectorXd& goal);
   void shorten(std::vector<Eigen::VectorXd>& path);
   std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q);
 
