@@ -837,6 +837,26 @@ class Run {
     }
     release.start = *away;
     release.goal = receiving_.spec.home;
+    // The way the arm came, backwards (transfer to the human, grasp, approach), as a stored path:
+    // from beside the human's hands a straight segment often reaches no roadmap node, while the
+    // arm's own way in, now empty-handed, is mostly still clear.
+    std::vector<Eigen::VectorXd> way_back;
+    const auto add_reversed = [&](const Stage& from, const std::string& name) {
+      for (const auto& step : from.steps) {
+        if (step.name != name) continue;
+        for (auto q = step.q.rbegin(); q != step.q.rend(); ++q) {
+          if (way_back.empty() || (*q - way_back.back()).norm() >= settings_.way_back_spacing) {
+            way_back.push_back(*q);
+          }
+        }
+      }
+    };
+    if (settings_.way_back_spacing > 0.0) {
+      add_reversed(present(rr, grasp, goal), "transfer_to_human");
+      add_reversed(receive(rr, grasp), "receiving_grasp");
+      add_reversed(receive(rr, grasp), "receiving_approach");
+    }
+    if (way_back.size() > 1) release.hints = {&way_back};
     // The board is the human's now; it no longer stands where the arm goes home.
     if (auto e = step(st, receiving_planner_, receiving_, release, "receiving_arm_home", "", "");
         !e.empty()) {

@@ -27,6 +27,9 @@ struct BoardPlanSettings {
   SmootherSettings smoother;
   double timing_step =
       0.05;  // rad: the timed trajectory's longest piece (time_parameterize_through)
+  // rad: waypoints of the receiving arm's way back (its way in, reversed) at least this far
+  // apart; the hint for its way home after the release (0 disables the hint).
+  double way_back_spacing = 0.05;
   MotionSettings motion;
   ValidatorSettings validator;
   // The validator's dense pass is split over this many threads (the same report as one).
