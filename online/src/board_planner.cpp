@@ -837,9 +837,10 @@ class Run {
     }
     release.start = *away;
     release.goal = receiving_.spec.home;
-    // The way the arm came, backwards (transfer to the human, grasp, approach), as a stored path:
-    // from beside the human's hands a straight segment often reaches no roadmap node, while the
-    // arm's own way in, now empty-handed, is mostly still clear.
+    // The way the arm came, backwards (transfer to the human, grasp, approach), as a stored path
+    // that leads into the roadmap: from beside the human's hands a straight segment often
+    // reaches no roadmap node, while the arm's own way in, now empty-handed, is clear for a
+    // while.
     std::vector<Eigen::VectorXd> way_back;
     const auto add_reversed = [&](const Stage& from, const std::string& name) {
       for (const auto& step : from.steps) {
@@ -857,6 +858,8 @@ class Run {
       add_reversed(receive(rr, grasp), "receiving_approach");
     }
     if (way_back.size() > 1) release.hints = {&way_back};
+    // Only where the retreat attaches to no roadmap node: mostly the roadmap's way is shorter.
+    release.follow_hints = false;
     // The board is the human's now; it no longer stands where the arm goes home.
     if (auto e = step(st, receiving_planner_, receiving_, release, "receiving_arm_home", "", "");
         !e.empty()) {

@@ -52,6 +52,9 @@ struct MotionRequest {
   // order before the roadmap: each is joined to the start and goal by straight segments within
   // its first and last few waypoints and re-validated against the scene as it is.
   std::vector<const std::vector<Eigen::VectorXd>*> hints;
+  // Whether the hints are followed whole before the roadmap is searched; false keeps them for
+  // leading a wedged end into the roadmap only (a hint that seldom holds whole).
+  bool follow_hints = true;
   bool allow_bridge = true;  // false: roadmap (and stored paths) only, e.g. for a staging try
   // Every segment at MotionSettings::fine_resolution (the validator's): a retry after the
   // validator found a thin collision between the planner's coarser samples.
