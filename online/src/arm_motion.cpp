@@ -377,7 +377,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(late() ? MotionStatus::kTimeout : MotionStatus::kNoPath,
                   std::string(to_string(settings_.planner)) + " found no path within its budget");
   }
-  for (const auto* hint : request.follow_hints ? request.hints : Hints{}) {
+  for (const auto* hint : request.hints) {
+    if (!request.follow_hints) break;  // kept for leading a wedged end in (below)
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed on a stored path");
     r.path = follow(*hint, request.start, request.goal);
     if (!r.path.empty()) {
