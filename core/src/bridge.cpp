@@ -3,6 +3,7 @@
 #include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/ProblemDefinition.h>
 #include <ompl/base/SpaceInformation.h>
+#include <ompl/base/goals/GoalStates.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/PathGeometric.h>
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
@@ -57,11 +58,32 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
                                          const std::function<bool(const Eigen::VectorXd&)>& valid,
                                          const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                                          const BridgeSettings& settings) {
-  if (!valid(from) || !valid(to)) return {};
-  if (segment_valid(valid, from, to, settings.resolution)) return {from, to};
+  return plan_bridge_to_any(arm, valid, from, {to}, settings);
+}
+
+std::vector<Eigen::VectorXd> plan_bridge_to_any(
+    const Arm& arm, const std::function<bool(const Eigen::VectorXd&)>& valid,
+    const Eigen::VectorXd& from, const std::vector<Eigen::VectorXd>& targets,
+    const BridgeSettings& settings) {
+  if (!valid(from)) return {};
+  std::vector<const Eigen::VectorXd*> ends;
+  for (const auto& t : targets) {
+    if (valid(t)) ends.push_back(&t);
+  }
+  if (ends.empty()) return {};
+  for (const auto* t : ends) {
+    if (segment_valid(valid, from, *t, settings.resolution)) return {from, *t};
+  }
   const int dof = arm.chain.dof();
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  const auto space = detail::joint_space(arm, settings.joint_range, settings.seed, &from, &to);
+  // The space's bounds take in the start and every end (joint_space widens them by two).
+  Eigen::VectorXd low = from;
+  Eigen::VectorXd high = from;
+  for (const auto* t : ends) {
+    low = low.cwiseMin(*t);
+    high = high.cwiseMax(*t);
+  }
+  const auto space = detail::joint_space(arm, settings.joint_range, settings.seed, &low, &high);
   auto si = std::make_shared<ob::SpaceInformation>(space);
   long checks = 0;
   si->setStateValidityChecker([&](const ob::State* s) {
@@ -71,12 +93,16 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
   si->setStateValidityCheckingResolution(settings.resolution / space->getMaximumExtent());
   si->setup();
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
-  ob::ScopedState<> start(space), goal(space);
-  for (int i = 0; i < dof; ++i) {
-    start[static_cast<unsigned>(i)] = from[i];
-    goal[static_cast<unsigned>(i)] = to[i];
+  ob::ScopedState<> start(space);
+  for (int i = 0; i < dof; ++i) start[static_cast<unsigned>(i)] = from[i];
+  pdef->addStartState(start);
+  auto goals = std::make_shared<ob::GoalStates>(si);
+  for (const auto* t : ends) {
+    ob::ScopedState<> goal(space);
+    for (int i = 0; i < dof; ++i) goal[static_cast<unsigned>(i)] = (*t)[i];
+    goals->addState(goal);
   }
-  pdef->setStartAndGoalStates(start, goal);
+  pdef->setGoal(goals);
   og::RRTConnect planner(si);
   planner.setRange(settings.range);
   planner.setProblemDefinition(pdef);

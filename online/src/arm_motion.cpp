@@ -191,6 +191,26 @@ bool ArmMotionPlanner::edge_valid(int edge) {
 // (the stored ends are the offline scene's: the board's nominal pose, a neighbouring IK
 // solution); empty when any piece is blocked. The goal join is tried before the path is walked:
 // where the scene moved the goal, that fails after a few checks.
+bool ArmMotionPlanner::join_ends(const std::vector<Eigen::VectorXd>& hint,
+                                 const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
+                                 int& first, int& last) {
+  const int n = static_cast<int>(hint.size());
+  const auto at = [&](int i) -> const Eigen::VectorXd& {
+    return hint[static_cast<std::size_t>(i)];
+  };
+  const int tries = std::max(1, settings_.join_waypoints);
+  first = -1;
+  for (int i = 0; i < std::min(n, tries) && first < 0; ++i) {
+    if (valid(at(i)) && segment_valid(start, at(i))) first = i;
+  }
+  if (first < 0) return false;
+  last = -1;
+  for (int j = n - 1; j >= std::max(first, n - tries) && last < 0; --j) {
+    if ((j == first || valid(at(j))) && segment_valid(at(j), goal)) last = j;
+  }
+  return last >= 0;
+}
+
 std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::VectorXd>& hint,
                                                       const Eigen::VectorXd& start,
                                                       const Eigen::VectorXd& goal) {
@@ -199,22 +219,60 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::V
   const auto at = [&](int i) -> const Eigen::VectorXd& {
     return hint[static_cast<std::size_t>(i)];
   };
-  const int tries = std::max(1, settings_.join_waypoints);
   int first = -1;
-  for (int i = 0; i < std::min(n, tries) && first < 0; ++i) {
-    if (valid(at(i)) && segment_valid(start, at(i))) first = i;
-  }
-  if (first < 0) return {};
   int last = -1;
-  for (int j = n - 1; j >= std::max(first, n - tries) && last < 0; --j) {
-    if ((j == first || valid(at(j))) && segment_valid(at(j), goal)) last = j;
-  }
-  if (last < 0) return {};
+  if (!join_ends(hint, start, goal, first, last)) return {};
   for (int i = first + 1; i <= last; ++i) {
     if ((i != last && !valid(at(i))) || !segment_valid(at(i - 1), at(i))) return {};
   }
   std::vector<Eigen::VectorXd> path{start};
   for (int i = first; i <= last; ++i) path.push_back(at(i));
+  path.push_back(goal);
+  return path;
+}
+
+std::vector<Eigen::VectorXd> ArmMotionPlanner::repair(
+    const std::vector<Eigen::VectorXd>& hint, const Eigen::VectorXd& start,
+    const Eigen::VectorXd& goal, const std::function<bool(const Eigen::VectorXd&)>& valid_here,
+    std::chrono::steady_clock::time_point deadline) {
+  const int n = static_cast<int>(hint.size());
+  if (n < 2 || hint.front().size() != start.size() || settings_.repair_checks <= 0) return {};
+  const auto at = [&](int i) -> const Eigen::VectorXd& {
+    return hint[static_cast<std::size_t>(i)];
+  };
+  int first = -1;
+  int last = -1;
+  if (!join_ends(hint, start, goal, first, last)) return {};
+  std::vector<Eigen::VectorXd> path{start, at(first)};
+  int repairs = 0;
+  for (int i = first; i < last;) {
+    if ((i + 1 == last || valid(at(i + 1))) && segment_valid(at(i), at(i + 1))) {
+      path.push_back(at(++i));
+      continue;
+    }
+    // Blocked after waypoint i: a bridge from it to whichever of the next valid waypoints it
+    // reaches, and the stored path again from there.
+    if (++repairs > settings_.max_repairs) return {};
+    std::vector<Eigen::VectorXd> targets;
+    std::vector<int> index;
+    for (int k = i + 1; k <= last && static_cast<int>(targets.size()) < settings_.repair_targets;
+         ++k) {
+      if (k == last || valid(at(k))) {
+        targets.push_back(at(k));
+        index.push_back(k);
+      }
+    }
+    core::BridgeSettings bridge;
+    bridge.max_checks = settings_.repair_checks;
+    bridge.resolution = resolution_;
+    bridge.seed = settings_.seed;
+    bridge.deadline = deadline;
+    const auto around = core::plan_bridge_to_any(arm_, valid_here, at(i), targets, bridge);
+    if (around.empty()) return {};
+    path.insert(path.end(), around.begin() + 1, around.end());
+    const auto reached = std::find(targets.begin(), targets.end(), around.back());
+    i = index[static_cast<std::size_t>(reached - targets.begin())];
+  }
   path.push_back(goal);
   return path;
 }
@@ -447,6 +505,16 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed before a bridge");
   if (!request.allow_bridge) {
     return finish(MotionStatus::kNoPath, "the roadmap does not connect start and goal");
+  }
+  // A stored path the scene blocks, repaired around what is in the way (local bridges), before
+  // a bridge across the whole motion.
+  for (const auto* hint : request.hints) {
+    if (!request.follow_hints || late()) break;
+    r.path = repair(*hint, request.start, request.goal, valid_here, request.deadline);
+    if (!r.path.empty()) {
+      r.via = "stored+repair";
+      return finish(MotionStatus::kSolved, "");
+    }
   }
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
   core::BridgeSettings bridge;

@@ -143,11 +143,14 @@ class Run {
   const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps() const { return robot_grasps_; }
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
 
-  // Bridges of `checks` from now on. The stages that failed are forgotten so that they are
-  // planned again; those that were planned stand (a larger budget finds the same or more).
-  void escalate(long checks) {
+  // Bridges of `checks` and stored-path repairs of `repair_checks` from now on. The stages that
+  // failed are forgotten so that they are planned again; those that were planned stand (a larger
+  // budget finds the same or more).
+  void escalate(long checks, long repair_checks) {
     suction_planner_.set_bridge_checks(checks);
     receiving_planner_.set_bridge_checks(checks);
+    suction_planner_.set_repair_checks(repair_checks);
+    receiving_planner_.set_repair_checks(repair_checks);
     if (tool_ && !tool_->ok()) tool_.reset();
     auto forget_failed = [](auto& stages) {
       std::erase_if(stages, [](const auto& entry) { return !entry.second.ok(); });
@@ -995,7 +998,8 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (settings_.motion.planner == MotionPlannerKind::kRoadmap &&
       settings_.motion.escalated_bridge_checks > settings_.motion.bridge_checks && !goals.empty() &&
       std::chrono::steady_clock::now() < deadline) {
-    run.escalate(settings_.motion.escalated_bridge_checks);
+    run.escalate(settings_.motion.escalated_bridge_checks,
+                 settings_.motion.escalated_repair_checks);
     if (try_goals("(larger bridges) ")) {
       result.larger_bridges = true;
       return finish(BoardPlanStatus::kSolved, "");

@@ -177,6 +177,49 @@ TEST(Bridge, EnclosedGoalReturnsNothingWithinBudget) {
   EXPECT_LE(calls, settings.max_checks + 2000);
 }
 
+// Several ends: invalid ones are skipped, and the path ends exactly at a valid one, valid all
+// the way at the resolution. One in straight reach is joined directly.
+TEST(Bridge, ToAnyEndsAtOneOfTheValidTargets) {
+  const core::Arm& arm = left_arm();
+  const Scenario s = wall_scenario();
+  const Validity valid = validity_of(s.wall);
+  Eigen::VectorXd inside = s.from;
+  inside[0] = s.wall.wall_q0;
+  ASSERT_FALSE(valid(inside));
+  Eigen::VectorXd beyond = s.to;
+  beyond[5] += 0.5;
+  ASSERT_TRUE(valid(beyond));
+  ASSERT_FALSE(core::segment_valid(valid, s.from, beyond, 0.05));
+  const std::vector<Eigen::VectorXd> targets{inside, s.to, beyond};
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    core::BridgeSettings settings;
+    settings.seed = seed;
+    const auto path = core::plan_bridge_to_any(arm, valid, s.from, targets, settings);
+    ASSERT_GE(path.size(), 3u);
+    EXPECT_EQ(path.front(), s.from);
+    EXPECT_TRUE(path.back() == s.to || path.back() == beyond) << path.back().transpose();
+    // The contract: valid at the resolution (a segment may clip the gap's corner between
+    // samples, as any resolution-checked path may).
+    expect_path_valid(path, valid, 5.0 * settings.resolution);
+  }
+  // Only the wall's side the start is on in straight reach: joined directly.
+  Eigen::VectorXd near = s.from;
+  near[5] += 0.3;
+  ASSERT_TRUE(core::segment_valid(valid, s.from, near, 0.05));
+  const auto direct = core::plan_bridge_to_any(arm, valid, s.from, {inside, s.to, near}, {});
+  ASSERT_EQ(direct.size(), 2u);
+  EXPECT_EQ(direct.back(), near);
+  // No valid target: nothing, at once.
+  long calls = 0;
+  const Validity counting = [&](const Eigen::VectorXd& q) {
+    ++calls;
+    return valid(q);
+  };
+  EXPECT_TRUE(core::plan_bridge_to_any(arm, counting, s.from, {inside}, {}).empty());
+  EXPECT_LE(calls, 2);
+}
+
 TEST(Bridge, SegmentValidMatchesDenseCheck) {
   const Scenario s = wall_scenario();
   const Validity valid = validity_of(s.wall);

@@ -146,6 +146,48 @@ TEST(ArmMotion, AnObstacleOnTheStoredPathIsRepairedAround) {
   EXPECT_TRUE(report.valid()) << describe(report);
 }
 
+// The same crate, the blocked roadmap path given as a stored path, and the roadmap allowed one
+// search only: with a repair budget the stored path is bridged around the crate where it is
+// blocked and kept elsewhere (its waypoint before the crate is still on the path); without one
+// the motion falls through to a bridge across the whole motion.
+TEST(ArmMotion, AStoredPathBlockedMidwayIsRepairedLocally) {
+  const auto& cell = *test::reference_cell();
+  const auto crated = crate_on_a_roadmap_path();
+  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
+  const auto& [a, b, before, blocked] = *crated;
+  const online::World world(cell, cabinet(), blocked, "top");
+  core::CollisionData data = world.make_data();
+  const std::vector<Eigen::VectorXd>& stored = before.path;
+  const std::size_t crate_at = stored.size() / 2;  // the waypoint the crate sits on
+  online::MotionRequest r = request(a, b);
+  r.hints = {&stored};
+  r.max_searches = 1;
+
+  online::MotionSettings settings;
+  settings.repair_checks = 20000;
+  online::ArmMotionPlanner repairing(world, left_roadmap(), "left", settings);
+  repairing.prepare(r);
+  ASSERT_FALSE(repairing.valid(stored[crate_at])) << "the crate must block the stored path";
+  const auto repaired = repairing.plan(r);
+  ASSERT_TRUE(repaired.solved()) << repaired.reason;
+  EXPECT_EQ(repaired.via, "stored+repair");
+  EXPECT_TRUE(repaired.path.front().isApprox(a, 0.0));
+  EXPECT_TRUE(repaired.path.back().isApprox(b, 0.0));
+  // Kept up to the blockage (shortcutting only drops waypoints between kept ones, and the
+  // stored start's neighbour is where the stored path is left only if the crate is there).
+  const auto kept = std::find(repaired.path.begin(), repaired.path.end(), stored[crate_at - 1]);
+  EXPECT_TRUE(kept != repaired.path.end() || crate_at - 1 == 0 ||
+              repairing.segment_valid(a, stored[crate_at + 1]))
+      << "the stored path before the crate was not kept";
+  const auto report =
+      online::validate_motion(world, data, timed(repaired.path, cabinet().part("top").initial));
+  EXPECT_TRUE(report.valid()) << describe(report);
+
+  online::ArmMotionPlanner plain(world, left_roadmap(), "left");  // repair_checks 0
+  const auto without = plain.plan(r);
+  EXPECT_NE(without.via, "stored+repair");
+}
+
 TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
   const auto& cell = *test::reference_cell();
   const auto pair = far_pairs(1).front();

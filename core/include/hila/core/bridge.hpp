@@ -34,6 +34,15 @@ std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
                                          const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                                          const BridgeSettings& settings);
 
+// The same towards whichever of several ends it reaches first: RRT-Connect with every valid one
+// of `targets` a root of its goal tree (invalid ones are skipped), for repairing a blocked
+// stored path, where any later waypoint past the blockage will do. The path ends exactly at
+// the target it reached; nothing when none is reached within the budget.
+std::vector<Eigen::VectorXd> plan_bridge_to_any(
+    const Arm& arm, const std::function<bool(const Eigen::VectorXd&)>& valid,
+    const Eigen::VectorXd& from, const std::vector<Eigen::VectorXd>& targets,
+    const BridgeSettings& settings);
+
 // The interior samples of the straight joint-space segment a -> b at `resolution`:
 // ceil(|b - a| / resolution) - 1 points, evenly spaced (what roadmaps check and annotate).
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -72,8 +73,8 @@ struct MotionResult {
   std::string reason;                 // why not solved, naming what is in the way
   std::vector<Eigen::VectorXd> path;  // start ... goal, straight segments between waypoints
   // "direct", "stored" (an offline path re-validated), "roadmap", "stored+roadmap" (the roadmap
-  // entered or left along the part of a stored path that holds), "bridge"; the baselines'
-  // "rrt_connect" or "lazy_prm"
+  // entered or left along the part of a stored path that holds), "stored+repair" (a stored path
+  // bridged around what blocks it), "bridge"; the baselines' "rrt_connect" or "lazy_prm"
   std::string via;
   int searches = 0;           // A* runs (one more after each invalidated edge)
   int edges_checked = 0;      // roadmap edges validated against the scene
@@ -106,6 +107,17 @@ struct MotionSettings {
   // go home from beside the human's hands on back_lower and shelf_middle (the whole goal was then
   // abandoned after every other motion was planned); 10000 bridges them.
   long bridge_checks = 10000;
+  // A stored path the scene blocks, repaired around each blocked stretch (at most
+  // `max_repairs`) by a bridge of this many checks to one of the next `repair_targets` valid
+  // waypoints, when the roadmap fails and before a bridge across the whole motion. Off (0) in
+  // the first round, where a failing repair would add to every blocked motion; a board whose
+  // every goal failed gets `escalated_repair_checks` with the larger bridges. Where a stored
+  // transfer under a 17 deg slip limit threads between finished boards and a box blocks it
+  // further on, the repair (20000) gets through where a whole-motion bridge needs luck.
+  long repair_checks = 0;
+  long escalated_repair_checks = 20000;
+  int max_repairs = 2;
+  int repair_targets = 12;
   // A board whose every goal failed within bridge_checks is tried once more, time permitting,
   // with bridges this large (the baselines' from-scratch budget).
   long escalated_bridge_checks = 200000;
@@ -137,14 +149,26 @@ class ArmMotionPlanner {
 
   // A bridge's check budget from the next request on (MotionSettings::bridge_checks).
   void set_bridge_checks(long checks) { settings_.bridge_checks = checks; }
+  // A stored path's repair budget from the next request on (MotionSettings::repair_checks).
+  void set_repair_checks(long checks) { settings_.repair_checks = checks; }
 
  private:
   enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
   Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
   bool edge_valid(int edge);
   using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
+  // The first of a stored path's first few waypoints a straight segment joins to the start, and
+  // the last of its last few joined to the goal; false when either end does not join.
+  bool join_ends(const std::vector<Eigen::VectorXd>& hint, const Eigen::VectorXd& start,
+                 const Eigen::VectorXd& goal, int& first, int& last);
   std::vector<Eigen::VectorXd> follow(const std::vector<Eigen::VectorXd>& hint,
                                       const Eigen::VectorXd& start, const Eigen::VectorXd& goal);
+  // A stored path followed as follow() does, each stretch the scene blocks bridged from the
+  // waypoint before it to one of the next valid waypoints; nothing when a join or a repair fails.
+  std::vector<Eigen::VectorXd> repair(const std::vector<Eigen::VectorXd>& hint,
+                                      const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
+                                      const std::function<bool(const Eigen::VectorXd&)>& valid_here,
+                                      std::chrono::steady_clock::time_point deadline);
   std::vector<Eigen::VectorXd> stored_lead(const Hints& hints, const Eigen::VectorXd& start);
   std::vector<Eigen::VectorXd> stored_tail(const Hints& hints, const Eigen::VectorXd& goal);
   void shorten(std::vector<Eigen::VectorXd>& path);
