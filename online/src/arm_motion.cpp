@@ -233,10 +233,11 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::V
 
 std::vector<Eigen::VectorXd> ArmMotionPlanner::repair(
     const std::vector<Eigen::VectorXd>& hint, const Eigen::VectorXd& start,
-    const Eigen::VectorXd& goal, const std::function<bool(const Eigen::VectorXd&)>& valid_here,
+    const Eigen::VectorXd& goal, long checks,
+    const std::function<bool(const Eigen::VectorXd&)>& valid_here,
     std::chrono::steady_clock::time_point deadline) {
   const int n = static_cast<int>(hint.size());
-  if (n < 2 || hint.front().size() != start.size() || settings_.repair_checks <= 0) return {};
+  if (n < 2 || hint.front().size() != start.size() || checks <= 0) return {};
   const auto at = [&](int i) -> const Eigen::VectorXd& {
     return hint[static_cast<std::size_t>(i)];
   };
@@ -263,7 +264,7 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::repair(
       }
     }
     core::BridgeSettings bridge;
-    bridge.max_checks = settings_.repair_checks;
+    bridge.max_checks = checks;
     bridge.resolution = resolution_;
     bridge.seed = settings_.seed;
     bridge.deadline = deadline;
@@ -503,14 +504,23 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed before a bridge");
+  const char* wedge = entries.empty() ? "the start attaches to no roadmap node"
+                      : exits.empty() ? "the goal attaches to no roadmap node"
+                                      : nullptr;
+  r.wedged = wedge != nullptr;
   if (!request.allow_bridge) {
     return finish(MotionStatus::kNoPath, "the roadmap does not connect start and goal");
   }
   // A stored path the scene blocks, repaired around what is in the way (local bridges), before
-  // a bridge across the whole motion.
+  // a bridge across the whole motion; in the first round only when an end attaches to no
+  // roadmap node (the whole-motion bridge then has to find the way out of a wedge by chance).
+  const long repair_budget = r.wedged
+                                 ? std::max(settings_.repair_checks, settings_.wedged_repair_checks)
+                                 : settings_.repair_checks;
   for (const auto* hint : request.hints) {
     if (!request.follow_hints || late()) break;
-    r.path = repair(*hint, request.start, request.goal, valid_here, request.deadline);
+    r.path =
+        repair(*hint, request.start, request.goal, repair_budget, valid_here, request.deadline);
     if (!r.path.empty()) {
       r.via = "stored+repair";
       return finish(MotionStatus::kSolved, "");
@@ -530,9 +540,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the bridge");
   return finish(
       MotionStatus::kNoPath,
-      entries.empty() ? "the start attaches to no roadmap node and no bridge was found"
-      : exits.empty()
-          ? "the goal attaches to no roadmap node and no bridge was found"
+      r.wedged
+          ? std::string(wedge) + " and no bridge was found"
           : "the roadmap is cut between start and goal (" + std::to_string(invalidated_) +
                 " edges blocked in the scene) and no bridge was found; the straight motion meets " +
                 direct_blocker());

@@ -185,7 +185,26 @@ TEST(ArmMotion, AStoredPathBlockedMidwayIsRepairedLocally) {
 
   online::ArmMotionPlanner plain(world, left_roadmap(), "left");  // repair_checks 0
   const auto without = plain.plan(r);
+  EXPECT_FALSE(without.wedged);
   EXPECT_NE(without.via, "stored+repair");
+
+  // Ends that attach to no roadmap node (none is tried here): the default settings repair
+  // (wedged_repair_checks), and the motion says it was wedged only when it fails.
+  online::MotionSettings unattached;
+  unattached.attach_neighbours = 0;
+  online::ArmMotionPlanner wedged(world, left_roadmap(), "left", unattached);
+  const auto led = wedged.plan(r);
+  ASSERT_TRUE(led.solved()) << led.reason;
+  EXPECT_EQ(led.via, "stored+repair");
+  unattached.wedged_repair_checks = 0;
+  unattached.bridge_checks = 200;
+  online::ArmMotionPlanner no_repair(world, left_roadmap(), "left", unattached);
+  const auto stuck = no_repair.plan(r);
+  EXPECT_NE(stuck.via, "stored+repair");
+  if (!stuck.solved()) {
+    EXPECT_TRUE(stuck.wedged);
+    EXPECT_NE(stuck.reason.find("attaches to no roadmap node"), std::string::npos) << stuck.reason;
+  }
 }
 
 TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
