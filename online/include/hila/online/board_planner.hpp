@@ -40,7 +40,7 @@ struct BoardPlanSettings {
 struct PlanStep {
   std::string name;  // e.g. "suction_pick", "transfer_to_robot_handover"
   std::string arm;
-  std::string via;           // "direct", "roadmap" or "bridge" (for the planned part)
+  std::string via;           // how the motion was found (MotionResult::via)
   std::vector<double> time;  // s from the start of the board's plan
   std::vector<Eigen::VectorXd> q;
   std::string event;  // at the end: "suction_on", "suction_off", "gripper_close", "gripper_open",
