@@ -271,7 +271,7 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::repair(
     const auto around = core::plan_bridge_to_any(arm_, valid_here, at(i), targets, bridge);
     if (around.empty()) return {};
     path.insert(path.end(), around.begin() + 1, around.end());
-    // The bridge ends exactly at the target it joined (core::plan_bridge_between).
+    // The bridge ends exactly at the target it joined (core::plan_bridge_to_any).
     const auto reached = std::find(targets.begin(), targets.end(), around.back());
     assert(reached != targets.end());
     i = index[static_cast<std::size_t>(reached - targets.begin())];
