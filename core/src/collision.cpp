@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "hila/core/error.hpp"
+#include "hila/core/obb_separation.hpp"
 
 namespace hila::core {
 
@@ -260,8 +261,9 @@ struct CollisionDataImpl {
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
   std::vector<std::vector<int>> body_objects;
   std::vector<ShapeTag> tags;
-  std::vector<fcl::OBBd> obbs;         // per object, kept with its pose
-  std::vector<WorldBox> object_boxes;  // per object: its FCL world AABB
+  std::vector<fcl::OBBd> obbs;           // per object, kept with its pose
+  std::vector<unsigned char> last_axis;  // per pair of objects (QueryContext::last_axis)
+  std::vector<WorldBox> object_boxes;    // per object: its FCL world AABB
   fcl::DynamicAABBTreeCollisionManagerd static_manager;
   fcl::DynamicAABBTreeCollisionManagerd moving_manager;
   // Objects whose pose changed since the last query: only these are re-fitted in the trees.
@@ -301,6 +303,7 @@ CollisionData::CollisionData(const CollisionModel& model)
       impl_->objects.push_back(std::move(object));
     }
   }
+  impl_->last_axis.assign(impl_->objects.size() * impl_->objects.size(), 0);
   impl_->body_boxes.resize(bodies.size());
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     for (const int o : impl_->body_objects[b]) {
@@ -362,6 +365,9 @@ struct QueryContext {
   const CollisionModelImpl* model;
   CollisionPair* pair;
   const std::vector<fcl::OBBd>* obbs = nullptr;  // the oriented-box test first, when given
+  // Per pair of shapes (lower object index first), the axis that last separated their boxes:
+  // tried first next time (separating_axis).
+  std::vector<unsigned char>* last_axis = nullptr;
   bool hit = false;
   double min_distance = std::numeric_limits<double>::infinity();
 };
@@ -379,9 +385,14 @@ bool narrow_phase(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, int a, i
                   QueryContext* ctx) {
   if (ctx->obbs != nullptr) {
     const auto& obbs = *ctx->obbs;
-    const int i1 = static_cast<ShapeTag*>(o1->getUserData())->object;
-    const int i2 = static_cast<ShapeTag*>(o2->getUserData())->object;
-    if (!obbs[static_cast<std::size_t>(i1)].overlap(obbs[static_cast<std::size_t>(i2)])) {
+    const auto i1 = static_cast<std::size_t>(static_cast<ShapeTag*>(o1->getUserData())->object);
+    const auto i2 = static_cast<std::size_t>(static_cast<ShapeTag*>(o2->getUserData())->object);
+    const std::size_t lo = std::min(i1, i2);
+    const std::size_t hi = std::max(i1, i2);
+    unsigned char& hint = (*ctx->last_axis)[lo * obbs.size() + hi];
+    const int axis = separating_axis(obbs[lo], obbs[hi], hint);
+    if (axis >= 0) {
+      hint = static_cast<unsigned char>(axis);
       return false;
     }
   }
@@ -450,7 +461,7 @@ void refresh(CollisionDataImpl& d) {
 bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPair* first) {
   auto& d = data.impl();
   refresh(d);
-  QueryContext ctx{&model.impl(), first, &d.obbs};
+  QueryContext ctx{&model.impl(), first, &d.obbs, &d.last_axis};
   d.moving_manager.collide(&ctx, collide_callback);
   if (!ctx.hit) d.moving_manager.collide(&d.static_manager, &ctx, collide_callback);
   return ctx.hit;
@@ -460,7 +471,7 @@ bool in_collision(const CollisionModel& model, CollisionData& data, const std::v
                   CollisionPair* first) {
   auto& d = data.impl();
   const auto& m = model.impl();
-  QueryContext ctx{&m, first, &d.obbs};
+  QueryContext ctx{&m, first, &d.obbs, &d.last_axis};
   // No broad-phase tree: a cell has tens of bodies, and most fail one inline box test against
   // the active set's reach, which leaves a handful per active body.
   const std::size_t n = m.bodies.size();

@@ -1,0 +1,47 @@
+#pragma once
+
+#include <fcl/math/bv/OBB.h>
+
+#include <cmath>
+
+namespace hila::core {
+
+// The separating-axis test of two oriented boxes, as fcl::OBB::overlap computes it (the same
+// relative rotation and translation, each of the 15 axes' inequality as in fcl::obbDisjoint,
+// rotation magnitudes padded by 1e-6), but starting with the axis `first` and returning the axis
+// that separated: 0-2 box p's, 3-5 box q's, 6-14 their cross products; -1 when none does
+// (overlap). The boxes are disjoint exactly when one axis separates, whatever the order, so the
+// verdict is FCL's. A motion moves boxes a little between samples: the axis that separated a
+// pair last time mostly separates it again, and one inequality replaces up to fifteen.
+inline int separating_axis(const fcl::OBBd& p, const fcl::OBBd& q, int first) {
+  const Eigen::Vector3d d = q.To - p.To;
+  const Eigen::Vector3d t(p.axis.col(0).dot(d), p.axis.col(1).dot(d), p.axis.col(2).dot(d));
+  const Eigen::Matrix3d r = p.axis.transpose() * q.axis;
+  Eigen::Matrix3d f = r.cwiseAbs();
+  f.array() += 1e-6;
+  const Eigen::Vector3d& a = p.extent;
+  const Eigen::Vector3d& b = q.extent;
+  const auto separates = [&](int axis) {
+    if (axis < 3) return std::abs(t[axis]) > a[axis] + f.row(axis).dot(b);
+    if (axis < 6) {
+      const int j = axis - 3;
+      return std::abs(r.col(j).dot(t)) > b[j] + f.col(j).dot(a);
+    }
+    // p's axis i crossed with q's axis j.
+    const int i = (axis - 6) / 3;
+    const int j = (axis - 6) % 3;
+    const int i1 = (i + 1) % 3;
+    const int i2 = (i + 2) % 3;
+    const int j1 = (j + 1) % 3;
+    const int j2 = (j + 2) % 3;
+    const double s = t[i2] * r(i1, j) - t[i1] * r(i2, j);
+    return std::abs(s) > a[i1] * f(i2, j) + a[i2] * f(i1, j) + b[j1] * f(i, j2) + b[j2] * f(i, j1);
+  };
+  if (first >= 0 && first < 15 && separates(first)) return first;
+  for (int axis = 0; axis < 15; ++axis) {
+    if (axis != first && separates(axis)) return axis;
+  }
+  return -1;
+}
+
+}  // namespace hila::core
