@@ -187,10 +187,6 @@ bool ArmMotionPlanner::edge_valid(int edge) {
   return verdict == 1;
 }
 
-// The stored path re-validated for the scene, joined to the start and goal by straight segments
-// (the stored ends are the offline scene's: the board's nominal pose, a neighbouring IK
-// solution); empty when any piece is blocked. The goal join is tried before the path is walked:
-// where the scene moved the goal, that fails after a few checks.
 bool ArmMotionPlanner::join_ends(const std::vector<Eigen::VectorXd>& hint,
                                  const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
                                  int& first, int& last) {
@@ -211,33 +207,18 @@ bool ArmMotionPlanner::join_ends(const std::vector<Eigen::VectorXd>& hint,
   return last >= 0;
 }
 
-std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(const std::vector<Eigen::VectorXd>& hint,
-                                                      const Eigen::VectorXd& start,
-                                                      const Eigen::VectorXd& goal) {
-  const int n = static_cast<int>(hint.size());
-  if (n < 2 || hint.front().size() != start.size()) return {};
-  const auto at = [&](int i) -> const Eigen::VectorXd& {
-    return hint[static_cast<std::size_t>(i)];
-  };
-  int first = -1;
-  int last = -1;
-  if (!join_ends(hint, start, goal, first, last)) return {};
-  for (int i = first + 1; i <= last; ++i) {
-    if ((i != last && !valid(at(i))) || !segment_valid(at(i - 1), at(i))) return {};
-  }
-  std::vector<Eigen::VectorXd> path{start};
-  for (int i = first; i <= last; ++i) path.push_back(at(i));
-  path.push_back(goal);
-  return path;
-}
-
-std::vector<Eigen::VectorXd> ArmMotionPlanner::repair(
+// The stored path re-validated for the scene, joined to the start and goal by straight segments
+// (the stored ends are the offline scene's: the board's nominal pose, a neighbouring IK
+// solution). The goal join is tried before the path is walked: where the scene moved the goal,
+// that fails after a few checks. A stretch the scene blocks is repaired when `repair_checks` > 0
+// (else the path is empty).
+std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(
     const std::vector<Eigen::VectorXd>& hint, const Eigen::VectorXd& start,
-    const Eigen::VectorXd& goal, long checks,
+    const Eigen::VectorXd& goal, long repair_checks,
     const std::function<bool(const Eigen::VectorXd&)>& valid_here,
     std::chrono::steady_clock::time_point deadline) {
   const int n = static_cast<int>(hint.size());
-  if (n < 2 || hint.front().size() != start.size() || checks <= 0) return {};
+  if (n < 2 || hint.front().size() != start.size()) return {};
   const auto at = [&](int i) -> const Eigen::VectorXd& {
     return hint[static_cast<std::size_t>(i)];
   };
@@ -253,7 +234,7 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::repair(
     }
     // Blocked after waypoint i: a bridge from it to whichever of the next valid waypoints it
     // reaches, and the stored path again from there.
-    if (++repairs > settings_.max_repairs) return {};
+    if (repair_checks <= 0 || ++repairs > settings_.max_repairs) return {};
     std::vector<Eigen::VectorXd> targets;
     std::vector<int> index;
     for (int k = i + 1; k <= last && static_cast<int>(targets.size()) < settings_.repair_targets;
@@ -264,7 +245,7 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::repair(
       }
     }
     core::BridgeSettings bridge;
-    bridge.max_checks = checks;
+    bridge.max_checks = repair_checks;
     bridge.resolution = resolution_;
     bridge.seed = settings_.seed;
     bridge.deadline = deadline;
@@ -441,7 +422,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   for (const auto* hint : request.hints) {
     if (!request.follow_hints) break;  // kept for leading a wedged end in (below)
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed on a stored path");
-    r.path = follow(*hint, request.start, request.goal);
+    r.path = follow(*hint, request.start, request.goal, 0, valid_here, request.deadline);
     if (!r.path.empty()) {
       r.via = "stored";
       return finish(MotionStatus::kSolved, "");
@@ -520,9 +501,9 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
                                  ? std::max(settings_.repair_checks, settings_.wedged_repair_checks)
                                  : settings_.repair_checks;
   for (const auto* hint : request.hints) {
-    if (!request.follow_hints || late()) break;
+    if (!request.follow_hints || repair_budget <= 0 || late()) break;
     r.path =
-        repair(*hint, request.start, request.goal, repair_budget, valid_here, request.deadline);
+        follow(*hint, request.start, request.goal, repair_budget, valid_here, request.deadline);
     if (!r.path.empty()) {
       r.via = "stored+repair";
       return finish(MotionStatus::kSolved, "");

@@ -167,13 +167,13 @@ class ArmMotionPlanner {
   // the last of its last few joined to the goal; false when either end does not join.
   bool join_ends(const std::vector<Eigen::VectorXd>& hint, const Eigen::VectorXd& start,
                  const Eigen::VectorXd& goal, int& first, int& last);
+  // A stored path followed from the start to the goal, re-validated; with `repair_checks` > 0
+  // each stretch the scene blocks (at most MotionSettings::max_repairs) is bridged from the
+  // waypoint before it to one of the next valid waypoints. Empty when a join, a stretch or a
+  // repair fails.
   std::vector<Eigen::VectorXd> follow(const std::vector<Eigen::VectorXd>& hint,
-                                      const Eigen::VectorXd& start, const Eigen::VectorXd& goal);
-  // A stored path followed as follow() does, each stretch the scene blocks bridged from the
-  // waypoint before it to one of the next valid waypoints; nothing when a join or a repair fails.
-  std::vector<Eigen::VectorXd> repair(const std::vector<Eigen::VectorXd>& hint,
                                       const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
-                                      long checks,
+                                      long repair_checks,
                                       const std::function<bool(const Eigen::VectorXd&)>& valid_here,
                                       std::chrono::steady_clock::time_point deadline);
   std::vector<Eigen::VectorXd> stored_lead(const Hints& hints, const Eigen::VectorXd& start);
