@@ -11,6 +11,8 @@
 #include <fcl/narrowphase/distance.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "hila/core/error.hpp"
@@ -24,6 +26,7 @@ struct BodyModel {
   std::string name;
   std::vector<FclGeometry> geometries;
   std::vector<Pose> offsets;
+  std::vector<char> offset_is_identity;  // most shapes sit at their link's origin: no product
   bool is_static = false;
   bool enabled = true;
   Pose initial_pose = Pose::Identity();
@@ -38,8 +41,11 @@ struct CollisionModelImpl {
   std::vector<int> moving_bodies;
   std::vector<int> shaped_bodies;  // enabled, with at least one shape
   std::vector<unsigned char> testable;
+  // Bumped by every change of the pairs: what per-thread data derived from them is keyed on.
+  std::uint64_t version = 0;
 
   void refresh_pairs() {
+    ++version;
     const std::size_t n = bodies.size();
     moving_bodies.clear();
     shaped_bodies.clear();
@@ -143,6 +149,7 @@ int CollisionModel::add_body(const std::string& name, const std::vector<Geometry
   for (const auto& s : shapes) {
     body.geometries.push_back(make_geometry(s));
     body.offsets.push_back(s.origin);
+    body.offset_is_identity.push_back(s.origin.isApprox(Pose::Identity(), 0.0) ? 1 : 0);
   }
   impl_->bodies.push_back(std::move(body));
   for (auto& row : impl_->allowed) row.push_back(false);
@@ -156,6 +163,7 @@ int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& m
   const int id = add_body(name, {}, is_static, pose);
   impl_->bodies[id].geometries.push_back(make_mesh_geometry(mesh, Eigen::Vector3d::Ones()));
   impl_->bodies[id].offsets.push_back(Pose::Identity());
+  impl_->bodies[id].offset_is_identity.push_back(1);
   return id;
 }
 
@@ -165,6 +173,7 @@ void CollisionModel::allow(int a, int b) {
   const std::size_t n = impl_->bodies.size();
   impl_->testable[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)] = 0;
   impl_->testable[static_cast<std::size_t>(b) * n + static_cast<std::size_t>(a)] = 0;
+  ++impl_->version;
 }
 
 void CollisionModel::allow(const std::string& a, const std::string& b) {
@@ -233,6 +242,19 @@ inline bool overlap(const WorldBox& a, const WorldBox& b) {
          a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
 }
 
+// What the subset query tests for one set of bodies, derived once from the model's pairs: the
+// planner asks about the same set (one arm, its tool and board) thousands of times in a row.
+struct SubsetPlan {
+  std::uint64_t version = 0;
+  std::vector<int> key;  // the set as asked
+  struct Active {
+    int body = -1;
+    std::vector<int> inner;  // later bodies of the set testable with it, ascending
+  };
+  std::vector<Active> active;  // the set's enabled bodies with shapes, in the set's order
+  std::vector<int> outer;  // the other bodies with shapes testable with one of the set, ascending
+};
+
 struct ShapeTag {
   int body;
   int object;  // index into CollisionDataImpl::objects / obbs
@@ -253,6 +275,21 @@ void fit_obb(const fcl::CollisionObjectd& object, fcl::OBBd& obb) {
   obb.extent = 0.5 * (local.max_ - local.min_) + Eigen::Vector3d::Constant(kObbMargin);
 }
 
+// The world box of an oriented box: its centre +- |axes| * extent. Tighter than FCL's world AABB
+// of a rotated shape (a cube around the shape's bounding sphere), so far fewer pairs of shapes
+// reach the oriented-box test; it still encloses the shape.
+inline WorldBox to_world_box(const fcl::OBBd& obb) {
+  WorldBox box;
+  for (int k = 0; k < 3; ++k) {
+    const double half = std::abs(obb.axis(k, 0)) * obb.extent[0] +
+                        std::abs(obb.axis(k, 1)) * obb.extent[1] +
+                        std::abs(obb.axis(k, 2)) * obb.extent[2];
+    box.lo[k] = obb.To[k] - half;
+    box.hi[k] = obb.To[k] + half;
+  }
+  return box;
+}
+
 }  // namespace
 
 struct CollisionDataImpl {
@@ -263,13 +300,13 @@ struct CollisionDataImpl {
   std::vector<ShapeTag> tags;
   std::vector<fcl::OBBd> obbs;           // per object, kept with its pose
   std::vector<unsigned char> last_axis;  // per pair of objects (QueryContext::last_axis)
-  std::vector<WorldBox> object_boxes;    // per object: its FCL world AABB
+  std::vector<WorldBox> object_boxes;    // per object: the world box of its oriented box
   fcl::DynamicAABBTreeCollisionManagerd static_manager;
   fcl::DynamicAABBTreeCollisionManagerd moving_manager;
   // Objects whose pose changed since the last query: only these are re-fitted in the trees.
   std::vector<fcl::CollisionObjectd*> changed_moving;
   std::vector<fcl::CollisionObjectd*> changed_static;
-  std::vector<char> active_scratch;
+  std::vector<SubsetPlan> subset_plans;  // a few sets, most recent last
   std::vector<int> near_scratch;
   std::vector<WorldBox> body_boxes;  // each body's shapes' boxes, merged (world)
   bool moving_full_refit = false;
@@ -294,7 +331,7 @@ CollisionData::CollisionData(const CollisionModel& model)
       object->computeAABB();
       impl_->tags.push_back({static_cast<int>(b), static_cast<int>(impl_->objects.size())});
       fit_obb(*object, impl_->obbs.emplace_back());
-      impl_->object_boxes.push_back(to_world_box(object->getAABB()));
+      impl_->object_boxes.push_back(to_world_box(impl_->obbs.back()));
       object->setUserData(&impl_->tags.back());
       impl_->body_objects[b].push_back(static_cast<int>(impl_->objects.size()));
       if (bodies[b].enabled) {
@@ -339,13 +376,18 @@ void CollisionData::set_body_pose(int body, const Pose& pose) {
     changed.clear();
     (d.model->bodies[body].is_static ? d.static_full_refit : d.moving_full_refit) = true;
   }
+  const auto& identity = d.model->bodies[body].offset_is_identity;
   for (std::size_t s = 0; s < objs.size(); ++s) {
     auto& object = *d.objects[objs[s]];
-    object.setTransform(pose * offsets[s]);
-    object.computeAABB();
-    fit_obb(object, d.obbs[static_cast<std::size_t>(objs[s])]);
-    const WorldBox& box = d.object_boxes[static_cast<std::size_t>(objs[s])] =
-        to_world_box(object.getAABB());
+    // FCL's own world box is computed only when a tree query needs it (refresh).
+    if (identity[s]) {
+      object.setTransform(pose);
+    } else {
+      object.setTransform(pose * offsets[s]);
+    }
+    fcl::OBBd& obb = d.obbs[static_cast<std::size_t>(objs[s])];
+    fit_obb(object, obb);
+    const WorldBox& box = d.object_boxes[static_cast<std::size_t>(objs[s])] = to_world_box(obb);
     changed.push_back(&object);
     if (s == 0) {
       d.body_boxes[body] = box;
@@ -435,7 +477,15 @@ bool distance_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, voi
   return false;
 }
 
+// Brings the broad-phase trees up to date with the poses set since the last tree query: FCL's
+// world boxes of the changed objects, then the trees' refit.
 void refresh(CollisionDataImpl& d) {
+  if (d.moving_full_refit || d.static_full_refit) {
+    for (auto& object : d.objects) object->computeAABB();
+  } else {
+    for (auto* object : d.changed_moving) object->computeAABB();
+    for (auto* object : d.changed_static) object->computeAABB();
+  }
   if (d.moving_full_refit) {
     d.moving_manager.update();
     d.moving_full_refit = false;
@@ -467,48 +517,93 @@ bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPai
   return ctx.hit;
 }
 
+namespace {
+
+// Planning alternates between a handful of sets (each arm, with or without its load).
+constexpr std::size_t kSubsetPlans = 8;
+
+const SubsetPlan& subset_plan(CollisionDataImpl& d, const CollisionModelImpl& m,
+                              const std::vector<int>& bodies) {
+  for (auto it = d.subset_plans.rbegin(); it != d.subset_plans.rend(); ++it) {
+    if (it->version == m.version && it->key == bodies) return *it;
+  }
+  if (d.subset_plans.size() >= kSubsetPlans) d.subset_plans.erase(d.subset_plans.begin());
+  SubsetPlan& plan = d.subset_plans.emplace_back();
+  plan.version = m.version;
+  plan.key = bodies;
+  const std::size_t n = m.bodies.size();
+  std::vector<char> in_set(n, 0);
+  for (const int b : bodies) {
+    if (m.bodies[b].enabled && !d.body_objects[b].empty() && !in_set[b]) {
+      in_set[b] = 1;
+      plan.active.push_back({b, {}});
+    }
+  }
+  std::vector<char> outer(n, 0);
+  for (auto& a : plan.active) {
+    const unsigned char* testable = &m.testable[static_cast<std::size_t>(a.body) * n];
+    for (const int ob : m.shaped_bodies) {
+      if (!testable[ob]) continue;
+      if (!in_set[ob]) {
+        outer[ob] = 1;
+      } else if (ob > a.body) {
+        a.inner.push_back(ob);  // each pair within the set once
+      }
+    }
+  }
+  for (const int ob : m.shaped_bodies) {
+    if (outer[ob]) plan.outer.push_back(ob);
+  }
+  return plan;
+}
+
+}  // namespace
+
 bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
                   CollisionPair* first) {
   auto& d = data.impl();
   const auto& m = model.impl();
   QueryContext ctx{&m, first, &d.obbs, &d.last_axis};
-  // No broad-phase tree: a cell has tens of bodies, and most fail one inline box test against
-  // the active set's reach, which leaves a handful per active body.
-  const std::size_t n = m.bodies.size();
-  std::vector<char>& active = d.active_scratch;
-  active.assign(n, 0);
-  WorldBox reach;
-  bool any = false;
-  for (const int b : bodies) {
-    if (!m.bodies[b].enabled || d.body_objects[b].empty()) continue;
-    active[b] = 1;
-    if (any) {
-      merge(reach, d.body_boxes[b]);
-    } else {
-      reach = d.body_boxes[b];
-      any = true;
-    }
-  }
-  if (!any) return false;
+  const SubsetPlan& plan = subset_plan(d, m, bodies);
+  if (plan.active.empty()) return false;
+  // No broad-phase tree: a cell has tens of bodies, and most outside the set fail one inline box
+  // test against the set's reach.
+  WorldBox reach = d.body_boxes[static_cast<std::size_t>(plan.active.front().body)];
+  for (const auto& a : plan.active) merge(reach, d.body_boxes[static_cast<std::size_t>(a.body)]);
   std::vector<int>& near = d.near_scratch;
   near.clear();
-  for (const int ob : m.shaped_bodies) {
-    if (active[ob] || overlap(d.body_boxes[ob], reach)) near.push_back(ob);
+  for (const int ob : plan.outer) {
+    if (overlap(d.body_boxes[static_cast<std::size_t>(ob)], reach)) near.push_back(ob);
   }
-  for (const int b : bodies) {
-    if (!active[b]) continue;
-    const unsigned char* testable = &m.testable[static_cast<std::size_t>(b) * n];
-    const WorldBox& box_b = d.body_boxes[b];
-    for (const int ob : near) {
-      // Pairs of active bodies once each.
-      if (!testable[ob] || (active[ob] && ob <= b) || !overlap(d.body_boxes[ob], box_b)) continue;
-      for (const int o1 : d.body_objects[b]) {
-        const WorldBox& box1 = d.object_boxes[static_cast<std::size_t>(o1)];
-        for (const int o2 : d.body_objects[ob]) {
-          if (!overlap(box1, d.object_boxes[static_cast<std::size_t>(o2)])) continue;
-          if (narrow_phase(d.objects[o1].get(), d.objects[o2].get(), b, ob, &ctx)) return true;
-        }
+  const std::size_t n = m.bodies.size();
+  auto test_bodies = [&](int b, const WorldBox& box_b, int ob) {
+    if (!overlap(d.body_boxes[static_cast<std::size_t>(ob)], box_b)) return false;
+    for (const int o1 : d.body_objects[b]) {
+      const WorldBox& box1 = d.object_boxes[static_cast<std::size_t>(o1)];
+      for (const int o2 : d.body_objects[ob]) {
+        if (!overlap(box1, d.object_boxes[static_cast<std::size_t>(o2)])) continue;
+        if (narrow_phase(d.objects[o1].get(), d.objects[o2].get(), b, ob, &ctx)) return true;
       }
+    }
+    return false;
+  };
+  for (const auto& a : plan.active) {
+    const int b = a.body;
+    const unsigned char* testable = &m.testable[static_cast<std::size_t>(b) * n];
+    const WorldBox& box_b = d.body_boxes[static_cast<std::size_t>(b)];
+    // The set's later bodies and the near others, merged in ascending order (the order the
+    // first contact is reported in does not depend on the caching).
+    auto in = a.inner.begin();
+    auto out = near.begin();
+    while (in != a.inner.end() || out != near.end()) {
+      int ob;
+      if (out == near.end() || (in != a.inner.end() && *in < *out)) {
+        ob = *in++;
+      } else {
+        ob = *out++;
+        if (!testable[ob]) continue;
+      }
+      if (test_bodies(b, box_b, ob)) return true;
     }
   }
   return false;

@@ -147,6 +147,47 @@ TEST(Collision, ArmSubsetQueryAgreesWithBruteForceOverItsPairs) {
   EXPECT_LT(colliding, 580);
 }
 
+// The subset query derives its pair lists once per set of bodies and keeps a few: sets asked in
+// turn (more than it keeps, with repeats and bodies of both arms) must each get the brute-force
+// answer, and a pair allowed meanwhile must drop out of every kept set.
+TEST(Collision, SubsetQueriesOverManySetsAgreeWithBruteForce) {
+  auto& f = fixture();
+  core::CollisionModel model = core::build_cell_scene(*f.cell, {.human_moves = true}).model;
+  core::CollisionData data(model);
+  std::mt19937_64 rng(57);
+  std::vector<std::vector<int>> sets;
+  for (int s = 0; s < 11; ++s) {
+    std::vector<int> set = f.scene.arm_bodies[static_cast<std::size_t>(s % 2)];
+    std::shuffle(set.begin(), set.end(), rng);
+    set.resize(set.size() / 2 + static_cast<std::size_t>(s) % (set.size() / 2));
+    set.push_back(static_cast<int>(rng() % static_cast<std::uint64_t>(model.num_bodies())));
+    set.push_back(set.front());  // a body named twice counts once
+    sets.push_back(set);
+  }
+  int colliding = 0;
+  for (int i = 0; i < 400; ++i) {
+    core::set_cell_state(*f.cell, f.scene, data, random_robot_q(*f.cell, rng),
+                         random_human_q(*f.cell, rng));
+    const auto& set = sets[static_cast<std::size_t>(i) % sets.size()];
+    const bool fast = core::in_collision(model, data, set);
+    ASSERT_EQ(fast, core::in_collision_brute_force(model, data, set)) << "query " << i;
+    colliding += fast;
+  }
+  EXPECT_GT(colliding, 20);
+  EXPECT_LT(colliding, 380);
+  // Every pair of the first set allowed: nothing of it is tested any more, kept or not.
+  for (const int b : sets.front()) {
+    for (int other = 0; other < model.num_bodies(); ++other) {
+      if (other != b) model.allow(b, other);
+    }
+  }
+  for (int i = 0; i < 50; ++i) {
+    core::set_cell_state(*f.cell, f.scene, data, random_robot_q(*f.cell, rng),
+                         random_human_q(*f.cell, rng));
+    EXPECT_FALSE(core::in_collision(model, data, sets.front()));
+  }
+}
+
 TEST(Collision, ArmPushedIntoTheTableCollidesWithTheTable) {
   auto& f = fixture();
   const core::Arm& arm = f.cell->arm("left");
