@@ -342,7 +342,8 @@ void ArmMotionPlanner::shorten(std::vector<Eigen::VectorXd>& path) {
   path = std::move(out);
 }
 
-std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd& q) {
+std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd& q,
+                                                          bool check_joins) {
   const auto& nodes = roadmap_.record.nodes;
   std::vector<std::pair<double, int>> near;
   near.reserve(nodes.size());
@@ -358,7 +359,7 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd&
     const int n = near[j].second;
     auto& state = node_state_[static_cast<std::size_t>(n)];
     if (state < 0) state = valid(nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
-    if (state == 1 && segment_valid(q, nodes[static_cast<std::size_t>(n)])) {
+    if (state == 1 && (!check_joins || segment_valid(q, nodes[static_cast<std::size_t>(n)]))) {
       out.push_back({n, near[j].first});
     }
   }
@@ -437,32 +438,78 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     }
     return std::string("nothing at the roadmap's resolution");
   };
-  // Through the roadmap, lazily validated.
+  // Through the roadmap, lazily validated. Each end first joins its nearest valid nodes with the
+  // straight joins unchecked, checked only when a found path uses them (as the roadmap's edges
+  // are): most first picks hold, and an end's six checked joins cost as much as the rest of the
+  // search. Once a join fails, or no path is found, that end is joined as before: its nearest
+  // nodes with joins that hold and, where none does, a stored path's beginning or end.
+  std::vector<Eigen::VectorXd> lead{request.start};
+  std::vector<Eigen::VectorXd> tail{request.goal};
+  bool entries_checked = false;
+  bool exits_checked = false;
+  std::vector<core::GraphEndpoint> entries;
+  std::vector<core::GraphEndpoint> exits;
   // A start in contact leaves straight up first (its lift is the request's goal, in practice):
   // the roadmap is entered from the goal side only when the direct segment failed.
-  auto entries = attach(request.start);
-  // An end wedged where no straight segment reaches a roadmap node (a held board out where the
-  // slip-filtered roadmap does not go, say) enters it where a stored path that held leads.
-  std::vector<Eigen::VectorXd> lead{request.start};
-  if (entries.empty() && !request.hints.empty()) {
-    auto stored = stored_lead(request.hints, request.start);
-    if (stored.size() > 1) entries = attach(stored.back());
-    if (!entries.empty()) lead = std::move(stored);
+  const auto check_entries = [&] {
+    entries_checked = true;
+    entries = attach(request.start, true);
+    // An end wedged where no straight segment reaches a roadmap node (a held board out where
+    // the slip-filtered roadmap does not go, say) enters it where a stored path that held leads.
+    if (entries.empty() && !request.hints.empty()) {
+      auto stored = stored_lead(request.hints, request.start);
+      if (stored.size() > 1) entries = attach(stored.back(), true);
+      if (!entries.empty()) lead = std::move(stored);
+    }
+  };
+  const auto check_exits = [&] {
+    exits_checked = true;
+    exits = attach(request.goal, true);
+    if (exits.empty() && !request.hints.empty()) {
+      auto stored = stored_tail(request.hints, request.goal);
+      if (stored.size() > 1) exits = attach(stored.front(), true);
+      if (!exits.empty()) tail = std::move(stored);
+    }
+  };
+  entries = attach(request.start, false);
+  if (entries.empty()) check_entries();
+  if (!entries.empty()) {
+    exits = attach(request.goal, false);
+    if (exits.empty()) check_exits();
   }
-  auto exits = entries.empty() ? std::vector<core::GraphEndpoint>{} : attach(request.goal);
-  std::vector<Eigen::VectorXd> tail{request.goal};
-  if (!entries.empty() && exits.empty() && !request.hints.empty()) {
-    auto stored = stored_tail(request.hints, request.goal);
-    if (stored.size() > 1) exits = attach(stored.front());
-    if (!exits.empty()) tail = std::move(stored);
-  }
+  std::vector<int> entries_joined;  // unchecked joins found to hold
+  std::vector<int> exits_joined;
+  const auto joins = [this](std::vector<int>& held, const Eigen::VectorXd& q, int node) {
+    if (std::find(held.begin(), held.end(), node) != held.end()) return true;
+    if (!segment_valid(q, roadmap_.record.nodes[static_cast<std::size_t>(node)])) return false;
+    held.push_back(node);
+    return true;
+  };
   const int max_searches = request.max_searches > 0 ? request.max_searches : settings_.max_searches;
   while (!entries.empty() && !exits.empty() && r.searches < max_searches) {
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the search");
     ++r.searches;
     const core::GraphPath path =
         core::shortest_path(roadmap_.graph, allowed_, entries, exits, search_);
-    if (!path.found) break;
+    if (!path.found) {
+      // Unchecked joins may stand in for nodes whose joins hold into another part of the roadmap.
+      if (!entries_checked) {
+        check_entries();
+      } else if (!exits_checked) {
+        check_exits();
+      } else {
+        break;
+      }
+      continue;
+    }
+    if (!entries_checked && !joins(entries_joined, request.start, path.nodes.front())) {
+      check_entries();
+      continue;
+    }
+    if (!exits_checked && !joins(exits_joined, request.goal, path.nodes.back())) {
+      check_exits();
+      continue;
+    }
     bool clear = true;
     for (std::size_t i = 1; i < path.nodes.size() && clear; ++i) {
       const int a = path.nodes[i - 1];

@@ -275,6 +275,50 @@ TEST(ArmMotion, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame) {
   }
 }
 
+// The roadmap node a search enters by is valid but a crate blocks the straight join to it: the
+// join, taken unchecked for the first search, fails when the path is checked and another holds.
+TEST(ArmMotion, ABlockedJoinIntoTheRoadmapIsReplacedByOneThatHolds) {
+  const auto& cell = *test::reference_cell();
+  const core::Arm& left = cell.arm("left");
+  const online::Scene nominal = online::nominal_scene(cell, cabinet());
+  const online::World nominal_world(cell, cabinet(), nominal, "top");
+  online::MotionSettings settings;
+  settings.shortcut_checks = 0;  // the path as searched: its second waypoint is the entry node
+  online::ArmMotionPlanner nominal_planner(nominal_world, left_roadmap(), "left", settings);
+  int tried = 0;
+  for (const auto& [a, b] : far_pairs(20)) {
+    // A start off the roadmap, a quarter of the way to the far node.
+    const Eigen::VectorXd start = a + 0.25 * (b - a);
+    online::MotionRequest r = request(start, b);
+    r.allow_bridge = false;
+    const auto before = nominal_planner.plan(r);
+    if (!before.solved() || before.via != "roadmap" || before.path.size() < 3) continue;
+    const Eigen::VectorXd entry = before.path[1];
+    const core::Pose middle =
+        core::arm_base_in_world(cell, left) * left.chain.fk(0.5 * (start + entry));
+    online::Scene crated = nominal;
+    crated.obstacles.push_back(crate_at(middle.translation(), 0.06));
+    const online::World world(cell, cabinet(), crated, "top");
+    online::ArmMotionPlanner planner(world, left_roadmap(), "left", settings);
+    planner.prepare(r);
+    if (!planner.valid(start) || !planner.valid(b) || !planner.valid(entry) ||
+        planner.segment_valid(start, entry)) {
+      continue;
+    }
+    ++tried;
+    const auto result = planner.plan(r);
+    if (!result.solved()) continue;  // the crate may cut every way out: not this test's case
+    ASSERT_GE(result.path.size(), 3u);
+    EXPECT_FALSE(result.path[1].isApprox(entry, 0.0)) << "entered through the blocked join";
+    core::CollisionData data = world.make_data();
+    const auto report =
+        online::validate_motion(world, data, timed(result.path, cabinet().part("top").initial));
+    EXPECT_TRUE(report.valid()) << result.via << ": " << describe(report);
+    return;
+  }
+  FAIL() << "no far pair with a blocked join that plans (" << tried << " tried)";
+}
+
 // A start from which no straight segment reaches the roadmap, while a stored path still leads
 // from it: the roadmap is entered where the stored path, re-validated, takes the arm. The
 // roadmap here is the tail of a shortened roadmap path (greedy shortcuts: no waypoint past the

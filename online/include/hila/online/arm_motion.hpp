@@ -179,7 +179,9 @@ class ArmMotionPlanner {
   std::vector<Eigen::VectorXd> stored_lead(const Hints& hints, const Eigen::VectorXd& start);
   std::vector<Eigen::VectorXd> stored_tail(const Hints& hints, const Eigen::VectorXd& goal);
   void shorten(std::vector<Eigen::VectorXd>& path);
-  std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q);
+  // The nearest valid roadmap nodes (MotionSettings::attachments of the attach_neighbours
+  // nearest), with `check_joins` only those the straight segment from q reaches.
+  std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q, bool check_joins);
 
   const World& world_;
   const ArmRoadmap& roadmap_;
