@@ -117,10 +117,27 @@ double accel_ratio(const Pieces& p, const Eigen::VectorXd& amax, int a, double s
   return worst;
 }
 
+// accel_ratio(p, amax, a, sa, b, sb) <= 1, without the divisions and stopping at the first joint
+// over its limit: the passes below ask this hundreds of times per piece.
+bool accel_within(const Pieces& p, const Eigen::VectorXd& amax, int a, double sa, int b,
+                  double sb) {
+  const double ta = a < 0 ? 0.0 : p.length[static_cast<std::size_t>(a)] / sa;
+  const double tb = b < 0 ? 0.0 : p.length[static_cast<std::size_t>(b)] / sb;
+  const double mean = 0.5 * (ta + tb);
+  const double* ua = a < 0 ? nullptr : p.unit[static_cast<std::size_t>(a)].data();
+  const double* ub = b < 0 ? nullptr : p.unit[static_cast<std::size_t>(b)].data();
+  for (Eigen::Index j = 0; j < amax.size(); ++j) {
+    const double va = ua == nullptr ? 0.0 : sa * ua[j];
+    const double vb = ub == nullptr ? 0.0 : sb * ub[j];
+    if (std::abs(vb - va) > amax[j] * mean) return false;
+  }
+  return true;
+}
+
 // The largest speed of piece `next` (up to its cap) reachable from piece `prev` at `speed`.
 double reachable(const Pieces& p, const Eigen::VectorXd& amax, int prev, double speed, int next,
                  double cap) {
-  auto ok = [&](double s) { return accel_ratio(p, amax, prev, speed, next, s) <= 1.0; };
+  auto ok = [&](double s) { return accel_within(p, amax, prev, speed, next, s); };
   if (ok(cap)) return cap;
   // The feasible speeds are those near `speed` and, apart from them, tiny ones (a piece that
   // lasts long enough averages any jump away): step down from the cap to the first feasible
@@ -217,18 +234,28 @@ TimedPath time_parameterize_through(const std::vector<Eigen::VectorXd>& path,
   // The forward pass keeps each pair with its predecessor; a piece held below its backward
   // bound may still brake too hard into the next. Bring the faster of any violating pair
   // towards the slower (equal speeds under the caps are always feasible).
+  // A pair found within limits stays so until one of its speeds changes: only pairs next to a
+  // changed speed are checked again (the same sweeps, the same changes, in the same order).
+  std::vector<char> unchecked(static_cast<std::size_t>(n) + 1, 1);  // pair i: pieces i - 1, i
   for (int sweep = 0; sweep < 200; ++sweep) {
     bool changed = false;
     for (int i = 0; i <= n; ++i) {
+      if (!unchecked[static_cast<std::size_t>(i)]) continue;
       const int a = i - 1;
       const int b = i < n ? i : -1;
       const double sa = a < 0 ? 0.0 : speed[static_cast<std::size_t>(a)];
       const double sb = b < 0 ? 0.0 : speed[static_cast<std::size_t>(b)];
-      if (accel_ratio(p, amax, a, sa, b, sb) <= 1.0) continue;
+      if (accel_within(p, amax, a, sa, b, sb)) {
+        unchecked[static_cast<std::size_t>(i)] = 0;
+        continue;
+      }
       const bool a_faster = b < 0 || (a >= 0 && sa > sb);
-      double& faster = speed[static_cast<std::size_t>(a_faster ? a : b)];
+      const int piece = a_faster ? a : b;
+      double& faster = speed[static_cast<std::size_t>(piece)];
       faster = std::max(a_faster ? sb : sa, 0.9 * faster);
       if (faster <= 0.0) faster = 1e-6;
+      unchecked[static_cast<std::size_t>(piece)] = 1;
+      unchecked[static_cast<std::size_t>(piece) + 1] = 1;
       changed = true;
     }
     if (!changed) break;
