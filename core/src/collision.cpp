@@ -292,10 +292,22 @@ inline WorldBox to_world_box(const fcl::OBBd& obb) {
 
 }  // namespace
 
+// Where a shape's oriented box sits in its body (constant): a pose update places the box from the
+// body's pose directly, and FCL's object transform is brought up to date only when FCL itself
+// needs it (the narrow phase of a pair the boxes do not separate, a tree query).
+struct ShapeFrame {
+  Pose offset = Pose::Identity();  // the shape in its body
+  bool identity_offset = true;
+  bool rotated = false;                              // offset has a rotation
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // its local box's centre, body frame
+};
+
 struct CollisionDataImpl {
   const CollisionModelImpl* model = nullptr;
   std::vector<Pose> body_poses;
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
+  std::vector<ShapeFrame> shape_frames;  // per object
+  std::vector<unsigned char> stale;      // per object: its FCL transform lags its body's pose
   std::vector<std::vector<int>> body_objects;
   std::vector<ShapeTag> tags;
   std::vector<fcl::OBBd> obbs;           // per object, kept with its pose
@@ -330,6 +342,12 @@ CollisionData::CollisionData(const CollisionModel& model)
           bodies[b].geometries[s], bodies[b].initial_pose * bodies[b].offsets[s]);
       object->computeAABB();
       impl_->tags.push_back({static_cast<int>(b), static_cast<int>(impl_->objects.size())});
+      ShapeFrame& frame = impl_->shape_frames.emplace_back();
+      frame.offset = bodies[b].offsets[s];
+      frame.identity_offset = bodies[b].offset_is_identity[s] != 0;
+      frame.rotated = !frame.offset.linear().isIdentity(0.0);
+      frame.centre = frame.offset * bodies[b].geometries[s]->aabb_local.center();
+      impl_->stale.push_back(0);
       fit_obb(*object, impl_->obbs.emplace_back());
       impl_->object_boxes.push_back(to_world_box(impl_->obbs.back()));
       object->setUserData(&impl_->tags.back());
@@ -367,7 +385,6 @@ void CollisionData::set_body_pose(int body, const Pose& pose) {
   // Planning moves one arm at a time: skipping unchanged bodies keeps the tree update small.
   if (d.body_poses[body].matrix() == pose.matrix()) return;
   d.body_poses[body] = pose;
-  const auto& offsets = d.model->bodies[body].offsets;
   const auto& objs = d.body_objects[body];
   auto& changed = d.model->bodies[body].is_static ? d.changed_static : d.changed_moving;
   // Subset queries never drain the moving list; past one entry per object a full refit is
@@ -376,19 +393,21 @@ void CollisionData::set_body_pose(int body, const Pose& pose) {
     changed.clear();
     (d.model->bodies[body].is_static ? d.static_full_refit : d.moving_full_refit) = true;
   }
-  const auto& identity = d.model->bodies[body].offset_is_identity;
   for (std::size_t s = 0; s < objs.size(); ++s) {
-    auto& object = *d.objects[objs[s]];
-    // FCL's own world box is computed only when a tree query needs it (refresh).
-    if (identity[s]) {
-      object.setTransform(pose);
+    const auto o = static_cast<std::size_t>(objs[s]);
+    const ShapeFrame& frame = d.shape_frames[o];
+    // The oriented box from the body's pose (its extent never changes); FCL's transform and
+    // world box wait for a query that needs them (ensure_transform, refresh).
+    fcl::OBBd& obb = d.obbs[o];
+    if (frame.rotated) {
+      obb.axis.noalias() = pose.linear() * frame.offset.linear();
     } else {
-      object.setTransform(pose * offsets[s]);
+      obb.axis = pose.linear();
     }
-    fcl::OBBd& obb = d.obbs[static_cast<std::size_t>(objs[s])];
-    fit_obb(object, obb);
-    const WorldBox& box = d.object_boxes[static_cast<std::size_t>(objs[s])] = to_world_box(obb);
-    changed.push_back(&object);
+    obb.To = pose * frame.centre;
+    const WorldBox& box = d.object_boxes[o] = to_world_box(obb);
+    d.stale[o] = 1;
+    changed.push_back(d.objects[o].get());
     if (s == 0) {
       d.body_boxes[body] = box;
     } else {
@@ -403,9 +422,19 @@ const Pose& CollisionData::body_pose(int body) const {
 
 namespace {
 
+// FCL's transform of object o, from its body's pose, when a pose update left it behind.
+inline void ensure_transform(CollisionDataImpl& d, std::size_t o) {
+  if (!d.stale[o]) return;
+  const ShapeFrame& frame = d.shape_frames[o];
+  const Pose& pose = d.body_poses[static_cast<std::size_t>(d.tags[o].body)];
+  d.objects[o]->setTransform(frame.identity_offset ? pose : pose * frame.offset);
+  d.stale[o] = 0;
+}
+
 struct QueryContext {
   const CollisionModelImpl* model;
   CollisionPair* pair;
+  CollisionDataImpl* data;  // whose objects' transforms the narrow phase brings up to date
   const std::vector<fcl::OBBd>* obbs = nullptr;  // the oriented-box test first, when given
   // Per pair of shapes (lower object index first), the axis that last separated their boxes:
   // tried first next time (separating_axis).
@@ -438,6 +467,10 @@ bool narrow_phase(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, int a, i
       return false;
     }
   }
+  ensure_transform(*ctx->data,
+                   static_cast<std::size_t>(static_cast<ShapeTag*>(o1->getUserData())->object));
+  ensure_transform(*ctx->data,
+                   static_cast<std::size_t>(static_cast<ShapeTag*>(o2->getUserData())->object));
   fcl::CollisionRequestd request;
   fcl::CollisionResultd result;
   if (fcl::collide(o1, o2, request, result) > 0) {
@@ -480,11 +513,16 @@ bool distance_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, voi
 // Brings the broad-phase trees up to date with the poses set since the last tree query: FCL's
 // world boxes of the changed objects, then the trees' refit.
 void refresh(CollisionDataImpl& d) {
+  const auto update = [&d](fcl::CollisionObjectd& object) {
+    ensure_transform(
+        d, static_cast<std::size_t>(static_cast<ShapeTag*>(object.getUserData())->object));
+    object.computeAABB();
+  };
   if (d.moving_full_refit || d.static_full_refit) {
-    for (auto& object : d.objects) object->computeAABB();
+    for (auto& object : d.objects) update(*object);
   } else {
-    for (auto* object : d.changed_moving) object->computeAABB();
-    for (auto* object : d.changed_static) object->computeAABB();
+    for (auto* object : d.changed_moving) update(*object);
+    for (auto* object : d.changed_static) update(*object);
   }
   if (d.moving_full_refit) {
     d.moving_manager.update();
@@ -511,7 +549,7 @@ void refresh(CollisionDataImpl& d) {
 bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPair* first) {
   auto& d = data.impl();
   refresh(d);
-  QueryContext ctx{&model.impl(), first, &d.obbs, &d.last_axis};
+  QueryContext ctx{&model.impl(), first, &d, &d.obbs, &d.last_axis};
   d.moving_manager.collide(&ctx, collide_callback);
   if (!ctx.hit) d.moving_manager.collide(&d.static_manager, &ctx, collide_callback);
   return ctx.hit;
@@ -563,7 +601,7 @@ bool in_collision(const CollisionModel& model, CollisionData& data, const std::v
                   CollisionPair* first) {
   auto& d = data.impl();
   const auto& m = model.impl();
-  QueryContext ctx{&m, first, &d.obbs, &d.last_axis};
+  QueryContext ctx{&m, first, &d, &d.obbs, &d.last_axis};
   const SubsetPlan& plan = subset_plan(d, m, bodies);
   if (plan.active.empty()) return false;
   // No broad-phase tree: a cell has tens of bodies, and most outside the set fail one inline box
@@ -612,7 +650,7 @@ bool in_collision(const CollisionModel& model, CollisionData& data, const std::v
 bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
                               CollisionPair* first) {
   auto& d = data.impl();
-  QueryContext ctx{&model.impl(), first};
+  QueryContext ctx{&model.impl(), first, &d};
   for (std::size_t i = 0; i < d.objects.size(); ++i) {
     for (std::size_t j = i + 1; j < d.objects.size(); ++j) {
       if (collide_callback(d.objects[i].get(), d.objects[j].get(), &ctx)) return true;
@@ -624,7 +662,7 @@ bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
 bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
                               const std::vector<int>& bodies, CollisionPair* first) {
   auto& d = data.impl();
-  QueryContext ctx{&model.impl(), first};
+  QueryContext ctx{&model.impl(), first, &d};
   std::vector<char> active(model.impl().bodies.size(), 0);
   for (const int b : bodies) active[b] = 1;
   for (std::size_t i = 0; i < d.objects.size(); ++i) {
@@ -641,7 +679,7 @@ bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
 double min_distance(const CollisionModel& model, CollisionData& data, CollisionPair* closest) {
   auto& d = data.impl();
   refresh(d);
-  QueryContext ctx{&model.impl(), closest};
+  QueryContext ctx{&model.impl(), closest, &d};
   d.moving_manager.distance(&ctx, distance_callback);
   d.moving_manager.distance(&d.static_manager, &ctx, distance_callback);
   return ctx.min_distance;
