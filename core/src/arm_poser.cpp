@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 
 namespace hila::core {
 
@@ -33,11 +34,23 @@ void ArmPoser::pose_arm(CollisionData& data, const Eigen::VectorXd& robot_q) {
   assert(poses_.size() == robot_.links().size());  // pose_robot() first
   for (const int j : joints_) {
     const Joint& joint = robot_.joints()[static_cast<std::size_t>(j)];
-    Pose child = poses_[static_cast<std::size_t>(joint.parent_link)] * joint.origin;
-    if (joint.type != JointType::Fixed) {
-      child = child * joint_motion(joint, robot_.joint_value(robot_q, j));
+    Pose& child = poses_[static_cast<std::size_t>(joint.child_link)];
+    child = poses_[static_cast<std::size_t>(joint.parent_link)] * joint.origin;
+    if (joint.type == JointType::Fixed) continue;
+    const double value = robot_.joint_value(robot_q, j);
+    if (joint.type == JointType::Prismatic) {
+      child.translation() += child.linear() * (value * joint.axis);
+    } else if (joint.axis == Eigen::Vector3d::UnitZ()) {
+      // A rotation about the joint's own z (every UR joint): two columns turn, nothing else.
+      const double c = std::cos(value);
+      const double s = std::sin(value);
+      auto r = child.linear();
+      const Eigen::Vector3d x = r.col(0);
+      r.col(0) = c * x + s * r.col(1);
+      r.col(1) = c * r.col(1) - s * x;
+    } else {
+      child = child * joint_motion(joint, value);
     }
-    poses_[static_cast<std::size_t>(joint.child_link)] = child;
   }
   for (const auto& [link, body] : link_bodies_) {
     data.set_body_pose(body, poses_[static_cast<std::size_t>(link)]);
