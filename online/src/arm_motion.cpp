@@ -49,7 +49,13 @@ const char* to_string(MotionPlannerKind kind) {
 }
 
 ArmRoadmap::ArmRoadmap(db::RoadmapRecord stored)
-    : record(std::move(stored)), graph(record.nodes, record.edges) {}
+    : record(std::move(stored)), graph(record.nodes, record.edges) {
+  const Eigen::Index dof = record.nodes.empty() ? 0 : record.nodes.front().size();
+  node_matrix.resize(dof, static_cast<Eigen::Index>(record.nodes.size()));
+  for (std::size_t i = 0; i < record.nodes.size(); ++i) {
+    node_matrix.col(static_cast<Eigen::Index>(i)) = record.nodes[i];
+  }
+}
 
 ArmMotionPlanner::ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap,
                                    const std::string& arm, const MotionSettings& settings,
@@ -106,6 +112,7 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
     context_ = std::move(context);
     node_state_.assign(roadmap_.record.nodes.size(), -1);
     edge_state_.assign(edges, -1);
+    blocked_edges_.clear();
   }
   // No filter: every edge (a held board's slip and clearance are then checked lazily, as all).
   assert(request.filter == nullptr || request.filter->size() == edges);
@@ -114,9 +121,7 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   } else {
     allowed_.assign(edges, true);
   }
-  for (std::size_t e = 0; e < edges; ++e) {
-    if (edge_state_[e] == 0) allowed_[e] = false;
-  }
+  for (const int e : blocked_edges_) allowed_[static_cast<std::size_t>(e)] = false;
   checked_ = 0;
   invalidated_ = 0;
 }
@@ -177,13 +182,17 @@ bool ArmMotionPlanner::edge_valid(int edge) {
   for (const int n : {u, v}) {
     auto& state = node_state_[static_cast<std::size_t>(n)];
     if (state < 0) state = valid(roadmap_.record.nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
-    if (state == 0) return false;
+    if (state == 0) {
+      blocked_edges_.push_back(edge);
+      return false;
+    }
   }
   ++checked_;
   verdict = segment_valid(roadmap_.record.nodes[static_cast<std::size_t>(u)],
                           roadmap_.record.nodes[static_cast<std::size_t>(v)])
                 ? 1
                 : 0;
+  if (verdict == 0) blocked_edges_.push_back(edge);
   return verdict == 1;
 }
 
@@ -345,17 +354,30 @@ void ArmMotionPlanner::shorten(std::vector<Eigen::VectorXd>& path) {
 std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd& q,
                                                           bool check_joins) {
   const auto& nodes = roadmap_.record.nodes;
-  std::vector<std::pair<double, int>> near;
+  std::vector<std::pair<double, int>>& near = near_scratch_;
+  near.clear();
   near.reserve(nodes.size());
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    near.emplace_back((nodes[i] - q).norm(), static_cast<int>(i));
+  for (Eigen::Index i = 0; i < roadmap_.node_matrix.cols(); ++i) {
+    near.emplace_back((roadmap_.node_matrix.col(i) - q).norm(), static_cast<int>(i));
   }
   const auto take =
       std::min<std::size_t>(near.size(), static_cast<std::size_t>(settings_.attach_neighbours));
-  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(take), near.end());
+  // Nearest first, sorted in growing chunks as far as the walk below goes: it usually stops
+  // after the first few (a full sort of the 150 nearest of thousands cost more than the checks).
+  std::size_t sorted = 0;
+  const auto sort_up_to = [&](std::size_t j) {
+    if (j < sorted) return;
+    const std::size_t end = std::min(take, std::max<std::size_t>(2 * sorted, 16));
+    const auto first = near.begin() + static_cast<std::ptrdiff_t>(sorted);
+    const auto last = near.begin() + static_cast<std::ptrdiff_t>(end);
+    if (last != near.end()) std::nth_element(first, last, near.end());
+    std::sort(first, last);
+    sorted = end;
+  };
   std::vector<core::GraphEndpoint> out;
   for (std::size_t j = 0; j < take; ++j) {
     if (static_cast<int>(out.size()) >= settings_.attachments) break;
+    sort_up_to(j);
     const int n = near[j].second;
     auto& state = node_state_[static_cast<std::size_t>(n)];
     if (state < 0) state = valid(nodes[static_cast<std::size_t>(n)]) ? 1 : 0;

@@ -21,6 +21,7 @@ struct ArmRoadmap {
   explicit ArmRoadmap(db::RoadmapRecord stored);
   db::RoadmapRecord record;
   core::RoadmapGraph graph;
+  Eigen::MatrixXd node_matrix;  // the nodes as columns, for the nearest-node scans
 };
 
 // The board in the moving arm's hand, if any.
@@ -205,7 +206,9 @@ class ArmMotionPlanner {
   // motion (stagings, other goals sharing a stage) do not re-learn the same blocked edges.
   std::vector<signed char> node_state_;
   std::vector<signed char> edge_state_;
-  std::vector<double> context_;  // what the verdicts were found under
+  std::vector<int> blocked_edges_;  // the edges whose verdict is blocked, for prepare()
+  std::vector<double> context_;     // what the verdicts were found under
+  std::vector<std::pair<double, int>> near_scratch_;  // attach()
   int checked_ = 0;
   int invalidated_ = 0;
 };
