@@ -91,8 +91,12 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   poser_.pose_robot(data_, robot_q_);
   world_.place_tool(data_, robot_q_, request.tool_in_hand, request.tool_world);
   if (!held_.held) data_.set_body_pose(stage.board, request.board_world);
-  // The verdicts found so far hold while everything validity depends on is posed the same.
-  std::vector<double> context(robot_q_.data(), robot_q_.data() + robot_q_.size());
+  // The verdicts found so far hold while everything validity depends on is posed the same: the
+  // rest of the robot (not this arm's joints, which every check sets), what is held, the tool,
+  // the board, the resolution.
+  Eigen::VectorXd rest = robot_q_;
+  cell.set_arm(rest, arm_, Eigen::VectorXd::Zero(arm_.chain.dof()));
+  std::vector<double> context(rest.data(), rest.data() + rest.size());
   auto append_pose = [&context](const core::Pose& p) {
     context.insert(context.end(), p.matrix().data(), p.matrix().data() + 16);
   };

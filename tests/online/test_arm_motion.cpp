@@ -257,6 +257,15 @@ TEST(ArmMotion, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame) {
     EXPECT_TRUE(again.path[i].isApprox(first.path[i], 0.0)) << "waypoint " << i;
   }
 
+  // The left arm's own joints in the request's robot state are set by every check: they do not
+  // make the scene different, and what was learnt still holds.
+  online::MotionRequest own_joints_elsewhere = request(a, b);
+  cell.set_arm(own_joints_elsewhere.robot_q, cell.arm("left"), b);
+  const auto reused = planner.plan(own_joints_elsewhere);
+  ASSERT_TRUE(reused.solved());
+  EXPECT_EQ(reused.edges_invalidated, 0);
+  EXPECT_EQ(reused.searches, again.searches);
+
   // The right arm elsewhere: a different scene for the left arm's checks.
   online::MotionRequest moved = request(a, b);
   Eigen::VectorXd right_q = cell.arm("right").spec.home;
