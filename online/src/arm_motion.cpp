@@ -68,7 +68,8 @@ ArmMotionPlanner::ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap
       lazy_prm_(lazy_prm),
       data_(world.make_data()),
       poser_(world.cell(), world.stage().cell, arm_),
-      base_(core::arm_base_in_world(world.cell(), arm_)) {
+      base_(core::arm_base_in_world(world.cell(), arm_)),
+      tip_link_(world.cell().robot().link_index(arm_.spec.tip_link)) {
   // The LazyPRM baseline keeps its roadmap outside the planner: without one it cannot run.
   assert(settings_.planner != MotionPlannerKind::kLazyPrm || lazy_prm_ != nullptr);
 }
@@ -140,8 +141,12 @@ ArmMotionPlanner::Verdict ArmMotionPlanner::check(const Eigen::VectorXd& q,
   if (q.size() != arm_.chain.dof() || !arm_.chain.within_limits(q, 1e-9)) {
     return Verdict::kOutsideLimits;
   }
-  const core::Pose tcp = base_ * arm_.chain.fk(q);
-  if (held_.held && held_.theta_c_deg < 90.0) {
+  // Under a slip limit the TCP comes first (a slipping sample is rejected before the arm is
+  // posed); otherwise it is read off the posed arm.
+  const bool slip_checked = held_.held && held_.theta_c_deg < 90.0;
+  core::Pose tcp;
+  if (slip_checked) {
+    tcp = base_ * arm_.chain.fk(q);
     const double slip =
         core::slip_angle_deg(tcp.linear() * held_.axis_tcp, tcp.linear() * held_.lever_tcp,
                              Eigen::Vector3d(0.0, 0.0, -1.0));
@@ -151,6 +156,7 @@ ArmMotionPlanner::Verdict ArmMotionPlanner::check(const Eigen::VectorXd& q,
   const core::StageScene& stage = world_.stage();
   cell.set_arm(robot_q_, arm_, q);
   poser_.pose_arm(data_, robot_q_);
+  if (!slip_checked) tcp = poser_.link_pose(tip_link_);
   if (moves_tool_) core::set_tool_held(cell, stage, data_, tcp);
   if (held_.held) data_.set_body_pose(stage.board, tcp * held_.board_in_tcp);
   return core::in_collision(stage.cell.model, data_, moving_, pair) ? Verdict::kCollides

@@ -68,7 +68,6 @@ void check_samples(const World& world, core::CollisionData& data, const Motion& 
   std::vector<int> moving = stage.cell.arm_bodies[arm_index];
   if (moves_tool) moving.insert(moving.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
   if (motion.holds_board) moving.push_back(stage.board);
-  const core::Pose base = core::arm_base_in_world(cell, arm);
   Eigen::VectorXd robot_q = motion.robot_q.size() == 0 ? cell.home_configuration() : motion.robot_q;
   if (!motion.holds_board) data.set_body_pose(stage.board, motion.board_world);
   // In the resting arm's hand (posed once) or on the table; a moving tool follows each sample.
@@ -76,6 +75,7 @@ void check_samples(const World& world, core::CollisionData& data, const Motion& 
   // The rest of the robot stands still: each sample moves this arm's links only.
   core::ArmPoser poser(cell, stage.cell, arm);
   poser.pose_robot(data, robot_q);
+  const int tip_link = cell.robot().link_index(arm.spec.tip_link);  // the TCP, read off the pose
   const Eigen::Vector3d down(0.0, 0.0, -1.0);
   for (std::size_t i = begin; i < end; ++i) {
     const Eigen::VectorXd& q = samples[i].q;
@@ -85,7 +85,7 @@ void check_samples(const World& world, core::CollisionData& data, const Motion& 
     }
     cell.set_arm(robot_q, arm, q);
     poser.pose_arm(data, robot_q);
-    const core::Pose tcp = base * arm.chain.fk(q);
+    const core::Pose& tcp = poser.link_pose(tip_link);
     if (moves_tool) core::set_tool_held(cell, stage, data, tcp);
     if (motion.holds_board) {
       data.set_body_pose(stage.board, tcp * motion.board_in_tcp);

@@ -23,6 +23,8 @@ class ArmPoser {
   // The arm's links only. robot_q may differ from the last pose_robot() on this data in the
   // arm's own joints and jaw only; everything else is as posed then.
   void pose_arm(CollisionData& data, const Eigen::VectorXd& robot_q);
+  // A link's pose (root frame, which is the world's) as last posed.
+  const Pose& link_pose(int link) const { return poses_[static_cast<std::size_t>(link)]; }
 
  private:
   const RobotModel& robot_;

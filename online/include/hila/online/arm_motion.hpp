@@ -195,6 +195,7 @@ class ArmMotionPlanner {
   core::GraphSearchWorkspace search_;
   std::vector<int> moving_;
   core::Pose base_;
+  int tip_link_ = -1;  // the TCP's link in the robot model
   Eigen::VectorXd robot_q_;
   HeldBoard held_;
   bool moves_tool_ = false;
