@@ -246,7 +246,8 @@ inline bool overlap(const WorldBox& a, const WorldBox& b) {
 // planner asks about the same set (one arm, its tool and board) thousands of times in a row.
 struct SubsetPlan {
   std::uint64_t version = 0;
-  std::vector<int> key;  // the set as asked
+  std::vector<int> key;    // the set as asked
+  std::vector<int> rigid;  // its part whose pairs are left out
   struct Active {
     int body = -1;
     std::vector<int> inner;  // later bodies of the set testable with it, ascending
@@ -561,15 +562,18 @@ namespace {
 constexpr std::size_t kSubsetPlans = 8;
 
 const SubsetPlan& subset_plan(CollisionDataImpl& d, const CollisionModelImpl& m,
-                              const std::vector<int>& bodies) {
+                              const std::vector<int>& bodies, const std::vector<int>& rigid) {
   for (auto it = d.subset_plans.rbegin(); it != d.subset_plans.rend(); ++it) {
-    if (it->version == m.version && it->key == bodies) return *it;
+    if (it->version == m.version && it->key == bodies && it->rigid == rigid) return *it;
   }
   if (d.subset_plans.size() >= kSubsetPlans) d.subset_plans.erase(d.subset_plans.begin());
   SubsetPlan& plan = d.subset_plans.emplace_back();
   plan.version = m.version;
   plan.key = bodies;
+  plan.rigid = rigid;
   const std::size_t n = m.bodies.size();
+  std::vector<char> in_rigid(n, 0);
+  for (const int b : rigid) in_rigid[static_cast<std::size_t>(b)] = 1;
   std::vector<char> in_set(n, 0);
   for (const int b : bodies) {
     if (m.bodies[b].enabled && !d.body_objects[b].empty() && !in_set[b]) {
@@ -584,7 +588,7 @@ const SubsetPlan& subset_plan(CollisionDataImpl& d, const CollisionModelImpl& m,
       if (!testable[ob]) continue;
       if (!in_set[ob]) {
         outer[ob] = 1;
-      } else if (ob > a.body) {
+      } else if (ob > a.body && !(in_rigid[static_cast<std::size_t>(a.body)] && in_rigid[ob])) {
         a.inner.push_back(ob);  // each pair within the set once
       }
     }
@@ -599,10 +603,37 @@ const SubsetPlan& subset_plan(CollisionDataImpl& d, const CollisionModelImpl& m,
 
 bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
                   CollisionPair* first) {
+  static const std::vector<int> none;
+  return in_collision(model, data, bodies, first, none);
+}
+
+bool in_collision_among(const CollisionModel& model, CollisionData& data,
+                        const std::vector<int>& bodies, CollisionPair* first) {
   auto& d = data.impl();
   const auto& m = model.impl();
   QueryContext ctx{&m, first, &d, &d.obbs, &d.last_axis};
-  const SubsetPlan& plan = subset_plan(d, m, bodies);
+  const std::size_t n = m.bodies.size();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    for (std::size_t j = i + 1; j < bodies.size(); ++j) {
+      const int a = std::min(bodies[i], bodies[j]);
+      const int b = std::max(bodies[i], bodies[j]);
+      if (!m.testable[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)]) continue;
+      for (const int o1 : d.body_objects[static_cast<std::size_t>(a)]) {
+        for (const int o2 : d.body_objects[static_cast<std::size_t>(b)]) {
+          if (narrow_phase(d.objects[o1].get(), d.objects[o2].get(), a, b, &ctx)) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
+                  CollisionPair* first, const std::vector<int>& rigid) {
+  auto& d = data.impl();
+  const auto& m = model.impl();
+  QueryContext ctx{&m, first, &d, &d.obbs, &d.last_axis};
+  const SubsetPlan& plan = subset_plan(d, m, bodies, rigid);
   if (plan.active.empty()) return false;
   // No broad-phase tree: a cell has tens of bodies, and most outside the set fail one inline box
   // test against the set's reach.
@@ -728,6 +759,17 @@ std::vector<int> subtree_bodies(const RobotModel& robot, const RobotBodies& bodi
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+std::vector<int> rigid_tip_bodies(const RobotModel& robot, const RobotBodies& bodies,
+                                  int tip_link) {
+  int link = tip_link;
+  while (true) {
+    const int j = robot.links()[static_cast<std::size_t>(link)].parent_joint;
+    if (j < 0 || robot.joints()[static_cast<std::size_t>(j)].type != JointType::Fixed) break;
+    link = robot.joints()[static_cast<std::size_t>(j)].parent_link;
+  }
+  return subtree_bodies(robot, bodies, link);
 }
 
 void set_robot_pose(CollisionData& data, const RobotBodies& bodies,

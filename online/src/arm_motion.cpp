@@ -69,7 +69,9 @@ ArmMotionPlanner::ArmMotionPlanner(const World& world, const ArmRoadmap& roadmap
       data_(world.make_data()),
       poser_(world.cell(), world.stage().cell, arm_),
       base_(core::arm_base_in_world(world.cell(), arm_)),
-      tip_link_(world.cell().robot().link_index(arm_.spec.tip_link)) {
+      tip_link_(world.cell().robot().link_index(arm_.spec.tip_link)),
+      rigid_arm_(
+          core::rigid_tip_bodies(world.cell().robot(), world.stage().cell.robot, tip_link_)) {
   // The LazyPRM baseline keeps its roadmap outside the planner: without one it cannot run.
   assert(settings_.planner != MotionPlannerKind::kLazyPrm || lazy_prm_ != nullptr);
 }
@@ -92,6 +94,18 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   poser_.pose_robot(data_, robot_q_);
   world_.place_tool(data_, robot_q_, request.tool_in_hand, request.tool_world);
   if (!held_.held) data_.set_body_pose(stage.board, request.board_world);
+  // The arm's last link, gripper, tool in hand and held board keep their relative poses through
+  // the motion: their pairs are checked once, here, and left out of every sample's query.
+  rigid_ = rigid_arm_;
+  if (moves_tool_) rigid_.insert(rigid_.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
+  if (held_.held) rigid_.push_back(stage.board);
+  {
+    const core::Pose& tcp = poser_.link_pose(tip_link_);
+    if (moves_tool_) core::set_tool_held(cell, stage, data_, tcp);
+    if (held_.held) data_.set_body_pose(stage.board, tcp * held_.board_in_tcp);
+    rigid_pair_ = {};
+    rigid_collides_ = core::in_collision_among(stage.cell.model, data_, rigid_, &rigid_pair_);
+  }
   // The verdicts found so far hold while everything validity depends on is posed the same: the
   // rest of the robot (not this arm's joints, which every check sets), what is held, the tool,
   // the board, the resolution.
@@ -152,6 +166,10 @@ ArmMotionPlanner::Verdict ArmMotionPlanner::check(const Eigen::VectorXd& q,
                              Eigen::Vector3d(0.0, 0.0, -1.0));
     if (slip > held_.theta_c_deg) return Verdict::kSlips;
   }
+  if (rigid_collides_) {
+    if (pair != nullptr) *pair = rigid_pair_;
+    return Verdict::kCollides;
+  }
   const core::Cell& cell = world_.cell();
   const core::StageScene& stage = world_.stage();
   cell.set_arm(robot_q_, arm_, q);
@@ -159,8 +177,8 @@ ArmMotionPlanner::Verdict ArmMotionPlanner::check(const Eigen::VectorXd& q,
   if (!slip_checked) tcp = poser_.link_pose(tip_link_);
   if (moves_tool_) core::set_tool_held(cell, stage, data_, tcp);
   if (held_.held) data_.set_body_pose(stage.board, tcp * held_.board_in_tcp);
-  return core::in_collision(stage.cell.model, data_, moving_, pair) ? Verdict::kCollides
-                                                                    : Verdict::kValid;
+  return core::in_collision(stage.cell.model, data_, moving_, pair, rigid_) ? Verdict::kCollides
+                                                                            : Verdict::kValid;
 }
 
 std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {

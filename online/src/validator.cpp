@@ -76,6 +76,14 @@ void check_samples(const World& world, core::CollisionData& data, const Motion& 
   core::ArmPoser poser(cell, stage.cell, arm);
   poser.pose_robot(data, robot_q);
   const int tip_link = cell.robot().link_index(arm.spec.tip_link);  // the TCP, read off the pose
+  // The arm's last link, gripper, tool in hand and held board move as one piece through the
+  // motion: their pairs are checked once (at the first sample), then left out of each sample's.
+  std::vector<int> rigid = core::rigid_tip_bodies(cell.robot(), stage.cell.robot, tip_link);
+  if (moves_tool) rigid.insert(rigid.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
+  if (motion.holds_board) rigid.push_back(stage.board);
+  bool rigid_checked = false;
+  bool rigid_collides = false;
+  core::CollisionPair rigid_pair;
   const Eigen::Vector3d down(0.0, 0.0, -1.0);
   for (std::size_t i = begin; i < end; ++i) {
     const Eigen::VectorXd& q = samples[i].q;
@@ -101,9 +109,14 @@ void check_samples(const World& world, core::CollisionData& data, const Motion& 
         }
       }
     }
-    core::CollisionPair pair;
+    if (!rigid_checked) {
+      rigid_collides = core::in_collision_among(stage.cell.model, data, rigid, &rigid_pair);
+      rigid_checked = true;
+    }
+    core::CollisionPair pair = rigid_pair;
     const bool contact_allowed = motion.start_in_contact && i == 0;
-    if (!contact_allowed && core::in_collision(stage.cell.model, data, moving, &pair)) {
+    if (!contact_allowed &&
+        (rigid_collides || core::in_collision(stage.cell.model, data, moving, &pair, rigid))) {
       violation.add("collision", t,
                     stage.cell.model.body_name(pair.body_a) + " vs " +
                         stage.cell.model.body_name(pair.body_b));

@@ -193,6 +193,41 @@ TEST(Collision, SubsetQueriesOverManySetsAgreeWithBruteForce) {
   }
 }
 
+// An arm's last link with its gripper moves as one piece: a query that leaves the pairs among
+// them out, with those pairs checked on their own, gives the whole query's answer.
+TEST(Collision, PairsWithinTheRigidTipCheckedApartGiveTheSameAnswer) {
+  auto& f = fixture();
+  const core::RobotModel& robot = f.cell->robot();
+  const core::Arm& left = f.cell->arm("left");
+  const auto rigid =
+      core::rigid_tip_bodies(robot, f.scene.robot, robot.link_index(left.spec.tip_link));
+  std::vector<std::string> names;
+  for (const int b : rigid) names.push_back(f.scene.model.body_name(b));
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"left_finger_l", "left_finger_r", "left_ft_sensor",
+                                             "left_gripper_palm", "left_pad_l", "left_pad_r",
+                                             "left_wrist_3_link"}));
+  core::CollisionData data(f.scene.model);
+  std::mt19937_64 rng(61);
+  const auto& arm = f.scene.arm_bodies[0];
+  int colliding = 0;
+  int among = 0;
+  for (int i = 0; i < 600; ++i) {
+    core::set_cell_state(*f.cell, f.scene, data, random_robot_q(*f.cell, rng),
+                         random_human_q(*f.cell, rng));
+    const bool whole = core::in_collision(f.scene.model, data, arm);
+    const bool within = core::in_collision_among(f.scene.model, data, rigid);
+    const bool rest = core::in_collision(f.scene.model, data, arm, nullptr, rigid);
+    ASSERT_EQ(whole, within || rest) << "configuration " << i;
+    ASSERT_EQ(whole, core::in_collision_brute_force(f.scene.model, data, arm));
+    colliding += whole;
+    among += within;
+  }
+  EXPECT_GT(colliding, 50);
+  EXPECT_LT(colliding, 580);
+  EXPECT_EQ(among, 0) << "the gripper's own links never touch at any jaw";
+}
+
 TEST(Collision, ArmPushedIntoTheTableCollidesWithTheTable) {
   auto& f = fixture();
   const core::Arm& arm = f.cell->arm("left");
@@ -371,6 +406,29 @@ TEST(Collision, AllowedStaticAndDisabledPairsAreSkipped) {
   EXPECT_FALSE(core::in_collision(model, data, std::vector<int>{c}));
   EXPECT_TRUE(model.allowed(a, c));
   test::expect_input_error([&] { model.allow("c", "nope"); }, {"nope"});
+}
+
+TEST(Collision, ARigidPartsOwnContactIsFoundByTheAmongQueryOnly) {
+  core::CollisionModel model;
+  const int palm = model.add_body("palm", {box(0.1, 0.1, 0.1)}, false);
+  const int board = model.add_body("board", {box(0.4, 0.1, 0.02)}, false,
+                                   core::make_pose({0.05, 0.0, 0.0}));  // into the palm
+  const int wrist = model.add_body("wrist", {sphere(0.03)}, false, core::make_pose({0, 0, 0.5}));
+  model.add_body("table", {box(2, 2, 0.1)}, true, core::make_pose({0, 0, -1}));
+  core::CollisionData data(model);
+  const std::vector<int> moving{wrist, palm, board};
+  const std::vector<int> rigid{palm, board};
+  core::CollisionPair pair;
+  EXPECT_TRUE(core::in_collision(model, data, moving, &pair));
+  EXPECT_EQ(core::describe_pair(model, pair), "palm <-> board");
+  EXPECT_FALSE(core::in_collision(model, data, moving, nullptr, rigid));
+  EXPECT_TRUE(core::in_collision_among(model, data, rigid, &pair));
+  EXPECT_EQ(core::describe_pair(model, pair), "palm <-> board");
+  EXPECT_FALSE(core::in_collision_among(model, data, {wrist, board}));
+  // Out of the rigid part, the board still meets the table.
+  data.set_body_pose(board, core::make_pose({0.05, 0.0, -0.96}));
+  EXPECT_TRUE(core::in_collision(model, data, moving, &pair, rigid));
+  EXPECT_EQ(core::describe_pair(model, pair), "board <-> table");
 }
 
 TEST(Collision, AdjacentRobotLinksAreAllowedThroughFramesWithoutGeometry) {

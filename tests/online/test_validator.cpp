@@ -242,3 +242,22 @@ TEST(Validator, FinishedBoardsStandWhereTheSceneSays) {
     EXPECT_EQ(v.detail.find("base"), std::string::npos) << v.detail;
   }
 }
+
+// A board held into the gripper's palm: the gripper and its load move as one piece, so the
+// contact is at every sample, and the validator reports it with the pair it is between.
+TEST(Validator, ABoardHeldIntoThePalmCollidesAtEverySample) {
+  Fixture f;
+  const Eigen::VectorXd start = f.left_at({0.35, 0.20, 1.35});
+  Eigen::VectorXd end = start;
+  end[5] += 0.5;  // the wrist turns the held board about the TCP
+  online::Motion m = slow_motion("left", {start, end});
+  m.holds_board = true;
+  m.board_in_tcp = core::Pose(Eigen::Translation3d(0.0, 0.0, 0.15));  // below the pads: clear
+  const auto clear = f.run(m);
+  EXPECT_FALSE(has(clear, "collision")) << describe(clear);
+  m.board_in_tcp = core::Pose(Eigen::Translation3d(0.0, 0.0, -0.1));  // into the palm
+  const auto into = f.run(m);
+  ASSERT_TRUE(has(into, "collision")) << describe(into);
+  EXPECT_EQ(into.violations.front().detail, "left_gripper_palm vs board") << describe(into);
+  EXPECT_EQ(into.violations.front().time, 0.0) << "from the first sample on";
+}

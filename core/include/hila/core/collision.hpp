@@ -83,6 +83,14 @@ bool in_collision(const CollisionModel& model, CollisionData& data, CollisionPai
 // moving set's reach, then per body, per shape, the oriented boxes, then FCL's narrow phase.
 bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
                   CollisionPair* first = nullptr);
+// The same, except pairs of two bodies of `rigid`: a part of `bodies` that moves as one piece
+// through the caller's motion (an arm's last link with its gripper and what it holds), whose
+// pairs keep their verdict while it does. The caller checks those once, in_collision_among().
+bool in_collision(const CollisionModel& model, CollisionData& data, const std::vector<int>& bodies,
+                  CollisionPair* first, const std::vector<int>& rigid);
+// Collisions between two of `bodies` only (testable pairs).
+bool in_collision_among(const CollisionModel& model, CollisionData& data,
+                        const std::vector<int>& bodies, CollisionPair* first = nullptr);
 // The same answer by testing every candidate pair with FCL's narrow phase (reference for tests).
 bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
                               CollisionPair* first = nullptr);
@@ -108,6 +116,10 @@ RobotBodies add_robot(CollisionModel& model, const RobotModel& robot, const std:
 
 // Bodies of the links at and below `root_link` (an arm with its gripper, say).
 std::vector<int> subtree_bodies(const RobotModel& robot, const RobotBodies& bodies, int root_link);
+
+// The bodies that move rigidly with `tip_link` while only joints above it move: those below the
+// last movable joint on its way up (an arm's last link with the gripper, at a given jaw).
+std::vector<int> rigid_tip_bodies(const RobotModel& robot, const RobotBodies& bodies, int tip_link);
 
 // Sets every link body's pose to base * link_poses[link].
 void set_robot_pose(CollisionData& data, const RobotBodies& bodies,

@@ -195,7 +195,12 @@ class ArmMotionPlanner {
   core::GraphSearchWorkspace search_;
   std::vector<int> moving_;
   core::Pose base_;
-  int tip_link_ = -1;  // the TCP's link in the robot model
+  int tip_link_ = -1;           // the TCP's link in the robot model
+  std::vector<int> rigid_arm_;  // the arm's bodies rigid with the TCP (core::rigid_tip_bodies)
+  // Those with the tool in hand and the held board: pairs among them checked in prepare() only.
+  std::vector<int> rigid_;
+  bool rigid_collides_ = false;
+  core::CollisionPair rigid_pair_;
   Eigen::VectorXd robot_q_;
   HeldBoard held_;
   bool moves_tool_ = false;
