@@ -26,7 +26,6 @@ struct BodyModel {
   std::string name;
   std::vector<FclGeometry> geometries;
   std::vector<Pose> offsets;
-  std::vector<char> offset_is_identity;  // most shapes sit at their link's origin: no product
   bool is_static = false;
   bool enabled = true;
   Pose initial_pose = Pose::Identity();
@@ -149,7 +148,6 @@ int CollisionModel::add_body(const std::string& name, const std::vector<Geometry
   for (const auto& s : shapes) {
     body.geometries.push_back(make_geometry(s));
     body.offsets.push_back(s.origin);
-    body.offset_is_identity.push_back(s.origin.isApprox(Pose::Identity(), 0.0) ? 1 : 0);
   }
   impl_->bodies.push_back(std::move(body));
   for (auto& row : impl_->allowed) row.push_back(false);
@@ -163,7 +161,6 @@ int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& m
   const int id = add_body(name, {}, is_static, pose);
   impl_->bodies[id].geometries.push_back(make_mesh_geometry(mesh, Eigen::Vector3d::Ones()));
   impl_->bodies[id].offsets.push_back(Pose::Identity());
-  impl_->bodies[id].offset_is_identity.push_back(1);
   return id;
 }
 
@@ -345,7 +342,7 @@ CollisionData::CollisionData(const CollisionModel& model)
       impl_->tags.push_back({static_cast<int>(b), static_cast<int>(impl_->objects.size())});
       ShapeFrame& frame = impl_->shape_frames.emplace_back();
       frame.offset = bodies[b].offsets[s];
-      frame.identity_offset = bodies[b].offset_is_identity[s] != 0;
+      frame.identity_offset = frame.offset.isApprox(Pose::Identity(), 0.0);
       frame.rotated = !frame.offset.linear().isIdentity(0.0);
       frame.centre = frame.offset * bodies[b].geometries[s]->aabb_local.center();
       impl_->stale.push_back(0);

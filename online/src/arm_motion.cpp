@@ -416,6 +416,21 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd&
   return out;
 }
 
+// An end wedged where no straight segment reaches a roadmap node (a held board out where the
+// slip-filtered roadmap does not go, say) enters it where a stored path that held leads: `via`
+// becomes the start and the stored path's valid beginning, or its valid end and the goal.
+std::vector<core::GraphEndpoint> ArmMotionPlanner::attach_end(const Hints& hints,
+                                                              const Eigen::VectorXd& q,
+                                                              bool is_start,
+                                                              std::vector<Eigen::VectorXd>& via) {
+  auto out = attach(q, true);
+  if (!out.empty() || hints.empty()) return out;
+  auto stored = is_start ? stored_lead(hints, q) : stored_tail(hints, q);
+  if (stored.size() > 1) out = attach(is_start ? stored.back() : stored.front(), true);
+  if (!out.empty()) via = std::move(stored);
+  return out;
+}
+
 MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   const auto started = std::chrono::steady_clock::now();
   MotionResult r;
@@ -499,28 +514,16 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   bool exits_checked = false;
   std::vector<core::GraphEndpoint> entries;
   std::vector<core::GraphEndpoint> exits;
-  // A start in contact leaves straight up first (its lift is the request's goal, in practice):
-  // the roadmap is entered from the goal side only when the direct segment failed.
   const auto check_entries = [&] {
     entries_checked = true;
-    entries = attach(request.start, true);
-    // An end wedged where no straight segment reaches a roadmap node (a held board out where
-    // the slip-filtered roadmap does not go, say) enters it where a stored path that held leads.
-    if (entries.empty() && !request.hints.empty()) {
-      auto stored = stored_lead(request.hints, request.start);
-      if (stored.size() > 1) entries = attach(stored.back(), true);
-      if (!entries.empty()) lead = std::move(stored);
-    }
+    entries = attach_end(request.hints, request.start, true, lead);
   };
   const auto check_exits = [&] {
     exits_checked = true;
-    exits = attach(request.goal, true);
-    if (exits.empty() && !request.hints.empty()) {
-      auto stored = stored_tail(request.hints, request.goal);
-      if (stored.size() > 1) exits = attach(stored.front(), true);
-      if (!exits.empty()) tail = std::move(stored);
-    }
+    exits = attach_end(request.hints, request.goal, false, tail);
   };
+  // A start in contact leaves straight up first (its lift is the request's goal, in practice):
+  // the roadmap is entered from the goal side only when the direct segment failed.
   entries = attach(request.start, false);
   if (entries.empty()) check_entries();
   if (!entries.empty()) {

@@ -183,6 +183,10 @@ class ArmMotionPlanner {
   // The nearest valid roadmap nodes (MotionSettings::attachments of the attach_neighbours
   // nearest), with `check_joins` only those the straight segment from q reaches.
   std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q, bool check_joins);
+  // attach() with checked joins for the start (`is_start`) or the goal, along a stored path
+  // (`via`) where no join holds.
+  std::vector<core::GraphEndpoint> attach_end(const Hints& hints, const Eigen::VectorXd& q,
+                                              bool is_start, std::vector<Eigen::VectorXd>& via);
 
   const World& world_;
   const ArmRoadmap& roadmap_;
