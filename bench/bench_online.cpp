@@ -156,6 +156,7 @@ struct Result {
   std::string status;
   std::string reason;
   double seconds = 0.0;
+  online::PlanTimes times;  // of seconds
   double path_length = 0.0;
   double duration = 0.0;
   int attempts = 0;
@@ -224,6 +225,7 @@ Result run(online::BoardPlanner& planner, const online::PlannerModel& model,
   r.status = online::to_string(plan.status);
   r.reason = plan.reason;
   r.seconds = plan.planning_seconds;
+  r.times = plan.times;
   r.attempts = static_cast<int>(plan.attempts.size());
   for (const auto& a : plan.attempts) ++r.outcomes[a.outcome];
   if (!r.solved) {
@@ -268,11 +270,14 @@ struct Summary {
   int invalid = 0;
   double median_s = 0, p95_s = 0, median_all_s = 0, p95_all_s = 0;
   double median_path = 0, median_duration = 0;
+  // Medians over the solved problems of where the time went (online::PlanTimes).
+  double median_motions_s = 0, median_smoothing_s = 0, median_validation_s = 0;
+  double p95_motions_s = 0;
 };
 
 Summary summarise(const std::vector<Problem>& problems, std::size_t planner) {
   Summary s;
-  std::vector<double> solved_s, all_s, path, duration;
+  std::vector<double> solved_s, all_s, path, duration, motions, smoothing, validation;
   for (const auto& p : problems) {
     const Result& r = p.results[planner];
     ++s.problems;
@@ -284,6 +289,9 @@ Summary summarise(const std::vector<Problem>& problems, std::size_t planner) {
     solved_s.push_back(r.seconds);
     path.push_back(r.path_length);
     duration.push_back(r.duration);
+    motions.push_back(r.times.motions);
+    smoothing.push_back(r.times.smoothing);
+    validation.push_back(r.times.validation);
   }
   s.median_s = quantile(solved_s, 0.5);
   s.p95_s = quantile(solved_s, 0.95);
@@ -291,12 +299,24 @@ Summary summarise(const std::vector<Problem>& problems, std::size_t planner) {
   s.p95_all_s = quantile(all_s, 0.95);
   s.median_path = quantile(path, 0.5);
   s.median_duration = quantile(duration, 0.5);
+  s.median_motions_s = quantile(motions, 0.5);
+  s.p95_motions_s = quantile(motions, 0.95);
+  s.median_smoothing_s = quantile(smoothing, 0.5);
+  s.median_validation_s = quantile(validation, 0.5);
   return s;
 }
 
 nlohmann::json result_json(const Result& r) {
-  nlohmann::json j = {{"status", r.status},     {"reason", r.reason}, {"planning_s", r.seconds},
-                      {"attempts", r.attempts}, {"solved", r.solved}, {"why_failed", r.why_failed},
+  nlohmann::json j = {{"status", r.status},
+                      {"reason", r.reason},
+                      {"planning_s", r.seconds},
+                      {"planning_split_s",
+                       {{"motions", r.times.motions},
+                        {"smoothing", r.times.smoothing},
+                        {"validation", r.times.validation}}},
+                      {"attempts", r.attempts},
+                      {"solved", r.solved},
+                      {"why_failed", r.why_failed},
                       {"outcomes", r.outcomes}};
   if (r.solved) {
     j["path_length_rad"] = r.path_length;
@@ -419,10 +439,23 @@ int main(int argc, char** argv) {
     const Summary& s = summary[k];
     std::cout << "| " << names[k] << " | " << s.solved << "/" << s.problems << " | "
               << fixed(100.0 * s.solved / std::max(1, s.problems), 0) << " % | "
-              << fixed(s.median_s, 2) << " | " << fixed(s.p95_s, 2) << " | "
-              << fixed(s.median_all_s, 2) << " | " << fixed(s.p95_all_s, 2) << " | "
+              << fixed(s.median_s, 3) << " | " << fixed(s.p95_s, 3) << " | "
+              << fixed(s.median_all_s, 3) << " | " << fixed(s.p95_all_s, 3) << " | "
               << fixed(s.median_path, 2) << " | " << fixed(s.median_duration, 1) << " | "
               << s.timeouts << " | " << s.invalid << " |\n";
+  }
+  std::cout
+      << "\nWhere the time went (medians over the solved problems, s; online::PlanTimes): the "
+         "motions' planning is what the planners differ in, smoothing and the timing with "
+         "the validator's re-check are the same work for all.\n\n"
+      << "| planner | full board | motions | motions p95 | smoothing | timing + validation |\n"
+      << "| --- | --- | --- | --- | --- | --- |\n";
+  for (std::size_t k = 0; k < planners.size(); ++k) {
+    const Summary& s = summary[k];
+    std::cout << "| " << names[k] << " | " << fixed(s.median_s, 4) << " | "
+              << fixed(s.median_motions_s, 4) << " | " << fixed(s.p95_motions_s, 4) << " | "
+              << fixed(s.median_smoothing_s, 4) << " | " << fixed(s.median_validation_s, 4)
+              << " |\n";
   }
 
   // Ratios to hila: over each planner's own solved problems, and over the problems both solved
@@ -433,11 +466,12 @@ int main(int argc, char** argv) {
     const auto h = static_cast<std::size_t>(hila - opt.planners.begin());
     std::cout << "\nRatios baseline / hila (> 1: hila is faster or shorter).\n\n"
               << "| baseline | median | p95 | both solved | median (both) | p95 (both) "
-                 "| path (both) | only hila solved | only baseline solved |\n"
-              << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+                 "| motions median (both) | motions p95 (both) | path (both) | only hila solved "
+                 "| only baseline solved |\n"
+              << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for (std::size_t k = 0; k < planners.size(); ++k) {
       if (k == h) continue;
-      std::vector<double> bh, bb, ph, pb;
+      std::vector<double> bh, bb, ph, pb, mh, mb;
       int only_hila = 0, only_baseline = 0;
       for (const auto& p : problems) {
         const Result& rh = p.results[h];
@@ -449,12 +483,16 @@ int main(int argc, char** argv) {
           bb.push_back(rb.seconds);
           ph.push_back(rh.path_length);
           pb.push_back(rb.path_length);
+          mh.push_back(rh.times.motions);
+          mb.push_back(rb.times.motions);
         }
       }
       std::cout << "| " << names[k] << " | " << fixed(summary[k].median_s / summary[h].median_s, 2)
                 << " | " << fixed(summary[k].p95_s / summary[h].p95_s, 2) << " | " << bh.size()
                 << " | " << fixed(quantile(bb, 0.5) / quantile(bh, 0.5), 2) << " | "
                 << fixed(quantile(bb, 0.95) / quantile(bh, 0.95), 2) << " | "
+                << fixed(quantile(mb, 0.5) / quantile(mh, 0.5), 2) << " | "
+                << fixed(quantile(mb, 0.95) / quantile(mh, 0.95), 2) << " | "
                 << fixed(quantile(pb, 0.5) / quantile(ph, 0.5), 2) << " | " << only_hila << " | "
                 << only_baseline << " |\n";
     }
@@ -540,12 +578,20 @@ int main(int argc, char** argv) {
     }
     for (std::size_t k = 0; k < names.size(); ++k) {
       const Summary& s = summary[k];
-      out["summary"][names[k]] = {
-          {"problems", s.problems},           {"solved", s.solved},
-          {"timeouts", s.timeouts},           {"invalid", s.invalid},
-          {"median_s", s.median_s},           {"p95_s", s.p95_s},
-          {"median_all_s", s.median_all_s},   {"p95_all_s", s.p95_all_s},
-          {"median_path_rad", s.median_path}, {"median_duration_s", s.median_duration}};
+      out["summary"][names[k]] = {{"problems", s.problems},
+                                  {"solved", s.solved},
+                                  {"timeouts", s.timeouts},
+                                  {"invalid", s.invalid},
+                                  {"median_s", s.median_s},
+                                  {"p95_s", s.p95_s},
+                                  {"median_all_s", s.median_all_s},
+                                  {"p95_all_s", s.p95_all_s},
+                                  {"median_path_rad", s.median_path},
+                                  {"median_duration_s", s.median_duration},
+                                  {"median_motions_s", s.median_motions_s},
+                                  {"p95_motions_s", s.p95_motions_s},
+                                  {"median_smoothing_s", s.median_smoothing_s},
+                                  {"median_validation_s", s.median_validation_s}};
     }
     // NaN (no solved problem) is not JSON: written as null.
     std::ofstream file(opt.json);

@@ -95,6 +95,21 @@ using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
 
 // One plan() call: the board's records, the scene's world, both arms' motion planners and the
 // memoised stages.
+// Adds the time from its construction to its destruction to `into`.
+class Stopwatch {
+ public:
+  explicit Stopwatch(double& into) : into_(into), started_(std::chrono::steady_clock::now()) {}
+  ~Stopwatch() {
+    into_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  }
+  Stopwatch(const Stopwatch&) = delete;
+  Stopwatch& operator=(const Stopwatch&) = delete;
+
+ private:
+  double& into_;
+  std::chrono::steady_clock::time_point started_;
+};
+
 class Run {
  public:
   Run(const PlannerModel& model, const BoardPlanSettings& settings, const Scene& scene,
@@ -142,6 +157,7 @@ class Run {
 
   const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps() const { return robot_grasps_; }
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
+  const PlanTimes& times() const { return times_; }
 
   // Bridges of `checks` and stored-path repairs of `repair_checks` from now on. The stages that
   // failed are forgotten so that they are planned again; those that were planned stand (a larger
@@ -281,7 +297,7 @@ class Run {
     request.tool_in_hand = stage.end.tool_in_hand;
     request.tool_world = scene_.tool;
     request.deadline = deadline_;
-    MotionResult motion = planner.plan(request);
+    MotionResult motion = timed_plan(planner, request);
     for (std::size_t i = 0; !motion.solved() && motion.status != MotionStatus::kTimeout &&
                             motion.status != MotionStatus::kInvalidStart && i < stagings.size();
          ++i) {
@@ -289,7 +305,7 @@ class Run {
       staged.goal = stagings[i];
       staged.allow_bridge = false;
       staged.max_searches = settings_.motion.staging_searches;
-      MotionResult via_staging = planner.plan(staged);
+      MotionResult via_staging = timed_plan(planner, staged);
       if (!via_staging.solved() || !planner.segment_valid(stagings[i], request.goal)) continue;
       via_staging.path.push_back(request.goal);
       via_staging.via += "+staging";
@@ -302,6 +318,7 @@ class Run {
     // the smoothing fails or the validator rejects it.
     std::vector<Eigen::VectorXd> path = motion.path;
     if (settings_.smooth && path.size() > 2 && !request.start_in_contact) {
+      const Stopwatch watch(times_.smoothing);
       SmoothResult smooth = smooth_path(
           path,
           [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
@@ -327,7 +344,7 @@ class Run {
       // between its samples is planned around once at the validator's.
       MotionRequest fine = request;
       fine.fine_checks = true;
-      MotionResult again = planner.plan(fine);
+      MotionResult again = timed_plan(planner, fine);
       if (again.solved()) {
         motion = std::move(again);
         path = motion.path;
@@ -352,10 +369,16 @@ class Run {
     return "";
   }
 
+  MotionResult timed_plan(ArmMotionPlanner& planner, const MotionRequest& request) {
+    const Stopwatch watch(times_.motions);
+    return planner.plan(request);
+  }
+
   // Times the motion's path and re-checks it with the validator: whether it passed.
   bool timed_and_valid(const Stage& stage, const core::Arm& arm, const MotionRequest& request,
                        const std::vector<Eigen::VectorXd>& path, TimedPath& timed,
                        ValidationReport& report) {
+    const Stopwatch watch(times_.validation);
     timed = time_parameterize_through(path, arm.spec.max_velocity, arm.spec.max_acceleration,
                                       settings_.speed_scale, settings_.timing_step);
     Motion check;
@@ -898,6 +921,7 @@ class Run {
   std::map<std::int64_t, const db::RegraspNodeRecord*> node_by_id_;
   std::vector<db::RegraspEdgeRecord> edges_;
 
+  PlanTimes times_;
   std::optional<Stage> tool_;
   std::map<std::int64_t, Stage> picks_;                              // by suction grasp
   std::map<std::int64_t, Stage> transfers_;                          // by robot handover
@@ -919,7 +943,9 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   const auto started = std::chrono::steady_clock::now();
   BoardPlan result;
   result.board = board;
+  const PlanTimes* times = nullptr;  // the run's, once it is under way
   auto finish = [&](BoardPlanStatus status, std::string reason) {
+    if (times != nullptr) result.times = *times;
     result.status = status;
     result.reason = std::move(reason);
     result.planning_seconds =
@@ -951,6 +977,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   bool any_connected_offline = false;
   // Every goal in order under `settings`; true when one is planned (result filled in).
   Run run(model_, settings_, scene, *part, *record, deadline, lazy_prm_);
+  times = &run.times();
   auto try_goals = [&](const std::string& round) {
     for (const auto& goal : goals) {
       // The shared grasps the offline regrasp graph connected for this goal first: their

@@ -36,6 +36,13 @@ std::chrono::steady_clock::time_point in_seconds(double s) {
 void expect_plan_well_formed(const online::PlannerModel& model, const online::Scene& scene,
                              const online::BoardPlan& plan) {
   EXPECT_TRUE(plan.validated);
+  // The time split: every motion planned, smoothed and validated within the board's planning
+  // time, the pieces disjoint (none counted inside another).
+  EXPECT_GT(plan.times.motions, 0.0);
+  EXPECT_GT(plan.times.validation, 0.0);
+  EXPECT_GE(plan.times.smoothing, 0.0);
+  EXPECT_LE(plan.times.motions + plan.times.smoothing + plan.times.validation,
+            plan.planning_seconds);
   ASSERT_FALSE(plan.attempts.empty());
   EXPECT_EQ(plan.attempts.back().outcome, "planned");
   EXPECT_LE(plan.theta_c_deg, 90.0);

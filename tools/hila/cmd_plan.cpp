@@ -56,6 +56,10 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                       {"status", online::to_string(plan.status)},
                       {"reason", plan.reason},
                       {"planning_ms", 1e3 * plan.planning_seconds},
+                      {"planning_split_ms",
+                       {{"motions", 1e3 * plan.times.motions},
+                        {"smoothing", 1e3 * plan.times.smoothing},
+                        {"validation", 1e3 * plan.times.validation}}},
                       {"attempts", attempts}};
   if (plan.solved()) {
     j["goal_rank"] = plan.goal_rank;

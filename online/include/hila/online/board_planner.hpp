@@ -62,6 +62,17 @@ struct GoalAttempt {
 enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout };
 const char* to_string(BoardPlanStatus status);
 
+// Where a board's planning time went (s, wall clock, summed over every goal attempt; the rest is
+// the goals' IK, the stages' bookkeeping and the database's records): the motions' planning
+// (ArmMotionPlanner::plan, stagings and fine retries included), smoothing, and the timing with
+// the validator's re-check. The motions are what the planners differ in: the rest is the same
+// work for hila's roadmaps and the from-scratch baselines.
+struct PlanTimes {
+  double motions = 0.0;
+  double smoothing = 0.0;
+  double validation = 0.0;
+};
+
 struct BoardPlan {
   BoardPlanStatus status = BoardPlanStatus::kNoGoal;
   std::string reason;
@@ -77,6 +88,7 @@ struct BoardPlan {
   std::vector<PlanStep> steps;
   std::vector<GoalAttempt> attempts;
   double planning_seconds = 0.0;
+  PlanTimes times;           // of planning_seconds
   double duration = 0.0;     // s, the robot's motion
   double path_length = 0.0;  // rad, both arms
   bool validated = false;    // every step passed the validator
