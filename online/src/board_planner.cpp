@@ -93,8 +93,6 @@ struct Stage {
 
 using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
 
-// One plan() call: the board's records, the scene's world, both arms' motion planners and the
-// memoised stages.
 // Adds the time from its construction to its destruction to `into`.
 class Stopwatch {
  public:
@@ -110,6 +108,8 @@ class Stopwatch {
   std::chrono::steady_clock::time_point started_;
 };
 
+// One plan() call: the board's records, the scene's world, both arms' motion planners and the
+// memoised stages.
 class Run {
  public:
   Run(const PlannerModel& model, const BoardPlanSettings& settings, const Scene& scene,
