@@ -12,6 +12,17 @@ std::vector<core::PlacedPart> placed(const core::ProductSpec& product, const Sce
   return out;
 }
 
+// The boards neither finished nor being handled: still in the stack, where the scene has them.
+std::vector<core::PlacedPart> still_stacked(const core::ProductSpec& product, const Scene& scene,
+                                            const std::string& board) {
+  std::vector<core::PlacedPart> out;
+  for (const auto& part : product.parts) {
+    if (part.name == board || scene.is_finished(part.name)) continue;
+    out.push_back({part.name, &part.mesh, scene.initial_pose(part)});
+  }
+  return out;
+}
+
 }  // namespace
 
 World::World(const core::Cell& cell, const core::ProductSpec& product, const Scene& scene,
@@ -21,6 +32,9 @@ World::World(const core::Cell& cell, const core::ProductSpec& product, const Sce
       scene_(scene),
       finished_(placed(product, scene)),
       stage_(core::build_stage_scene(cell, board_.mesh, finished_, suction_arm)) {
+  for (const auto& p : still_stacked(product, scene, board)) {
+    stacked_.push_back(stage_.cell.model.add_mesh_body("stack/" + p.name, *p.mesh, true, p.pose));
+  }
   for (const auto& o : scene_.obstacles) {
     if (o.is_box()) {
       core::GeometrySpec box;

@@ -243,6 +243,38 @@ TEST(Validator, FinishedBoardsStandWhereTheSceneSays) {
   }
 }
 
+// The boards not yet handled stand in the stack where the scene has them (detected, else
+// nominal), under the board being handled: the laterals are longer than the base on top, so a
+// TCP pushed down beside the base's end meets lateral_right, the next board down.
+TEST(Validator, BoardsStillInTheStackAreObstaclesWhereTheSceneHasThem) {
+  Fixture f;
+  const auto check = [&](const online::Scene& s, const online::Motion& m) {
+    const online::World world(*f.cell, cabinet(), s, "base");
+    core::CollisionData data = world.make_data();
+    return online::validate_motion(world, data, m);
+  };
+  const Eigen::Vector3d beside_base(0.30, -0.035, 1.141);  // lateral_right's mid-plane
+  const Eigen::VectorXd above = f.left_at(beside_base + Eigen::Vector3d(0.0, 0.0, 0.2));
+  const Eigen::VectorXd into = f.left_at(beside_base);
+  online::Motion m = slow_motion("left", {above, into});
+  m.board_world = cabinet().part("base").initial;
+  const auto report = check(f.scene, m);
+  ASSERT_TRUE(has(report, "collision")) << describe(report);
+  EXPECT_NE(report.violations.front().detail.find("stack/lateral_right"), std::string::npos)
+      << describe(report);
+  // Detected 40 cm further along the table, lateral_right is out of this motion's way.
+  online::Scene moved = f.scene;
+  moved.detected["lateral_right"] = cabinet().part("lateral_right").initial;
+  moved.detected["lateral_right"].translation().x() += 0.40;
+  for (const auto& v : check(moved, m).violations) {
+    EXPECT_EQ(v.detail.find("lateral_right"), std::string::npos) << v.detail;
+  }
+  // Finished, it stands in the assembly instead.
+  for (const auto& v : check(f.scene.with_finished(cabinet(), "lateral_right"), m).violations) {
+    EXPECT_EQ(v.detail.find("stack/lateral_right"), std::string::npos) << v.detail;
+  }
+}
+
 // A board held into the gripper's palm: the gripper and its load move as one piece, so the
 // contact is at every sample, and the validator reports it with the pair it is between.
 TEST(Validator, ABoardHeldIntoThePalmCollidesAtEverySample) {

@@ -12,8 +12,9 @@
 namespace hila::online {
 
 // The scene as one collision world for handling one board: the cell with the human at the
-// scene's stance, the finished boards where the scene says, the board and the suction tool
-// (both moving) and the scene's extra obstacles (static). Const after construction: one
+// scene's stance, the finished boards where the scene says, the boards still in the stack where
+// the scene has them (detected, else nominal), the board and the suction tool (both moving) and
+// the scene's extra obstacles (static). Const after construction: one
 // CollisionData per thread (make_data()).
 class World {
  public:
@@ -24,6 +25,7 @@ class World {
   const core::StageScene& stage() const { return stage_; }
   const core::PartSpec& board() const { return board_; }
   const std::vector<int>& obstacles() const { return obstacles_; }  // the scene's extra bodies
+  const std::vector<int>& stacked() const { return stacked_; }      // the boards still stacked
   // A CollisionData with the human at the scene's stance, the board at its initial pose, the
   // tool where the scene has it (on the table, or in the suction arm's hand at its current
   // joints) and the robot at the scene's joints.
@@ -39,6 +41,7 @@ class World {
   Scene scene_;
   std::vector<core::PlacedPart> finished_;
   core::StageScene stage_;
+  std::vector<int> stacked_;
   std::vector<int> obstacles_;
 };
 
