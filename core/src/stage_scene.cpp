@@ -34,14 +34,27 @@ std::vector<PlacedPart> parts_before(const ProductSpec& product, std::size_t ind
   return out;
 }
 
+std::vector<PlacedPart> parts_after(const ProductSpec& product, std::size_t index) {
+  std::vector<PlacedPart> out;
+  for (std::size_t i = index + 1; i < product.parts.size(); ++i) {
+    const PartSpec& p = product.parts[i];
+    out.push_back({p.name, &p.mesh, p.initial});
+  }
+  return out;
+}
+
 StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
                              const std::vector<PlacedPart>& finished,
-                             const std::string& suction_arm) {
+                             const std::string& suction_arm,
+                             const std::vector<PlacedPart>& stacked) {
   StageScene scene;
   scene.cell = build_cell_scene(cell);
   CollisionModel& model = scene.cell.model;
   for (const PlacedPart& p : finished) {
     scene.finished.push_back(model.add_mesh_body("finished/" + p.name, *p.mesh, true, p.pose));
+  }
+  for (const PlacedPart& p : stacked) {
+    scene.stacked.push_back(model.add_mesh_body("stack/" + p.name, *p.mesh, true, p.pose));
   }
   scene.board = model.add_mesh_body("board", board, false);
 

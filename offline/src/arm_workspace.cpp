@@ -34,12 +34,13 @@ int arm_index_of(const core::Cell& cell, const core::Arm& arm) {
 
 ArmWorkspace::ArmWorkspace(const core::Cell& cell, const std::string& arm,
                            const std::string& suction_arm, const core::TriangleMesh* board,
-                           const std::vector<core::PlacedPart>& finished)
+                           const std::vector<core::PlacedPart>& finished,
+                           const std::vector<core::PlacedPart>& stacked)
     : cell_(cell),
       arm_(cell.arm(arm)),
       arm_index_(arm_index_of(cell, arm_)),
       scene_(core::build_stage_scene(cell, board ? *board : placeholder_board(), finished,
-                                     suction_arm)),
+                                     suction_arm, stacked)),
       data_(scene_.cell.model),
       arm_bodies_(scene_.cell.arm_bodies[static_cast<std::size_t>(arm_index_)]),
       board_bodies_{scene_.board},

@@ -181,8 +181,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     core::set_robot_pose(screen_data, screen_human, poses, cell.spec().human_stance);
   }
 
-  // Robot checks: the stage scene with the human's hands at the receiving grasp.
-  core::StageScene scene = core::build_stage_scene(cell, part.mesh, finished, settings.suction_arm);
+  // Robot checks: the stage scene (the stack under the board included) with the human's hands
+  // at the receiving grasp.
+  core::StageScene scene = core::build_stage_scene(cell, part.mesh, finished, settings.suction_arm,
+                                                   core::parts_after(product, index));
   const HandBodies robot_hands[2] = {
       add_hand(scene.cell.model, hand_geometry, "hand0", scene.board),
       add_hand(scene.cell.model, hand_geometry, "hand1", scene.board)};
@@ -465,7 +467,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // Suction grasps usable from the stack: a robot-robot pose with any other is unreachable.
   std::vector<char> pickable(static_cast<std::size_t>(n_suction), 0);
   {
-    ArmWorkspace pick(cell, suction_arm.spec.name, suction_arm.spec.name, &part.mesh);
+    ArmWorkspace pick(cell, suction_arm.spec.name, suction_arm.spec.name, &part.mesh, finished,
+                      core::parts_after(product, index));
     for (int s = 0; s < n_suction; ++s) {
       pickable[static_cast<std::size_t>(s)] =
           plan_suction_pick(pick, part.initial, grasps.suction[static_cast<std::size_t>(s)],

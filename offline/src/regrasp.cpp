@@ -171,10 +171,11 @@ std::vector<Eigen::VectorXd> valid_branches(ArmPlanning& arm, const core::Pose& 
 class ExchangeCheck {
  public:
   ExchangeCheck(const core::Cell& cell, const core::TriangleMesh& board,
-                const std::vector<core::PlacedPart>& finished, const std::string& suction_arm,
+                const std::vector<core::PlacedPart>& finished,
+                const std::vector<core::PlacedPart>& stacked, const std::string& suction_arm,
                 const std::string& receiving_arm)
       : cell_(cell),
-        scene_(core::build_stage_scene(cell, board, finished, suction_arm)),
+        scene_(core::build_stage_scene(cell, board, finished, suction_arm, stacked)),
         data_(scene_.cell.model),
         suction_(cell.arm(suction_arm)),
         receiving_(cell.arm(receiving_arm)),
@@ -293,19 +294,22 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   }
 
   // The board's stage: its chains must not carry it (or the arm) through the parts already
-  // assembled, or the online planner would find every stored transfer blocked in the nominal
-  // sequence and fall back to bridges.
+  // assembled or those still in the stack, or the online planner would find every stored
+  // transfer blocked in the nominal sequence and fall back to bridges.
   const std::vector<core::PlacedPart> finished = core::parts_before(product, index);
+  const std::vector<core::PlacedPart> stacked = core::parts_after(product, index);
   ArmPlanning suction{
       suction_roadmap, core::RoadmapGraph(suction_roadmap.nodes, suction_roadmap.edges),
-      ArmWorkspace(cell, settings.suction_arm, settings.suction_arm, &part.mesh, finished),
+      ArmWorkspace(cell, settings.suction_arm, settings.suction_arm, &part.mesh, finished, stacked),
       std::vector<bool>(suction_roadmap.edges.size(), true), settings.held_resolution};
   ArmPlanning receiving{
       receiving_roadmap, core::RoadmapGraph(receiving_roadmap.nodes, receiving_roadmap.edges),
-      ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, &part.mesh, finished),
+      ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, &part.mesh, finished,
+                   stacked),
       std::vector<bool>(receiving_roadmap.edges.size(), true), settings.held_resolution};
   core::GraphSearchWorkspace search;
-  ExchangeCheck exchange(cell, part.mesh, finished, settings.suction_arm, settings.receiving_arm);
+  ExchangeCheck exchange(cell, part.mesh, finished, stacked, settings.suction_arm,
+                         settings.receiving_arm);
   std::uint64_t bridges = 0;
   auto bridge = [&] {
     core::BridgeSettings b = settings.bridge;

@@ -31,10 +31,8 @@ World::World(const core::Cell& cell, const core::ProductSpec& product, const Sce
       board_(product.part(board)),
       scene_(scene),
       finished_(placed(product, scene)),
-      stage_(core::build_stage_scene(cell, board_.mesh, finished_, suction_arm)) {
-  for (const auto& p : still_stacked(product, scene, board)) {
-    stacked_.push_back(stage_.cell.model.add_mesh_body("stack/" + p.name, *p.mesh, true, p.pose));
-  }
+      stage_(core::build_stage_scene(cell, board_.mesh, finished_, suction_arm,
+                                     still_stacked(product, scene, board))) {
   for (const auto& o : scene_.obstacles) {
     if (o.is_box()) {
       core::GeometrySpec box;

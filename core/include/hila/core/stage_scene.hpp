@@ -18,12 +18,14 @@ struct PlacedPart {
 };
 
 // The cell at one assembly stage, as a collision scene: the static cell (robot, human at its
-// stance, table), the finished parts (static), the board being handled and the suction tool
-// (both moving). The tool's handle touches the suction arm's gripper and the board touches the
-// tool's cup: those pairs are allowed. Built once per stage; one CollisionData per thread.
+// stance, table), the finished parts and the parts still in the stack (static), the board being
+// handled and the suction tool (both moving). The tool's handle touches the suction arm's gripper
+// and the board touches the tool's cup: those pairs are allowed. Built once per stage; one
+// CollisionData per thread.
 struct StageScene {
   CellScene cell;
   std::vector<int> finished;           // bodies of the finished parts
+  std::vector<int> stacked;            // bodies of the parts still in the stack
   int board = -1;                      // the board being handled
   RobotBodies tool;                    // suction tool links
   std::vector<int> tool_bodies;        // their bodies
@@ -37,9 +39,15 @@ struct StageScene {
 // assembly frame: the nominal stage of the part at `index`.
 std::vector<PlacedPart> parts_before(const ProductSpec& product, std::size_t index);
 
+// The parts after `index` (product order) at their initial poses: the stack under the part at
+// `index`, in the nominal stage.
+std::vector<PlacedPart> parts_after(const ProductSpec& product, std::size_t index);
+
+// `finished` become bodies "finished/NAME", `stacked` "stack/NAME".
 StageScene build_stage_scene(const Cell& cell, const TriangleMesh& board,
                              const std::vector<PlacedPart>& finished,
-                             const std::string& suction_arm);
+                             const std::string& suction_arm,
+                             const std::vector<PlacedPart>& stacked = {});
 
 // Poses the tool held by the suction arm whose TCP is at `tcp` (world).
 void set_tool_held(const Cell& cell, const StageScene& scene, CollisionData& data, const Pose& tcp);

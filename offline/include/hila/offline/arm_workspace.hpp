@@ -18,10 +18,12 @@ namespace hila::offline {
 class ArmWorkspace {
  public:
   // `board`: the mesh a held board has (nullptr: the arm never holds one).
-  // `finished`: parts standing in the cell (static), e.g. core::parts_before(product, index).
+  // `finished`: parts standing in the cell (static), e.g. core::parts_before(product, index);
+  // `stacked`: those still in the stack, e.g. core::parts_after(product, index).
   ArmWorkspace(const core::Cell& cell, const std::string& arm, const std::string& suction_arm,
                const core::TriangleMesh* board = nullptr,
-               const std::vector<core::PlacedPart>& finished = {});
+               const std::vector<core::PlacedPart>& finished = {},
+               const std::vector<core::PlacedPart>& stacked = {});
 
   const core::Arm& arm() const { return arm_; }
   int arm_index() const { return arm_index_; }
