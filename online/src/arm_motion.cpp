@@ -424,8 +424,16 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach_end(const Hints& hints
                                                               bool is_start,
                                                               std::vector<Eigen::VectorXd>& via) {
   auto out = attach(q, true);
-  if (!out.empty() || hints.empty()) return out;
+  if (!out.empty()) return out;
+  return attach_along_stored(hints, q, is_start, via);
+}
+
+std::vector<core::GraphEndpoint> ArmMotionPlanner::attach_along_stored(
+    const Hints& hints, const Eigen::VectorXd& q, bool is_start,
+    std::vector<Eigen::VectorXd>& via) {
+  if (hints.empty()) return {};
   auto stored = is_start ? stored_lead(hints, q) : stored_tail(hints, q);
+  std::vector<core::GraphEndpoint> out;
   if (stored.size() > 1) out = attach(is_start ? stored.back() : stored.front(), true);
   if (!out.empty()) via = std::move(stored);
   return out;
@@ -539,52 +547,84 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return true;
   };
   const int max_searches = request.max_searches > 0 ? request.max_searches : settings_.max_searches;
-  while (!entries.empty() && !exits.empty() && r.searches < max_searches) {
-    if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the search");
-    ++r.searches;
-    const core::GraphPath path =
-        core::shortest_path(roadmap_.graph, allowed_, entries, exits, search_);
-    if (!path.found) {
-      // Unchecked joins may stand in for nodes whose joins hold into another part of the roadmap.
-      if (!entries_checked) {
-        check_entries();
-      } else if (!exits_checked) {
-        check_exits();
-      } else {
-        break;
-      }
-      continue;
-    }
-    if (!entries_checked && !joins(entries_joined, request.start, path.nodes.front())) {
-      check_entries();
-      continue;
-    }
-    if (!exits_checked && !joins(exits_joined, request.goal, path.nodes.back())) {
-      check_exits();
-      continue;
-    }
-    bool clear = true;
-    for (std::size_t i = 1; i < path.nodes.size() && clear; ++i) {
-      const int a = path.nodes[i - 1];
-      const int b = path.nodes[i];
-      for (auto it = roadmap_.graph.neighbours_begin(a); it != roadmap_.graph.neighbours_end(a);
-           ++it) {
-        if (it->node != b || !allowed_[static_cast<std::size_t>(it->edge)]) continue;
-        if (!edge_valid(it->edge)) {
-          allowed_[static_cast<std::size_t>(it->edge)] = false;
-          ++invalidated_;
-          clear = false;
+  // A* over the allowed edges, lazily validated, until a path holds (r.path) or the ends part.
+  const auto search = [&] {
+    while (!entries.empty() && !exits.empty() && r.searches < max_searches) {
+      if (late()) return false;
+      ++r.searches;
+      const core::GraphPath path =
+          core::shortest_path(roadmap_.graph, allowed_, entries, exits, search_);
+      if (!path.found) {
+        // Unchecked joins may stand in for nodes whose joins hold into another part of the roadmap.
+        if (!entries_checked) {
+          check_entries();
+        } else if (!exits_checked) {
+          check_exits();
+        } else {
+          break;
         }
-        break;
+        continue;
+      }
+      if (!entries_checked && !joins(entries_joined, request.start, path.nodes.front())) {
+        check_entries();
+        continue;
+      }
+      if (!exits_checked && !joins(exits_joined, request.goal, path.nodes.back())) {
+        check_exits();
+        continue;
+      }
+      bool clear = true;
+      for (std::size_t i = 1; i < path.nodes.size() && clear; ++i) {
+        const int a = path.nodes[i - 1];
+        const int b = path.nodes[i];
+        for (auto it = roadmap_.graph.neighbours_begin(a); it != roadmap_.graph.neighbours_end(a);
+             ++it) {
+          if (it->node != b || !allowed_[static_cast<std::size_t>(it->edge)]) continue;
+          if (!edge_valid(it->edge)) {
+            allowed_[static_cast<std::size_t>(it->edge)] = false;
+            ++invalidated_;
+            clear = false;
+          }
+          break;
+        }
+      }
+      if (!clear) continue;
+      r.path = lead;
+      for (const int n : path.nodes)
+        r.path.push_back(roadmap_.record.nodes[static_cast<std::size_t>(n)]);
+      r.path.insert(r.path.end(), tail.begin(), tail.end());
+      r.via = lead.size() > 1 || tail.size() > 1 ? "stored+roadmap" : "roadmap";
+      return true;
+    }
+    return false;
+  };
+  if (search()) return finish(MotionStatus::kSolved, "");
+  // Both ends attach but the roadmap is cut between their nodes: where a stored path's valid
+  // beginning (or end) leads into another part of it (the way the arm came, say), the search
+  // starts there before any bridge. The moved end's joins are checked; the other's stay as
+  // they were.
+  if (!entries.empty() && !exits.empty() && !request.hints.empty() && !late()) {
+    bool moved = false;
+    std::vector<Eigen::VectorXd> via;
+    if (lead.size() == 1) {
+      auto e = attach_along_stored(request.hints, request.start, true, via);
+      if (!e.empty()) {
+        lead = std::move(via);
+        entries = std::move(e);
+        entries_checked = true;
+        moved = true;
       }
     }
-    if (!clear) continue;
-    r.path = lead;
-    for (const int n : path.nodes)
-      r.path.push_back(roadmap_.record.nodes[static_cast<std::size_t>(n)]);
-    r.path.insert(r.path.end(), tail.begin(), tail.end());
-    r.via = lead.size() > 1 || tail.size() > 1 ? "stored+roadmap" : "roadmap";
-    return finish(MotionStatus::kSolved, "");
+    if (tail.size() == 1) {
+      auto e = attach_along_stored(request.hints, request.goal, false, via);
+      if (!e.empty()) {
+        tail = std::move(via);
+        exits = std::move(e);
+        exits_checked = true;
+        moved = true;
+      }
+    }
+    if (moved && search()) return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed before a bridge");
   const char* wedge = entries.empty() ? "the start attaches to no roadmap node"

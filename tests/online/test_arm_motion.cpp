@@ -386,3 +386,68 @@ TEST(ArmMotion, AWedgedStartEntersTheRoadmapAlongAStoredPath) {
   }
   FAIL() << "no far node pair gave a roadmap path of four waypoints with a wedged start";
 }
+
+// Both ends attach, but the roadmap is cut between their nodes: the start joins only an
+// isolated node, while a stored path leads from the start to where the rest of the roadmap is
+// in straight reach. The search starts again along the stored path before any bridge. The
+// roadmap is the tail of a shortened roadmap path (p[2] on) plus a node alone on the way from
+// the start to p[1].
+TEST(ArmMotion, ACutRoadmapIsEnteredAlongAStoredPathBeforeABridge) {
+  const auto& cell = *test::reference_cell();
+  const online::World world(cell, cabinet(), online::nominal_scene(cell, cabinet()), "top");
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  core::CollisionData data = world.make_data();
+  for (const auto& [a, b] : far_pairs(20)) {
+    const auto before = planner.plan(request(a, b));
+    if (!before.solved() || before.path.size() < 4) continue;
+    const auto& p = before.path;
+    const Eigen::VectorXd alone = a + 0.3 * (p[1] - a);
+    const std::vector<Eigen::VectorXd> stored{a + 0.5 * (p[1] - a), p[1]};
+    // Nothing of the tail in straight reach of the start or of the lone node.
+    bool cut = !planner.segment_valid(stored[0], b) && !planner.segment_valid(p[1], b);
+    for (std::size_t k = 2; k < p.size(); ++k) {
+      cut = cut && !planner.segment_valid(a, p[k]) && !planner.segment_valid(alone, p[k]);
+    }
+    if (!cut) continue;
+
+    db::RoadmapRecord record = left_roadmap().record;
+    record.nodes.assign(p.begin() + 2, p.end());
+    record.nodes.push_back(alone);  // no edges
+    record.node_gravity.assign(record.nodes.size(), Eigen::Vector3d::UnitZ());
+    record.node_inclination_deg.assign(record.nodes.size(), 0.0);
+    record.edges.clear();
+    record.edge_length.clear();
+    record.edge_max_inclination_deg.clear();
+    for (int i = 0; i + 2 < static_cast<int>(record.nodes.size()); ++i) {
+      record.edges.emplace_back(i, i + 1);
+      record.edge_length.push_back((record.nodes[static_cast<std::size_t>(i + 1)] -
+                                    record.nodes[static_cast<std::size_t>(i)])
+                                       .norm());
+      record.edge_max_inclination_deg.push_back(0.0);
+    }
+    const online::ArmRoadmap roadmap(record);
+    online::ArmMotionPlanner cut_planner(world, roadmap, "left");
+    online::MotionRequest r = request(a, b);
+    r.allow_bridge = false;
+    r.follow_hints = false;  // the stored path only leads in, as for the way home
+    const auto without = cut_planner.plan(r);
+    ASSERT_FALSE(without.solved()) << without.via;
+    EXPECT_NE(without.reason.find("does not connect"), std::string::npos) << without.reason;
+
+    r.hints = {&stored};
+    const auto led = cut_planner.plan(r);
+    ASSERT_TRUE(led.solved()) << led.reason;
+    EXPECT_EQ(led.via, "stored+roadmap");
+    EXPECT_TRUE(led.path.front().isApprox(a, 0.0));
+    EXPECT_TRUE(led.path.back().isApprox(b, 0.0));
+    EXPECT_NE(std::find_if(led.path.begin(), led.path.end(),
+                           [&](const Eigen::VectorXd& q) { return q.isApprox(p[1], 0.0); }),
+              led.path.end())
+        << "through the stored path's end";
+    const auto report =
+        online::validate_motion(world, data, timed(led.path, cabinet().part("top").initial));
+    EXPECT_TRUE(report.valid()) << describe(report);
+    return;
+  }
+  FAIL() << "no far node pair gave a roadmap path of four waypoints cut from its start";
+}

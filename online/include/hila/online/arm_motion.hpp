@@ -187,6 +187,11 @@ class ArmMotionPlanner {
   // (`via`) where no join holds.
   std::vector<core::GraphEndpoint> attach_end(const Hints& hints, const Eigen::VectorXd& q,
                                               bool is_start, std::vector<Eigen::VectorXd>& via);
+  // The roadmap entered (checked joins) where a stored path's longest valid beginning from q
+  // (`is_start`), or end into q, takes the arm: `via` becomes that stretch. Empty when none.
+  std::vector<core::GraphEndpoint> attach_along_stored(const Hints& hints, const Eigen::VectorXd& q,
+                                                       bool is_start,
+                                                       std::vector<Eigen::VectorXd>& via);
 
   const World& world_;
   const ArmRoadmap& roadmap_;
