@@ -253,7 +253,7 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(
     const std::vector<Eigen::VectorXd>& hint, const Eigen::VectorXd& start,
     const Eigen::VectorXd& goal, long repair_checks,
     const std::function<bool(const Eigen::VectorXd&)>& valid_here,
-    std::chrono::steady_clock::time_point deadline) {
+    std::chrono::steady_clock::time_point deadline, int max_repairs) {
   const int n = static_cast<int>(hint.size());
   if (n < 2 || hint.front().size() != start.size()) return {};
   const auto at = [&](int i) -> const Eigen::VectorXd& {
@@ -271,7 +271,7 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(
     }
     // Blocked after waypoint i: a bridge from it to whichever of the next valid waypoints it
     // reaches, and the stored path again from there.
-    if (repair_checks <= 0 || ++repairs > settings_.max_repairs) return {};
+    if (repair_checks <= 0 || ++repairs > max_repairs) return {};
     std::vector<Eigen::VectorXd> targets;
     std::vector<int> index;
     for (int k = i + 1; k <= last && static_cast<int>(targets.size()) < settings_.repair_targets;
@@ -493,10 +493,19 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(late() ? MotionStatus::kTimeout : MotionStatus::kNoPath,
                   std::string(to_string(settings_.planner)) + " found no path within its budget");
   }
+  // A rejected path is mostly sound: mended where the validator's resolution finds it blocked.
+  if (request.rejected != nullptr && settings_.fine_repair_checks > 0) {
+    r.path = follow(*request.rejected, request.start, request.goal, settings_.fine_repair_checks,
+                    valid_here, request.deadline, settings_.fine_repairs);
+    if (!r.path.empty()) {
+      r.via = "repaired";
+      return finish(MotionStatus::kSolved, "");
+    }
+  }
   for (const auto* hint : request.hints) {
     if (!request.follow_hints) break;  // kept for leading a wedged end in (below)
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed on a stored path");
-    r.path = follow(*hint, request.start, request.goal, 0, valid_here, request.deadline);
+    r.path = follow(*hint, request.start, request.goal, 0, valid_here, request.deadline, 0);
     if (!r.path.empty()) {
       r.via = "stored";
       return finish(MotionStatus::kSolved, "");
@@ -642,8 +651,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
                                  : settings_.repair_checks;
   for (const auto* hint : request.hints) {
     if (!request.follow_hints || repair_budget <= 0 || late()) break;
-    r.path =
-        follow(*hint, request.start, request.goal, repair_budget, valid_here, request.deadline);
+    r.path = follow(*hint, request.start, request.goal, repair_budget, valid_here, request.deadline,
+                    settings_.max_repairs);
     if (!r.path.empty()) {
       r.via = "stored+repair";
       return finish(MotionStatus::kSolved, "");

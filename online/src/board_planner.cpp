@@ -344,6 +344,10 @@ class Run {
       // between its samples is planned around once at the validator's.
       MotionRequest fine = request;
       fine.fine_checks = true;
+      // A bridge, found at a large cost, is mended where it is blocked rather than searched for
+      // again (lateral_left's wedged transfers: 150 000 checks, then as many again); a roadmap
+      // path is searched again, which is cheap and finds shorter ways than mending.
+      if (motion.via.find("bridge") != std::string::npos) fine.rejected = &motion.path;
       MotionResult again = timed_plan(planner, fine);
       if (again.solved()) {
         motion = std::move(again);

@@ -207,6 +207,40 @@ TEST(ArmMotion, AStoredPathBlockedMidwayIsRepairedLocally) {
   }
 }
 
+// A path the validator rejected (the crate planted on it after it was found): given back as
+// MotionRequest::rejected, it is mended where the crate blocks it, kept elsewhere, and the
+// mended path passes the validator; with no mending budget the motion is planned again instead.
+TEST(ArmMotion, ARejectedPathIsMendedWhereItIsBlocked) {
+  const auto& cell = *test::reference_cell();
+  const auto crated = crate_on_a_roadmap_path();
+  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
+  const auto& [a, b, before, blocked] = *crated;
+  const online::World world(cell, cabinet(), blocked, "top");
+  core::CollisionData data = world.make_data();
+  const std::vector<Eigen::VectorXd>& rejected = before.path;
+  const auto first_report =
+      online::validate_motion(world, data, timed(rejected, cabinet().part("top").initial));
+  ASSERT_FALSE(first_report.valid()) << "the crate must block the path";
+  online::MotionRequest r = request(a, b);
+  r.fine_checks = true;
+  r.rejected = &rejected;
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  const auto mended = planner.plan(r);
+  ASSERT_TRUE(mended.solved()) << mended.reason;
+  EXPECT_EQ(mended.via, "repaired");
+  EXPECT_TRUE(mended.path.front().isApprox(a, 0.0));
+  EXPECT_TRUE(mended.path.back().isApprox(b, 0.0));
+  const auto report =
+      online::validate_motion(world, data, timed(mended.path, cabinet().part("top").initial));
+  EXPECT_TRUE(report.valid()) << describe(report);
+
+  online::MotionSettings no_mending;
+  no_mending.fine_repair_checks = 0;
+  online::ArmMotionPlanner again(world, left_roadmap(), "left", no_mending);
+  const auto replanned = again.plan(r);
+  EXPECT_NE(replanned.via, "repaired");
+}
+
 TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
   const auto& cell = *test::reference_cell();
   const auto pair = far_pairs(1).front();

@@ -61,6 +61,10 @@ struct MotionRequest {
   // Every segment at MotionSettings::fine_resolution (the validator's): a retry after the
   // validator found a thin collision between the planner's coarser samples.
   bool fine_checks = false;
+  // The path the validator rejected (hila's planner, with fine_checks): re-checked segment by
+  // segment, each blocked stretch bridged locally (MotionSettings::fine_repair_checks each, at
+  // most fine_repairs), before the motion is planned again from scratch.
+  const std::vector<Eigen::VectorXd>* rejected = nullptr;
   // A* runs allowed (0: MotionSettings::max_searches), e.g. fewer for a staging try, where a
   // bridge is the better tool once the roadmap around the goal proves this blocked.
   int max_searches = 0;
@@ -75,7 +79,8 @@ struct MotionResult {
   std::vector<Eigen::VectorXd> path;  // start ... goal, straight segments between waypoints
   // "direct", "stored" (an offline path re-validated), "roadmap", "stored+roadmap" (the roadmap
   // entered or left along the part of a stored path that holds), "stored+repair" (a stored path
-  // bridged around what blocks it), "bridge"; the baselines' "rrt_connect" or "lazy_prm"
+  // bridged around what blocks it), "bridge", "repaired" (a rejected path mended where it was
+  // blocked, MotionRequest::rejected); the baselines' "rrt_connect" or "lazy_prm"
   std::string via;
   // Set once the roadmap search is over: an end attached to no roadmap node, directly or along
   // a stored path (a failure then is a wedge, not a cut roadmap).
@@ -125,6 +130,10 @@ struct MotionSettings {
   long escalated_repair_checks = 20000;
   int max_repairs = 2;
   int repair_targets = 12;
+  // A path the validator rejected, mended stretch by stretch at its resolution
+  // (MotionRequest::rejected): each blocked stretch's bridge budget, and how many stretches.
+  long fine_repair_checks = 10000;
+  int fine_repairs = 4;
   // A board whose every goal failed within bridge_checks is tried once more, time permitting,
   // with bridges this large (the baselines' from-scratch budget).
   long escalated_bridge_checks = 200000;
@@ -176,7 +185,8 @@ class ArmMotionPlanner {
                                       const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
                                       long repair_checks,
                                       const std::function<bool(const Eigen::VectorXd&)>& valid_here,
-                                      std::chrono::steady_clock::time_point deadline);
+                                      std::chrono::steady_clock::time_point deadline,
+                                      int max_repairs);
   std::vector<Eigen::VectorXd> stored_lead(const Hints& hints, const Eigen::VectorXd& start);
   std::vector<Eigen::VectorXd> stored_tail(const Hints& hints, const Eigen::VectorXd& goal);
   void shorten(std::vector<Eigen::VectorXd>& path);
