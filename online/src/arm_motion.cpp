@@ -613,29 +613,25 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   // starts there before any bridge. The moved end's joins are checked; the other's stay as
   // they were.
   if (!entries.empty() && !exits.empty() && !request.hints.empty() && !late()) {
-    bool moved = false;
-    std::vector<Eigen::VectorXd> via;
-    if (lead.size() == 1) {
-      auto e = attach_along_stored(request.hints, request.start, true, via);
-      if (!e.empty()) {
-        lead = std::move(via);
-        entries = std::move(e);
-        entries_checked = true;
-        moved = true;
-      }
-    }
-    if (tail.size() == 1) {
-      auto e = attach_along_stored(request.hints, request.goal, false, via);
-      if (!e.empty()) {
-        tail = std::move(via);
-        exits = std::move(e);
-        exits_checked = true;
-        moved = true;
-      }
-    }
+    const auto reenter = [&](const Eigen::VectorXd& q, bool is_start,
+                             std::vector<Eigen::VectorXd>& along,
+                             std::vector<core::GraphEndpoint>& ends, bool& checked) {
+      if (along.size() != 1) return false;  // already along a stored path
+      std::vector<Eigen::VectorXd> via;
+      auto e = attach_along_stored(request.hints, q, is_start, via);
+      if (e.empty()) return false;
+      along = std::move(via);
+      ends = std::move(e);
+      checked = true;
+      return true;
+    };
+    const bool moved_start = reenter(request.start, true, lead, entries, entries_checked);
+    const bool moved = reenter(request.goal, false, tail, exits, exits_checked) || moved_start;
     if (moved && search()) return finish(MotionStatus::kSolved, "");
   }
-  if (late()) return finish(MotionStatus::kTimeout, "the deadline passed before a bridge");
+  if (late())
+    return finish(MotionStatus::kTimeout,
+                  "the deadline passed during the search, before any bridge");
   const char* wedge = entries.empty() ? "the start attaches to no roadmap node"
                       : exits.empty() ? "the goal attaches to no roadmap node"
                                       : nullptr;

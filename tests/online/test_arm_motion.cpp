@@ -30,6 +30,24 @@ const online::ArmRoadmap& left_roadmap() {
   return roadmap;
 }
 
+// A roadmap record of `nodes`, the first nodes.size() - loose chained by edges in order, the
+// last `loose` without edges.
+db::RoadmapRecord chain_roadmap(const std::vector<Eigen::VectorXd>& nodes, std::size_t loose = 0) {
+  db::RoadmapRecord r = left_roadmap().record;
+  r.nodes = nodes;
+  r.node_gravity.assign(nodes.size(), Eigen::Vector3d::UnitZ());
+  r.node_inclination_deg.assign(nodes.size(), 0.0);
+  r.edges.clear();
+  r.edge_length.clear();
+  r.edge_max_inclination_deg.clear();
+  for (std::size_t i = 0; i + 1 + loose < nodes.size(); ++i) {
+    r.edges.emplace_back(static_cast<int>(i), static_cast<int>(i + 1));
+    r.edge_length.push_back((nodes[i + 1] - nodes[i]).norm());
+    r.edge_max_inclination_deg.push_back(0.0);
+  }
+  return r;
+}
+
 // Waypoints 4 s apart: slow enough for every velocity and acceleration limit.
 online::Motion timed(const std::vector<Eigen::VectorXd>& path, const core::Pose& board) {
   online::Motion m;
@@ -383,21 +401,7 @@ TEST(ArmMotion, AWedgedStartEntersTheRoadmapAlongAStoredPath) {
     wedged = wedged && !planner.segment_valid(stored[0], b) && !planner.segment_valid(p[1], b);
     if (!wedged) continue;
 
-    db::RoadmapRecord tail = left_roadmap().record;
-    tail.nodes.assign(p.begin() + 2, p.end());
-    tail.node_gravity.assign(tail.nodes.size(), Eigen::Vector3d::UnitZ());
-    tail.node_inclination_deg.assign(tail.nodes.size(), 0.0);
-    tail.edges.clear();
-    tail.edge_length.clear();
-    tail.edge_max_inclination_deg.clear();
-    for (int i = 0; i + 1 < static_cast<int>(tail.nodes.size()); ++i) {
-      tail.edges.emplace_back(i, i + 1);
-      tail.edge_length.push_back(
-          (tail.nodes[static_cast<std::size_t>(i + 1)] - tail.nodes[static_cast<std::size_t>(i)])
-              .norm());
-      tail.edge_max_inclination_deg.push_back(0.0);
-    }
-    const online::ArmRoadmap roadmap(tail);
+    const online::ArmRoadmap roadmap(chain_roadmap({p.begin() + 2, p.end()}));
     online::ArmMotionPlanner cut(world, roadmap, "left");
     online::MotionRequest r = request(a, b);
     r.allow_bridge = false;
@@ -444,22 +448,9 @@ TEST(ArmMotion, ACutRoadmapIsEnteredAlongAStoredPathBeforeABridge) {
     }
     if (!cut) continue;
 
-    db::RoadmapRecord record = left_roadmap().record;
-    record.nodes.assign(p.begin() + 2, p.end());
-    record.nodes.push_back(alone);  // no edges
-    record.node_gravity.assign(record.nodes.size(), Eigen::Vector3d::UnitZ());
-    record.node_inclination_deg.assign(record.nodes.size(), 0.0);
-    record.edges.clear();
-    record.edge_length.clear();
-    record.edge_max_inclination_deg.clear();
-    for (int i = 0; i + 2 < static_cast<int>(record.nodes.size()); ++i) {
-      record.edges.emplace_back(i, i + 1);
-      record.edge_length.push_back((record.nodes[static_cast<std::size_t>(i + 1)] -
-                                    record.nodes[static_cast<std::size_t>(i)])
-                                       .norm());
-      record.edge_max_inclination_deg.push_back(0.0);
-    }
-    const online::ArmRoadmap roadmap(record);
+    std::vector<Eigen::VectorXd> nodes(p.begin() + 2, p.end());
+    nodes.push_back(alone);  // no edges
+    const online::ArmRoadmap roadmap(chain_roadmap(nodes, 1));
     online::ArmMotionPlanner cut_planner(world, roadmap, "left");
     online::MotionRequest r = request(a, b);
     r.allow_bridge = false;

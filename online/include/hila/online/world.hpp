@@ -24,8 +24,7 @@ class World {
   const core::Cell& cell() const { return cell_; }
   const core::StageScene& stage() const { return stage_; }
   const core::PartSpec& board() const { return board_; }
-  const std::vector<int>& obstacles() const { return obstacles_; }    // the scene's extra bodies
-  const std::vector<int>& stacked() const { return stage_.stacked; }  // the boards still stacked
+  const std::vector<int>& obstacles() const { return obstacles_; }  // the scene's extra bodies
   // A CollisionData with the human at the scene's stance, the board at its initial pose, the
   // tool where the scene has it (on the table, or in the suction arm's hand at its current
   // joints) and the robot at the scene's joints.
