@@ -48,7 +48,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_online [--db FILE] [--scene FILE] [--variations N] [--boards a,b]\n"
     "                    [--deadline S] [--planners hila,rrt_connect,lazy_prm] [--seed N]\n"
-    "                    [--json FILE]\n"
+    "                    [--overlap-validation yes|no] [--json FILE]\n"
     "  --db          the cabinet database (default: $HILA_BENCH_DATABASE, else\n"
     "                out/cabinet.hila)\n"
     "  --scene       the nominal scene (default: meshes/cabinet/scene.yaml)\n"
@@ -57,6 +57,9 @@ constexpr const char* kUsage =
     "  --deadline    seconds per board plan (default 10)\n"
     "  --planners    which planners (default: all three)\n"
     "  --seed        base seed of the variations (default 1)\n"
+    "  --overlap-validation\n"
+    "                validate each motion on a second thread while the next is planned\n"
+    "                (BoardPlanSettings::overlap_validation, default yes)\n"
     "  --json        also write every problem's figures to FILE\n";
 
 constexpr const char* kBuildHint =
@@ -74,6 +77,7 @@ struct Options {
                                                      online::MotionPlannerKind::kRrtConnect,
                                                      online::MotionPlannerKind::kLazyPrm};
   std::uint64_t seed = 1;
+  bool overlap_validation = true;
   std::string json;
 };
 
@@ -138,6 +142,11 @@ Options parse(int argc, char** argv) {
         if (opt.planners.empty()) usage_error("--planners: expected at least one planner");
       } else if (arg == "--seed") {
         opt.seed = std::stoull(value);
+      } else if (arg == "--overlap-validation") {
+        if (value != "yes" && value != "no") {
+          usage_error("--overlap-validation: expected yes or no, got '" + value + "'");
+        }
+        opt.overlap_validation = value == "yes";
       } else if (arg == "--json") {
         opt.json = value;
       } else {
@@ -313,7 +322,8 @@ nlohmann::json result_json(const Result& r) {
                       {"planning_split_s",
                        {{"motions", r.times.motions},
                         {"smoothing", r.times.smoothing},
-                        {"validation", r.times.validation}}},
+                        {"validation", r.times.validation},
+                        {"queued_validation", r.times.queued_validation}}},
                       {"attempts", r.attempts},
                       {"solved", r.solved},
                       {"why_failed", r.why_failed},
@@ -378,6 +388,7 @@ int main(int argc, char** argv) {
   for (const auto kind : opt.planners) {
     online::BoardPlanSettings s;
     s.motion.planner = kind;
+    s.overlap_validation = opt.overlap_validation;
     settings.push_back(s);
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
     names.emplace_back(online::to_string(kind));
@@ -553,6 +564,7 @@ int main(int argc, char** argv) {
                           {"variations", opt.variations},
                           {"deadline_s", opt.deadline},
                           {"seed", opt.seed},
+                          {"overlap_validation", opt.overlap_validation},
                           {"hardware_threads", std::thread::hardware_concurrency()},
                           {"wall_s", wall},
                           {"planners", names},

@@ -12,6 +12,7 @@
 #include "hila/core/stage_scene.hpp"
 #include "hila/online/smoother.hpp"
 #include "hila/online/time_parameterization.hpp"
+#include "hila/online/validation_queue.hpp"
 
 namespace hila::online {
 
@@ -78,6 +79,18 @@ struct ArmsState {
   bool tool_in_hand = true;
 };
 
+// A step planned and timed whose validator report is still to come (ValidationQueue), with
+// what its fallbacks need when the report is a rejection.
+struct PendingCheck {
+  std::size_t job = 0;    // the queue's
+  std::size_t step = 0;   // in Stage::steps
+  Motion frame;           // the validator's view of the motion, without its trajectory
+  MotionRequest request;  // as planned (its hints left out)
+  ArmMotionPlanner* planner = nullptr;
+  const core::Arm* arm = nullptr;
+  MotionResult found;  // the planner's path, before smoothing
+};
+
 // A stage of the chain (e.g. the suction pick for one cup): its timed steps (from 0) and where
 // it leaves the robot, or why it failed. Stages are memoised by what determines them, so a
 // failing piece shared by many goals is planned once.
@@ -88,6 +101,10 @@ struct Stage {
   // The stage re-plans the one before it in another order (the receiving arm waits at its
   // pre-grasp before the board is brought): the previous stage's steps are dropped.
   bool supersedes_previous = false;
+  // Steps planned on the assumption that the validator passes them (Run::settle()).
+  std::vector<PendingCheck> pending;
+  // The validator rejected a step it had been planned past: the stage is planned again in order.
+  bool rejected_late = false;
   bool ok() const { return failure.empty(); }
 };
 
@@ -137,6 +154,10 @@ class Run {
       validation_data_.push_back(std::make_unique<core::CollisionData>(world_.make_data()));
       validation_threads_.push_back(validation_data_.back().get());
     }
+    if (settings.overlap_validation && validation_data_.size() >= 2) {
+      queue_.emplace(world_, settings.validator, *validation_data_[0], *validation_data_[1]);
+      speculate_ = true;
+    }
     const db::Database& db = model.database();
     for (const auto& g : db.robot_grasps(record.id)) robot_grasps_[g.id] = g;
     for (const auto& g : db.suction_grasps(record.id)) suction_grasps_[g.id] = g;
@@ -157,7 +178,13 @@ class Run {
 
   const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps() const { return robot_grasps_; }
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
-  const PlanTimes& times() const { return times_; }
+  // The run's times so far, the validator's own time on either thread included.
+  int rejected_motions() const { return rejected_motions_; }
+  PlanTimes times() const {
+    PlanTimes t = times_;
+    if (queue_) t.queued_validation = queue_->seconds();
+    return t;
+  }
 
   // Bridges of `checks` and stored-path repairs of `repair_checks` from now on. The stages that
   // failed are forgotten so that they are planned again; those that were planned stand (a larger
@@ -167,16 +194,7 @@ class Run {
     receiving_planner_.set_bridge_checks(checks);
     suction_planner_.set_repair_checks(repair_checks);
     receiving_planner_.set_repair_checks(repair_checks);
-    if (tool_ && !tool_->ok()) tool_.reset();
-    auto forget_failed = [](auto& stages) {
-      std::erase_if(stages, [](const auto& entry) { return !entry.second.ok(); });
-    };
-    forget_failed(picks_);
-    forget_failed(transfers_);
-    forget_failed(receives_);
-    forget_failed(releases_);
-    forget_failed(presents_);
-    forget_failed(leaves_);
+    forget([](const Stage& st) { return !st.ok(); });
   }
 
   // Whether the offline regrasp graph connected this goal with this shared grasp.
@@ -205,13 +223,28 @@ class Run {
     }
     const db::RobotHandoverRecord& rr = rr_it->second;
     const db::RobotGraspRecord& grasp = robot_grasps_.at(shared.robot_grasp_id);
-    const Stage* stages[] = {&tool(), nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
-    if (stages[0]->ok()) stages[1] = &pick(rr.suction_grasp_id);
-    if (stages[1] != nullptr && stages[1]->ok()) stages[2] = &transfer(rr);
-    if (stages[2] != nullptr && stages[2]->ok()) stages[3] = &receive(rr, grasp);
-    if (stages[3] != nullptr && stages[3]->ok()) stages[4] = &release(rr, grasp);
-    if (stages[4] != nullptr && stages[4]->ok()) stages[5] = &present(rr, grasp, goal);
-    if (stages[5] != nullptr && stages[5]->ok()) stages[6] = &leave(rr, grasp, goal);
+    const Stage* stages[7] = {};
+    const auto plan_stages = [&] {
+      stages[0] = &tool();
+      if (stages[0]->ok()) stages[1] = &pick(rr.suction_grasp_id);
+      if (stages[1] != nullptr && stages[1]->ok()) stages[2] = &transfer(rr);
+      if (stages[2] != nullptr && stages[2]->ok()) stages[3] = &receive(rr, grasp);
+      if (stages[3] != nullptr && stages[3]->ok()) stages[4] = &release(rr, grasp);
+      if (stages[4] != nullptr && stages[4]->ok()) stages[5] = &present(rr, grasp, goal);
+      if (stages[5] != nullptr && stages[5]->ok()) stages[6] = &leave(rr, grasp, goal);
+    };
+    plan_stages();
+    if (!settle()) {
+      // A stage planned past a step the validator then rejected, fallbacks and all, is planned
+      // again in order, validating as it goes: after a rejection it may take another branch or
+      // route. The stages after it stand (a memoised stage ends where its key says).
+      forget([](const Stage& st) { return st.rejected_late; });
+      const bool speculating = speculate_;
+      speculate_ = false;
+      std::fill(std::begin(stages), std::end(stages), nullptr);
+      plan_stages();
+      speculate_ = speculating;
+    }
     double clock = 0.0;
     std::size_t previous_begin = 0;
     for (const Stage* stage : stages) {
@@ -246,6 +279,21 @@ class Run {
       p = std::make_unique<core::LazyPrmPlanner>(arm, s);
     }
     return p.get();
+  }
+
+  // Drops the memoised stages `which` picks, to be planned again when next asked for.
+  template <typename Which>
+  void forget(Which which) {
+    if (tool_ && which(*tool_)) tool_.reset();
+    auto from = [&](auto& stages) {
+      std::erase_if(stages, [&](const auto& entry) { return which(entry.second); });
+    };
+    from(picks_);
+    from(transfers_);
+    from(receives_);
+    from(releases_);
+    from(presents_);
+    from(leaves_);
   }
 
   const db::RegraspNodeRecord* node(std::int64_t id) const {
@@ -313,7 +361,6 @@ class Run {
     }
     if (!motion.solved()) return name + ": " + to_string(motion.status) + ": " + motion.reason;
     PlanStep s;
-    TimedPath timed;
     // Smoothed (SuiteSparse) under the planner's checks for this request; the found path when
     // the smoothing fails or the validator rejects it.
     std::vector<Eigen::VectorXd> path = motion.path;
@@ -330,11 +377,62 @@ class Run {
         s.smoothed = true;
       }
     }
-    bool valid = timed_and_valid(stage, arm, request, path, timed, s.validation);
-    if (!valid && s.smoothed) {
+    const Motion frame = motion_frame(stage, arm, request);
+    TimedPath timed;
+    if (speculate_) {
+      // Planned on as if the validator passes it: settle() reads the report.
+      Motion check = frame;
+      {
+        const Stopwatch watch(times_.validation);
+        timed = timed_path(arm, path);
+        check.time = timed.time;
+        check.q = timed.q;
+      }
+      PendingCheck pending{queue_->submit(std::move(check)),
+                           stage.steps.size(),
+                           frame,
+                           request,
+                           &planner,
+                           &arm,
+                           std::move(motion)};
+      pending.request.hints.clear();
+      s.via = pending.found.via;
+      stage.pending.push_back(std::move(pending));
+    } else {
+      const bool valid = timed_and_valid(frame, arm, path, timed, s.validation);
+      if (!valid) {
+        if (auto e = recover(frame, request, planner, arm, name, motion, path, timed, s);
+            !e.empty()) {
+          return e;
+        }
+      }
+      s.via = motion.via;
+    }
+    const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();
+    s.name = name;
+    s.arm = arm.spec.name;
+    for (const double t : timed.time) s.time.push_back(clock + t);
+    s.q = timed.q;
+    s.event =
+        start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
+    s.path_length = path_length(path);
+    cell_.set_arm(stage.end.robot_q, arm, path.back());
+    stage.steps.push_back(std::move(s));
+    return "";
+  }
+
+  // After the validator rejected the step's path (`s.validation`): the found path when the
+  // rejected one was smoothed, then a re-plan at the validator's resolution. Leaves the motion,
+  // its path, timing and report in place; the reason when nothing passed.
+  std::string recover(const Motion& frame, const MotionRequest& request, ArmMotionPlanner& planner,
+                      const core::Arm& arm, const std::string& name, MotionResult& motion,
+                      std::vector<Eigen::VectorXd>& path, TimedPath& timed, PlanStep& s) {
+    ++rejected_motions_;
+    bool valid = false;
+    if (s.smoothed) {
       path = motion.path;
       s.smoothed = false;
-      valid = timed_and_valid(stage, arm, request, path, timed, s.validation);
+      valid = timed_and_valid(frame, arm, path, timed, s.validation);
     }
     if (!valid && !request.fine_checks &&
         (s.validation.violations.front().kind == "collision" ||
@@ -352,25 +450,82 @@ class Run {
       if (again.solved()) {
         motion = std::move(again);
         path = motion.path;
-        timed_and_valid(stage, arm, request, path, timed, s.validation);
+        timed_and_valid(frame, arm, path, timed, s.validation);
       }
     }
     if (!s.validation.valid()) {
       const auto& v = s.validation.violations.front();
       return name + ": the validator rejected the plan (" + v.kind + ": " + v.detail + ")";
     }
-    const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();
-    s.name = name;
-    s.arm = arm.spec.name;
-    s.via = motion.via;
-    for (const double t : timed.time) s.time.push_back(clock + t);
-    s.q = timed.q;
-    s.event =
-        start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
-    s.path_length = path_length(path);
-    cell_.set_arm(stage.end.robot_q, arm, path.back());
-    stage.steps.push_back(std::move(s));
     return "";
+  }
+
+  // The queue's reports for the steps planned on without them, oldest first, with each rejected
+  // step's fallbacks (recover()) as step() would have run them. False when a stage's step is
+  // still rejected: that stage (marked rejected_late) must be planned again in order, since
+  // its alternatives come after a rejection.
+  bool settle() {
+    if (!queue_) return true;
+    std::vector<Stage*> waiting;
+    auto add = [&](Stage& st) {
+      if (!st.ok()) abandon(st);  // failed as planned: its reports do not matter
+      if (!st.pending.empty()) waiting.push_back(&st);
+    };
+    if (tool_) add(*tool_);
+    auto collect = [&](auto& stages) {
+      for (auto& entry : stages) add(entry.second);
+    };
+    collect(picks_);
+    collect(transfers_);
+    collect(receives_);
+    collect(releases_);
+    collect(presents_);
+    collect(leaves_);
+    std::sort(waiting.begin(), waiting.end(), [](const Stage* a, const Stage* b) {
+      return a->pending.front().job < b->pending.front().job;
+    });
+    {
+      // Every report in before any fallback: those validate here, with the worker's data too.
+      const Stopwatch watch(times_.validation);
+      queue_->drain();
+    }
+    bool all_passed = true;
+    for (Stage* st : waiting) {
+      for (PendingCheck& p : st->pending) {
+        PlanStep& s = st->steps[p.step];
+        s.validation = queue_->wait(p.job);
+        if (s.validation.valid()) continue;
+        std::vector<Eigen::VectorXd> path;
+        TimedPath timed;
+        const std::string e =
+            recover(p.frame, p.request, *p.planner, *p.arm, s.name, p.found, path, timed, s);
+        if (!e.empty()) {
+          st->failure = e;
+          st->rejected_late = true;
+          all_passed = false;
+          break;
+        }
+        // Another path between the same ends: the later steps move by its change in duration.
+        const double begin = s.time.front();
+        const double shift = timed.time.back() - (s.time.back() - begin);
+        s.time.clear();
+        for (const double t : timed.time) s.time.push_back(begin + t);
+        s.q = timed.q;
+        s.via = p.found.via;
+        s.path_length = path_length(path);
+        for (std::size_t later = p.step + 1; later < st->steps.size(); ++later) {
+          for (double& t : st->steps[later].time) t += shift;
+        }
+      }
+      st->pending.clear();
+    }
+    return all_passed;
+  }
+
+  // The stage's queued reports are not wanted (an attempt given up, a stage that failed).
+  void abandon(Stage& st) {
+    for (const PendingCheck& p : st.pending) queue_->discard(p.job);
+    st.pending.clear();
   }
 
   MotionResult timed_plan(ArmMotionPlanner& planner, const MotionRequest& request) {
@@ -378,17 +533,16 @@ class Run {
     return planner.plan(request);
   }
 
-  // Times the motion's path and re-checks it with the validator: whether it passed.
-  bool timed_and_valid(const Stage& stage, const core::Arm& arm, const MotionRequest& request,
-                       const std::vector<Eigen::VectorXd>& path, TimedPath& timed,
-                       ValidationReport& report) {
-    const Stopwatch watch(times_.validation);
-    timed = time_parameterize_through(path, arm.spec.max_velocity, arm.spec.max_acceleration,
-                                      settings_.speed_scale, settings_.timing_step);
+  TimedPath timed_path(const core::Arm& arm, const std::vector<Eigen::VectorXd>& path) const {
+    return time_parameterize_through(path, arm.spec.max_velocity, arm.spec.max_acceleration,
+                                     settings_.speed_scale, settings_.timing_step);
+  }
+
+  // What the validator needs to know of a motion of the stage besides its trajectory.
+  Motion motion_frame(const Stage& stage, const core::Arm& arm,
+                      const MotionRequest& request) const {
     Motion check;
     check.arm = arm.spec.name;
-    check.time = timed.time;
-    check.q = timed.q;
     check.robot_q = stage.end.robot_q;
     check.holds_board = request.held.held;
     check.board_in_tcp = request.held.board_in_tcp;
@@ -402,6 +556,18 @@ class Run {
     if (request.held.held && &arm == &receiving_) {
       cell_.set_jaw(check.robot_q, arm, request.held.jaw);
     }
+    return check;
+  }
+
+  // Times the path and re-checks it with the validator, here and now: whether it passed.
+  bool timed_and_valid(const Motion& frame, const core::Arm& arm,
+                       const std::vector<Eigen::VectorXd>& path, TimedPath& timed,
+                       ValidationReport& report) {
+    const Stopwatch watch(times_.validation);
+    timed = timed_path(arm, path);
+    Motion check = frame;
+    check.time = timed.time;
+    check.q = timed.q;
     report = validate_motion(world_, validation_threads_, check, settings_.validator);
     return report.valid();
   }
@@ -650,6 +816,7 @@ class Run {
           cell_.set_jaw(st.end.robot_q, receiving_, jaw_for(grasp));
           return true;
         }
+        abandon(attempt);
         if (first_failure.empty()) first_failure = failure;
         if (failure.find("deadline") != std::string::npos) {
           st.failure = failure;
@@ -669,6 +836,7 @@ class Run {
           cell_.set_jaw(st.end.robot_q, receiving_, jaw_for(grasp));
           return true;
         }
+        abandon(attempt);
       }
       return false;
     };
@@ -920,6 +1088,10 @@ class Run {
   ArmMotionPlanner receiving_planner_;
   std::vector<std::unique_ptr<core::CollisionData>> validation_data_;  // one per thread
   std::vector<core::CollisionData*> validation_threads_;
+  // Validates the steps on the second thread while the next are planned (after the data).
+  std::optional<ValidationQueue> queue_;
+  bool speculate_ = false;  // step() queues its motion's validation and plans on
+  int rejected_motions_ = 0;
   core::Pose board_initial_;
   Eigen::Vector3d opening_tcp_;
   Eigen::Vector3d approach_tcp_;
@@ -955,9 +1127,12 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   const auto started = std::chrono::steady_clock::now();
   BoardPlan result;
   result.board = board;
-  const PlanTimes* times = nullptr;  // the run's, once it is under way
+  const Run* running = nullptr;  // once it is under way
   auto finish = [&](BoardPlanStatus status, std::string reason) {
-    if (times != nullptr) result.times = *times;
+    if (running != nullptr) {
+      result.times = running->times();
+      result.rejected_motions = running->rejected_motions();
+    }
     result.status = status;
     result.reason = std::move(reason);
     result.planning_seconds =
@@ -989,7 +1164,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   bool any_connected_offline = false;
   // Every goal in order under `settings`; true when one is planned (result filled in).
   Run run(model_, settings_, scene, *part, *record, deadline, lazy_prm_);
-  times = &run.times();
+  running = &run;
   auto try_goals = [&](const std::string& round) {
     for (const auto& goal : goals) {
       // The shared grasps the offline regrasp graph connected for this goal first: their

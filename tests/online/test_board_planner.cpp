@@ -235,4 +235,35 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
   EXPECT_GE(fallback.attempts.size(), 2u);
   EXPECT_EQ(fallback.attempts.front().rank, nominal.goal_rank);
   EXPECT_NE(fallback.attempts.front().outcome, "planned");
+
+  // A validator stricter than the planner (a held board kept 2 deg inside theta_c) rejects
+  // transfers the planner has already planned past: with the validation overlapped, each is
+  // caught when the goal settles, its fallbacks run and its stage is planned again in order.
+  // The outcome is the one validating every motion before the next gives: the same goal, the
+  // same attempts, every emitted step passing the stricter validator. (On this database lateral
+  // right's first goal is rejected so, 15 times in order, and its second plans.)
+  online::BoardPlanSettings strict;
+  strict.validator.slip_tolerance_deg = -2.0;
+  online::BoardPlanSettings strict_in_order = strict;
+  strict_in_order.overlap_validation = false;
+  int rejected = 0;
+  for (const std::string& name : {"lateral_right", "top"}) {
+    SCOPED_TRACE(name);
+    const online::Scene& s = scene_of.at(name);
+    const auto overlapped = online::BoardPlanner(*model, strict).plan(s, name, in_seconds(120.0));
+    const auto in_order =
+        online::BoardPlanner(*model, strict_in_order).plan(s, name, in_seconds(120.0));
+    print_plan(overlapped);
+    rejected += overlapped.rejected_motions;
+    // Each rejected stage is planned twice when overlapped: first on, then in order.
+    EXPECT_GE(overlapped.rejected_motions, in_order.rejected_motions);
+    ASSERT_EQ(overlapped.status, in_order.status);
+    EXPECT_EQ(overlapped.candidate_id, in_order.candidate_id);
+    ASSERT_EQ(overlapped.attempts.size(), in_order.attempts.size());
+    for (std::size_t i = 0; i < overlapped.attempts.size(); ++i) {
+      EXPECT_EQ(overlapped.attempts[i].outcome, in_order.attempts[i].outcome) << "attempt " << i;
+    }
+    if (overlapped.solved()) expect_plan_well_formed(*model, s, overlapped);
+  }
+  EXPECT_GT(rejected, 0) << "the stricter validator must reject something";
 }

@@ -59,8 +59,10 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                       {"planning_split_ms",
                        {{"motions", 1e3 * plan.times.motions},
                         {"smoothing", 1e3 * plan.times.smoothing},
-                        {"validation", 1e3 * plan.times.validation}}},
-                      {"attempts", attempts}};
+                        {"validation", 1e3 * plan.times.validation},
+                        {"queued_validation", 1e3 * plan.times.queued_validation}}},
+                      {"attempts", attempts},
+                      {"rejected_motions", plan.rejected_motions}};
   if (plan.solved()) {
     j["goal_rank"] = plan.goal_rank;
     j["candidate"] = plan.candidate_id;

@@ -34,6 +34,10 @@ struct BoardPlanSettings {
   ValidatorSettings validator;
   // The validator's dense pass is split over this many threads (the same report as one).
   int validation_threads = 2;
+  // With two validation threads: each motion is validated on the second thread while the next
+  // ones are planned (ValidationQueue); a stage planned past a step the validator then rejects
+  // is planned again in order. false: each motion is validated before the next is planned.
+  bool overlap_validation = true;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
@@ -67,10 +71,14 @@ const char* to_string(BoardPlanStatus status);
 // (ArmMotionPlanner::plan, stagings and fine retries included), smoothing, and the timing with
 // the validator's re-check. The motions are what the planners differ in: the rest is the same
 // work for hila's roadmaps and the from-scratch baselines.
+// Seconds of BoardPlan::planning_seconds on the planner's thread, and the validator's own.
 struct PlanTimes {
   double motions = 0.0;
   double smoothing = 0.0;
-  double validation = 0.0;
+  double validation = 0.0;  // timing and validating, or waiting for the queue's reports
+  // The queue's validation on either thread (BoardPlanSettings::overlap_validation), most of it
+  // alongside the planning: not a part of planning_seconds.
+  double queued_validation = 0.0;
 };
 
 struct BoardPlan {
@@ -95,6 +103,9 @@ struct BoardPlan {
   // Planned in the second round, with MotionSettings::escalated_bridge_checks per bridge (every
   // goal had failed within the cheaper budget).
   bool larger_bridges = false;
+  // Motions the validator rejected as first planned (a fallback then passed, or the stage or
+  // goal was given up), over every goal tried.
+  int rejected_motions = 0;
   Eigen::VectorXd robot_q_after;  // the robot when the board has been taken
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };

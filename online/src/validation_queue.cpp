@@ -1,0 +1,117 @@
+#include "hila/online/validation_queue.hpp"
+
+#include <cassert>
+#include <chrono>
+#include <exception>
+#include <system_error>
+#include <utility>
+
+namespace hila::online {
+
+ValidationQueue::ValidationQueue(const World& world, const ValidatorSettings& settings,
+                                 core::CollisionData& worker_data, core::CollisionData& caller_data)
+    : world_(world), settings_(settings), worker_data_(worker_data), caller_data_(caller_data) {
+  try {
+    worker_ = std::thread([this] { run_worker(); });
+  } catch (const std::system_error&) {
+    // No second thread: wait() validates everything on the caller's.
+  }
+}
+
+ValidationQueue::~ValidationQueue() {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+std::size_t ValidationQueue::submit(Motion motion) {
+  std::size_t job = 0;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    job = jobs_.size();
+    jobs_.push_back({std::move(motion), {}, false, false});
+  }
+  changed_.notify_all();
+  return job;
+}
+
+const ValidationReport& ValidationQueue::wait(std::size_t job) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  assert(job < jobs_.size());
+  while (!jobs_[job].done) {
+    if (has_next()) {
+      run_next(lock, caller_data_);
+    } else {
+      changed_.wait(lock);
+    }
+  }
+  return jobs_[job].report;
+}
+
+void ValidationQueue::drain() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    if (has_next()) {
+      run_next(lock, caller_data_);
+    } else if (running_ > 0) {
+      changed_.wait(lock);
+    } else {
+      return;
+    }
+  }
+}
+
+void ValidationQueue::discard(std::size_t job) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  assert(job < jobs_.size());
+  jobs_[job].discarded = true;
+}
+
+bool ValidationQueue::has_next() {
+  while (next_ < jobs_.size() && jobs_[next_].discarded) {
+    jobs_[next_].done = true;
+    ++next_;
+  }
+  return next_ < jobs_.size();
+}
+
+double ValidationQueue::seconds() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return seconds_;
+}
+
+void ValidationQueue::run_worker() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    changed_.wait(lock, [this] { return stopping_ || has_next(); });
+    if (stopping_) return;
+    run_next(lock, worker_data_);
+  }
+}
+
+void ValidationQueue::run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data) {
+  Job& job = jobs_[next_++];
+  ++running_;
+  lock.unlock();
+  const auto started = std::chrono::steady_clock::now();
+  ValidationReport report;
+  try {
+    report = validate_motion(world_, data, job.motion, settings_);
+  } catch (const std::exception& e) {
+    // Out of memory, say: the motion is not known to be valid, so it is not.
+    report.violations.push_back({"internal", 0.0, e.what()});
+  }
+  const double took =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  lock.lock();
+  job.report = std::move(report);
+  job.done = true;
+  --running_;
+  seconds_ += took;
+  changed_.notify_all();
+}
+
+}  // namespace hila::online

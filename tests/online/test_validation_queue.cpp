@@ -1,0 +1,121 @@
+#include <gtest/gtest.h>
+
+#include "hila/core/product.hpp"
+#include "hila/online/validation_queue.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+const core::ProductSpec& cabinet() {
+  static const core::ProductSpec product = core::load_product(test::product_path());
+  return product;
+}
+
+std::string describe(const online::ValidationReport& r) {
+  std::string out = std::to_string(r.samples) + " samples; ";
+  for (const auto& v : r.violations) {
+    out += v.kind + " @" + std::to_string(v.time) + ": " + v.detail + "; ";
+  }
+  return out;
+}
+
+struct Fixture {
+  std::shared_ptr<const core::Cell> cell = test::reference_cell();
+  online::Scene scene = online::nominal_scene(*cell, cabinet());
+  online::World world{*cell, cabinet(), scene, "top"};
+  const core::Arm& left = cell->arm("left");
+
+  // The left arm's first IK solution for a TCP pointing down at `p` (world).
+  Eigen::VectorXd left_at(const Eigen::Vector3d& p) const {
+    core::Pose tcp = core::Pose::Identity();
+    tcp.linear() = Eigen::AngleAxisd(core::kPi, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    tcp.translation() = p;
+    core::UrIkSolutions ik;
+    const int n =
+        left.ur_ik->solve(core::arm_base_in_world(*cell, left).inverse() * tcp, left.spec.home, ik);
+    EXPECT_GT(n, 0) << "no IK at " << p.transpose();
+    return n > 0 ? Eigen::VectorXd(ik.q[0]) : left.spec.home;
+  }
+
+  // Slow straight motions of the left arm, some into the table (1.094 m), one with a joint jump.
+  std::vector<online::Motion> motions() const {
+    const Eigen::VectorXd above = left_at({0.40, 0.20, 1.30});
+    const Eigen::VectorXd inside = left_at({0.40, 0.20, 1.084});
+    const Eigen::VectorXd aside = left_at({0.30, 0.30, 1.25});
+    std::vector<std::vector<Eigen::VectorXd>> paths = {{left.spec.home, above},
+                                                       {above, inside},
+                                                       {above, aside, above},
+                                                       {left.spec.home, above, inside, above},
+                                                       {aside, left.spec.home}};
+    std::vector<online::Motion> out;
+    for (const auto& q : paths) {
+      online::Motion m;
+      m.arm = "left";
+      m.q = q;
+      for (std::size_t i = 0; i < q.size(); ++i) m.time.push_back(4.0 * static_cast<double>(i));
+      m.robot_q = cell->home_configuration();
+      m.board_world = cabinet().part("top").initial;
+      out.push_back(m);
+    }
+    out.back().time.back() = 0.01;  // a jump
+    return out;
+  }
+};
+
+}  // namespace
+
+// Whichever thread validates a job (the worker, or the caller helping while it waits), its
+// report is the one validate_motion gives for the motion alone.
+TEST(ValidationQueue, ReportsAreThoseOfTheMotionValidatedAlone) {
+  Fixture f;
+  const auto motions = f.motions();
+  std::vector<std::string> alone;
+  core::CollisionData data = f.world.make_data();
+  for (const auto& m : motions)
+    alone.push_back(describe(online::validate_motion(f.world, data, m)));
+  int invalid = 0;
+  for (const auto& a : alone) invalid += a.find('@') != std::string::npos ? 1 : 0;
+  ASSERT_GE(invalid, 2) << "the table and the jump must be caught";
+  ASSERT_LT(invalid, static_cast<int>(motions.size())) << "and the clear motions pass";
+
+  core::CollisionData worker = f.world.make_data();
+  core::CollisionData caller = f.world.make_data();
+  online::ValidationQueue queue(f.world, {}, worker, caller);
+  // Three rounds of every motion: the later ones find both threads' data posed by earlier jobs.
+  std::vector<std::size_t> jobs;
+  for (int round = 0; round < 3; ++round) {
+    for (const auto& m : motions) jobs.push_back(queue.submit(m));
+  }
+  // Waited for from the last: the caller validates whatever is still queued meanwhile.
+  for (std::size_t i = jobs.size(); i-- > 0;) {
+    EXPECT_EQ(describe(queue.wait(jobs[i])), alone[i % motions.size()]) << "job " << i;
+  }
+  EXPECT_GT(queue.seconds(), 0.0);
+}
+
+TEST(ValidationQueue, DiscardedJobsAreNotValidatedAndDrainWaitsForTheRest) {
+  Fixture f;
+  const auto motions = f.motions();
+  core::CollisionData worker = f.world.make_data();
+  core::CollisionData caller = f.world.make_data();
+  online::ValidationQueue queue(f.world, {}, worker, caller);
+  std::vector<std::size_t> jobs;
+  for (const auto& m : motions) jobs.push_back(queue.submit(m));
+  // Discarded straight away: unless the worker already took it, it is never validated (its
+  // report stays empty: no samples).
+  queue.discard(jobs.back());
+  queue.drain();
+  for (std::size_t i = 0; i + 1 < jobs.size(); ++i) {
+    EXPECT_GT(queue.wait(jobs[i]).samples, 0) << "job " << i << " was validated";
+  }
+  const auto& discarded = queue.wait(jobs.back());
+  if (discarded.samples == 0) {
+    EXPECT_TRUE(discarded.violations.empty());
+  }
+  // After a drain the queue takes new work as before.
+  const std::size_t again = queue.submit(motions.front());
+  EXPECT_EQ(describe(queue.wait(again)),
+            describe(online::validate_motion(f.world, caller, motions.front())));
+}
