@@ -281,19 +281,24 @@ class Run {
     return p.get();
   }
 
+  // Calls `visit` with every memo of stages after the tool's (each a map to Stage).
+  template <typename Visit>
+  void each_memo(Visit visit) {
+    visit(picks_);
+    visit(transfers_);
+    visit(receives_);
+    visit(releases_);
+    visit(presents_);
+    visit(leaves_);
+  }
+
   // Drops the memoised stages `which` picks, to be planned again when next asked for.
   template <typename Which>
   void forget(Which which) {
     if (tool_ && which(*tool_)) tool_.reset();
-    auto from = [&](auto& stages) {
+    each_memo([&](auto& stages) {
       std::erase_if(stages, [&](const auto& entry) { return which(entry.second); });
-    };
-    from(picks_);
-    from(transfers_);
-    from(receives_);
-    from(releases_);
-    from(presents_);
-    from(leaves_);
+    });
   }
 
   const db::RegraspNodeRecord* node(std::int64_t id) const {
@@ -472,15 +477,9 @@ class Run {
       if (!st.pending.empty()) waiting.push_back(&st);
     };
     if (tool_) add(*tool_);
-    auto collect = [&](auto& stages) {
+    each_memo([&](auto& stages) {
       for (auto& entry : stages) add(entry.second);
-    };
-    collect(picks_);
-    collect(transfers_);
-    collect(receives_);
-    collect(releases_);
-    collect(presents_);
-    collect(leaves_);
+    });
     std::sort(waiting.begin(), waiting.end(), [](const Stage* a, const Stage* b) {
       return a->pending.front().job < b->pending.front().job;
     });

@@ -62,14 +62,7 @@ struct Fixture {
 
   // The left arm's first IK solution for a TCP pointing down at `p` (world).
   Eigen::VectorXd left_at(const Eigen::Vector3d& p) const {
-    core::Pose tcp = core::Pose::Identity();
-    tcp.linear() = Eigen::AngleAxisd(core::kPi, Eigen::Vector3d::UnitX()).toRotationMatrix();
-    tcp.translation() = p;
-    core::UrIkSolutions ik;
-    const int n =
-        left.ur_ik->solve(core::arm_base_in_world(*cell, left).inverse() * tcp, left.spec.home, ik);
-    EXPECT_GT(n, 0) << "no IK at " << p.transpose();
-    return n > 0 ? Eigen::VectorXd(ik.q[0]) : left.spec.home;
+    return test::arm_pointing_down_at(*cell, left, p);
   }
 };
 

@@ -5,6 +5,8 @@
 #include <sstream>
 
 #include "hila/core/error.hpp"
+#include "hila/core/stage_scene.hpp"
+#include "hila/core/ur_ik.hpp"
 
 namespace hila::test {
 
@@ -21,6 +23,18 @@ std::string product_path() {
 std::shared_ptr<const core::Cell> reference_cell() {
   static const std::shared_ptr<const core::Cell> cell = core::Cell::load(cell_path());
   return cell;
+}
+
+Eigen::VectorXd arm_pointing_down_at(const core::Cell& cell, const core::Arm& arm,
+                                     const Eigen::Vector3d& p) {
+  core::Pose tcp = core::Pose::Identity();
+  tcp.linear() = Eigen::AngleAxisd(core::kPi, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  tcp.translation() = p;
+  core::UrIkSolutions ik;
+  const int n =
+      arm.ur_ik->solve(core::arm_base_in_world(cell, arm).inverse() * tcp, arm.spec.home, ik);
+  EXPECT_GT(n, 0) << "no IK at " << p.transpose();
+  return n > 0 ? Eigen::VectorXd(ik.q[0]) : arm.spec.home;
 }
 
 std::string temp_dir(const std::string& name) {

@@ -19,6 +19,10 @@ std::string product_path();                          // meshes/cabinet/product.y
 
 // The reference cell, loaded once per test binary.
 std::shared_ptr<const core::Cell> reference_cell();
+// The arm's first analytic IK solution (nearest its home) for its TCP pointing straight down at
+// `p` (world); a failed expectation and the home configuration when there is none.
+Eigen::VectorXd arm_pointing_down_at(const core::Cell& cell, const core::Arm& arm,
+                                     const Eigen::Vector3d& p);
 
 // A fresh, empty directory for this test (removed and recreated on every call).
 std::string temp_dir(const std::string& name);
