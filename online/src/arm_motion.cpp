@@ -202,19 +202,32 @@ bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::Vect
                                           [this](const Eigen::VectorXd& q) { return valid(q); });
 }
 
+bool ArmMotionPlanner::node_valid(int node) {
+  auto& state = node_state_[static_cast<std::size_t>(node)];
+  if (state >= 0) return state == 1;
+  state = valid(roadmap_.record.nodes[static_cast<std::size_t>(node)]) ? 1 : 0;
+  if (state == 1) return true;
+  // Every edge of a blocked node is blocked: dropped at once, not one per search.
+  for (auto it = roadmap_.graph.neighbours_begin(node); it != roadmap_.graph.neighbours_end(node);
+       ++it) {
+    const auto e = static_cast<std::size_t>(it->edge);
+    if (edge_state_[e] == 0) continue;
+    edge_state_[e] = 0;
+    blocked_edges_.push_back(it->edge);
+    if (allowed_[e]) {
+      allowed_[e] = false;
+      ++invalidated_;
+    }
+  }
+  return false;
+}
+
 bool ArmMotionPlanner::edge_valid(int edge) {
   auto& verdict = edge_state_[static_cast<std::size_t>(edge)];
   if (verdict >= 0) return verdict == 1;
   const auto [u, v] = roadmap_.record.edges[static_cast<std::size_t>(edge)];
+  if (!node_valid(u) || !node_valid(v)) return false;  // blocked with the node's edges
   verdict = 0;
-  for (const int n : {u, v}) {
-    auto& state = node_state_[static_cast<std::size_t>(n)];
-    if (state < 0) state = valid(roadmap_.record.nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
-    if (state == 0) {
-      blocked_edges_.push_back(edge);
-      return false;
-    }
-  }
   ++checked_;
   verdict = segment_valid(roadmap_.record.nodes[static_cast<std::size_t>(u)],
                           roadmap_.record.nodes[static_cast<std::size_t>(v)])
@@ -407,9 +420,7 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd&
     if (static_cast<int>(out.size()) >= settings_.attachments) break;
     sort_up_to(j);
     const int n = near[j].second;
-    auto& state = node_state_[static_cast<std::size_t>(n)];
-    if (state < 0) state = valid(nodes[static_cast<std::size_t>(n)]) ? 1 : 0;
-    if (state == 1 && (!check_joins || segment_valid(q, nodes[static_cast<std::size_t>(n)]))) {
+    if (node_valid(n) && (!check_joins || segment_valid(q, nodes[static_cast<std::size_t>(n)]))) {
       out.push_back({n, near[j].first});
     }
   }
@@ -582,7 +593,10 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
         check_exits();
         continue;
       }
+      // The path's nodes first (a check each, against a segment's dozens): a path through a
+      // blocked node is dropped with all the node's edges before any of its segments is checked.
       bool clear = true;
+      for (const int n : path.nodes) clear = node_valid(n) && clear;
       for (std::size_t i = 1; i < path.nodes.size() && clear; ++i) {
         const int a = path.nodes[i - 1];
         const int b = path.nodes[i];
@@ -590,8 +604,10 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
              ++it) {
           if (it->node != b || !allowed_[static_cast<std::size_t>(it->edge)]) continue;
           if (!edge_valid(it->edge)) {
-            allowed_[static_cast<std::size_t>(it->edge)] = false;
-            ++invalidated_;
+            if (allowed_[static_cast<std::size_t>(it->edge)]) {  // else dropped with its node
+              allowed_[static_cast<std::size_t>(it->edge)] = false;
+              ++invalidated_;
+            }
             clear = false;
           }
           break;

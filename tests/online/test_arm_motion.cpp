@@ -30,22 +30,31 @@ const online::ArmRoadmap& left_roadmap() {
   return roadmap;
 }
 
-// A roadmap record of `nodes`, the first nodes.size() - loose chained by edges in order, the
-// last `loose` without edges.
-db::RoadmapRecord chain_roadmap(const std::vector<Eigen::VectorXd>& nodes, std::size_t loose = 0) {
+// A roadmap record of `nodes` joined by `edges` (node indices).
+db::RoadmapRecord roadmap_of(const std::vector<Eigen::VectorXd>& nodes,
+                             const std::vector<std::pair<int, int>>& edges) {
   db::RoadmapRecord r = left_roadmap().record;
   r.nodes = nodes;
   r.node_gravity.assign(nodes.size(), Eigen::Vector3d::UnitZ());
   r.node_inclination_deg.assign(nodes.size(), 0.0);
-  r.edges.clear();
+  r.edges = edges;
   r.edge_length.clear();
-  r.edge_max_inclination_deg.clear();
-  for (std::size_t i = 0; i + 1 + loose < nodes.size(); ++i) {
-    r.edges.emplace_back(static_cast<int>(i), static_cast<int>(i + 1));
-    r.edge_length.push_back((nodes[i + 1] - nodes[i]).norm());
-    r.edge_max_inclination_deg.push_back(0.0);
+  for (const auto& [a, b] : edges) {
+    r.edge_length.push_back(
+        (nodes[static_cast<std::size_t>(b)] - nodes[static_cast<std::size_t>(a)]).norm());
   }
+  r.edge_max_inclination_deg.assign(edges.size(), 0.0);
   return r;
+}
+
+// A roadmap record of `nodes`, the first nodes.size() - loose chained by edges in order, the
+// last `loose` without edges.
+db::RoadmapRecord chain_roadmap(const std::vector<Eigen::VectorXd>& nodes, std::size_t loose = 0) {
+  std::vector<std::pair<int, int>> edges;
+  for (std::size_t i = 0; i + 1 + loose < nodes.size(); ++i) {
+    edges.emplace_back(static_cast<int>(i), static_cast<int>(i + 1));
+  }
+  return roadmap_of(nodes, edges);
 }
 
 // Waypoints 4 s apart: slow enough for every velocity and acceleration limit.
@@ -63,6 +72,13 @@ std::string describe(const online::ValidationReport& r) {
   std::string out;
   for (const auto& v : r.violations) out += v.kind + ": " + v.detail + "; ";
   return out;
+}
+
+// The independent validator's report on a planned path, timed slowly, in `world`.
+online::ValidationReport validate_in(const online::World& world,
+                                     const std::vector<Eigen::VectorXd>& path) {
+  core::CollisionData data = world.make_data();
+  return online::validate_motion(world, data, timed(path, cabinet().part("top").initial));
 }
 
 online::MotionRequest request(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
@@ -371,9 +387,7 @@ TEST(ArmMotion, ABlockedJoinIntoTheRoadmapIsReplacedByOneThatHolds) {
     if (!result.solved()) continue;  // the crate may cut every way out: not this test's case
     ASSERT_GE(result.path.size(), 3u);
     EXPECT_FALSE(result.path[1].isApprox(entry, 0.0)) << "entered through the blocked join";
-    core::CollisionData data = world.make_data();
-    const auto report =
-        online::validate_motion(world, data, timed(result.path, cabinet().part("top").initial));
+    const auto report = validate_in(world, result.path);
     EXPECT_TRUE(report.valid()) << result.via << ": " << describe(report);
     return;
   }
@@ -475,4 +489,62 @@ TEST(ArmMotion, ACutRoadmapIsEnteredAlongAStoredPathBeforeABridge) {
     return;
   }
   FAIL() << "no far node pair gave a roadmap path of four waypoints cut from its start";
+}
+
+// A roadmap node inside a crate, on the shortest way from many entries: the first time the search
+// meets it, all its edges are dropped, not one per search (the start, the goal, the blocked node
+// halfway between them, five spokes beside the start each joined to it, and a longer detour of
+// two nodes). Dropping only the edge a path used cost a search per spoke.
+TEST(ArmMotion, ABlockedNodeIsDroppedWithAllItsEdgesAtOnce) {
+  const auto& cell = *test::reference_cell();
+  const core::Arm& left = cell.arm("left");
+  const online::Scene nominal = online::nominal_scene(cell, cabinet());
+  const Eigen::VectorXd s = left.spec.home;
+  Eigen::VectorXd g = s;
+  g[0] += 0.8;
+  const Eigen::VectorXd x = 0.5 * (s + g);
+  online::Scene crated = nominal;
+  const core::Pose tcp = core::arm_base_in_world(cell, left) * left.chain.fk(x);
+  crated.obstacles.push_back(crate_at(tcp.translation(), 0.12));  // wider than the open jaw
+  const online::World world(cell, cabinet(), crated, "top");
+  online::MotionSettings settings;
+  settings.shortcut_checks = 0;  // the path as searched
+  int tried = 0;
+  for (int joint = 1; joint < 6; ++joint) {
+    for (const double lift : {0.8, -0.8}) {
+      Eigen::VectorXd d1 = s;
+      Eigen::VectorXd d2 = g;
+      d1[joint] += lift;
+      d2[joint] += lift;
+      std::vector<Eigen::VectorXd> nodes{s, g, x, d1, d2};
+      std::vector<std::pair<int, int>> edges{{0, 2}, {2, 1}, {0, 3}, {3, 4}, {4, 1}};
+      for (int spoke = 1; spoke < 6; ++spoke) {
+        Eigen::VectorXd y = s;
+        y[spoke] += 0.04;
+        nodes.push_back(y);
+        const int n = static_cast<int>(nodes.size()) - 1;
+        edges.emplace_back(0, n);
+        edges.emplace_back(n, 2);
+      }
+      const online::ArmRoadmap roadmap(roadmap_of(nodes, edges));
+      online::ArmMotionPlanner planner(world, roadmap, "left", settings);
+      online::MotionRequest r = request(s, g);
+      r.allow_bridge = false;
+      planner.prepare(r);
+      bool premises = !planner.valid(x) && planner.segment_valid(s, d1) &&
+                      planner.segment_valid(d1, d2) && planner.segment_valid(d2, g);
+      for (std::size_t k = 3; k < nodes.size(); ++k) premises = premises && planner.valid(nodes[k]);
+      if (!premises) continue;
+      ++tried;
+      const auto result = planner.plan(r);
+      ASSERT_TRUE(result.solved()) << result.reason;
+      for (const auto& q : result.path) EXPECT_FALSE(q.isApprox(x, 0.0)) << "through the crate";
+      EXPECT_LE(result.searches, 2) << "the blocked node's edges were dropped one search at a time";
+      EXPECT_EQ(result.edges_invalidated, 7) << "every edge of the blocked node, each once";
+      const auto report = validate_in(world, result.path);
+      EXPECT_TRUE(report.valid()) << result.via << ": " << describe(report);
+      return;
+    }
+  }
+  FAIL() << "no detour around the crated node holds (" << tried << " tried)";
 }

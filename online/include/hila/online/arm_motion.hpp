@@ -171,6 +171,8 @@ class ArmMotionPlanner {
  private:
   enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
   Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
+  // A roadmap node's verdict (kept); a blocked node's edges are all blocked with it.
+  bool node_valid(int node);
   bool edge_valid(int edge);
   using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
   // The first of a stored path's first few waypoints a straight segment joins to the start, and
