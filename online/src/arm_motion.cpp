@@ -143,6 +143,7 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   for (const int e : blocked_edges_) allowed_[static_cast<std::size_t>(e)] = false;
   checked_ = 0;
   invalidated_ = 0;
+  blocked_segments_.clear();
 }
 
 bool ArmMotionPlanner::valid(const Eigen::VectorXd& q) {
@@ -152,6 +153,7 @@ bool ArmMotionPlanner::valid(const Eigen::VectorXd& q) {
 // The hot path: no strings are built unless a reason is asked for.
 ArmMotionPlanner::Verdict ArmMotionPlanner::check(const Eigen::VectorXd& q,
                                                   core::CollisionPair* pair) {
+  ++checks_;
   if (q.size() != arm_.chain.dof() || !arm_.chain.within_limits(q, 1e-9)) {
     return Verdict::kOutsideLimits;
   }
@@ -198,8 +200,21 @@ std::string ArmMotionPlanner::why_invalid(const Eigen::VectorXd& q) {
 }
 
 bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return core::all_samples_coarse_to_fine(a, b, resolution_,
-                                          [this](const Eigen::VectorXd& q) { return valid(q); });
+  // A request asks some segments more than once (the straight motion, then again as the first
+  // shortcut of whatever path is found): the ones found blocked are remembered until the next
+  // prepare(). Exact ends in the same direction: the very same samples.
+  for (const auto& [from, to] : blocked_segments_) {
+    if (from.size() == a.size() && from == a && to == b) return false;
+  }
+  if (core::all_samples_coarse_to_fine(a, b, resolution_,
+                                       [this](const Eigen::VectorXd& q) { return valid(q); })) {
+    return true;
+  }
+  if (blocked_segments_.size() == kBlockedSegmentsKept) {
+    blocked_segments_.erase(blocked_segments_.begin());
+  }
+  blocked_segments_.emplace_back(a, b);
+  return false;
 }
 
 bool ArmMotionPlanner::node_valid(int node) {

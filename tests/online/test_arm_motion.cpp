@@ -548,3 +548,30 @@ TEST(ArmMotion, ABlockedNodeIsDroppedWithAllItsEdgesAtOnce) {
   }
   FAIL() << "no detour around the crated node holds (" << tried << " tried)";
 }
+
+// A segment found blocked is not sampled again for the same request (the straight motion is
+// asked again as the first shortcut of the path found): the same verdict without a check, until
+// the next prepare(); the other direction is its own segment.
+TEST(ArmMotion, ABlockedSegmentIsCheckedOncePerRequest) {
+  const auto crated = crate_on_a_roadmap_path();
+  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
+  const auto& [a, b, before, blocked] = *crated;
+  const auto& cell = *test::reference_cell();
+  const online::World world(cell, cabinet(), blocked, "top");
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  planner.prepare(request(a, b));
+  const long at_start = planner.checks();
+  ASSERT_FALSE(planner.segment_valid(a, b)) << "the crate blocks the straight motion";
+  const long first = planner.checks() - at_start;
+  EXPECT_GT(first, 0);
+  EXPECT_FALSE(planner.segment_valid(a, b));
+  EXPECT_EQ(planner.checks() - at_start, first) << "sampled again";
+  planner.prepare(request(a, b));
+  const long again = planner.checks();
+  EXPECT_FALSE(planner.segment_valid(a, b));
+  EXPECT_EQ(planner.checks() - again, first) << "the same samples after prepare()";
+  // A fresh planner agrees on both directions.
+  online::ArmMotionPlanner fresh(world, left_roadmap(), "left");
+  fresh.prepare(request(a, b));
+  EXPECT_EQ(planner.segment_valid(b, a), fresh.segment_valid(b, a));
+}

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hila/core/arm_poser.hpp"
@@ -162,6 +163,8 @@ class ArmMotionPlanner {
   bool valid(const Eigen::VectorXd& q);
   std::string why_invalid(const Eigen::VectorXd& q);
   bool segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+  // Validity checks of single configurations since construction (every query's unit of work).
+  long checks() const { return checks_; }
 
   // A bridge's check budget from the next request on (MotionSettings::bridge_checks).
   void set_bridge_checks(long checks) { settings_.bridge_checks = checks; }
@@ -235,9 +238,13 @@ class ArmMotionPlanner {
   std::vector<signed char> edge_state_;
   std::vector<int> blocked_edges_;  // the edges whose verdict is blocked, for prepare()
   std::vector<double> context_;     // what the verdicts were found under
+  // The last segments found blocked since prepare() (segment_valid()), oldest first.
+  static constexpr std::size_t kBlockedSegmentsKept = 8;
+  std::vector<std::pair<Eigen::VectorXd, Eigen::VectorXd>> blocked_segments_;
   std::vector<std::pair<double, int>> near_scratch_;  // attach()
   int checked_ = 0;
   int invalidated_ = 0;
+  long checks_ = 0;
 };
 
 }  // namespace hila::online
