@@ -373,8 +373,10 @@ class Run {
       const Stopwatch watch(times_.smoothing);
       SmoothResult smooth = smooth_path(
           path,
+          // Its points are new configurations, 0.05 rad apart: each is checked with the
+          // segment reaching it (an empty arm's segment has no sample between its ends).
           [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-            return planner.segment_valid(a, b);
+            return planner.step_valid(a, b);
           },
           settings_.smoother);
       if (smooth.smoothed) {

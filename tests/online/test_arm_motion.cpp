@@ -575,3 +575,27 @@ TEST(ArmMotion, ABlockedSegmentIsCheckedOncePerRequest) {
   fresh.prepare(request(a, b));
   EXPECT_EQ(planner.segment_valid(b, a), fresh.segment_valid(b, a));
 }
+
+// A segment no longer than the resolution has no sample between its ends: segment_valid()
+// passes it whatever its end is, step_valid() (what the smoother checks its new points with)
+// does not. The end here is past the base joint's limit.
+TEST(ArmMotion, AStepOntoAnUncheckedConfigurationChecksIt) {
+  const auto& cell = *test::reference_cell();
+  const core::Arm& left = cell.arm("left");
+  const online::World world(cell, cabinet(), online::nominal_scene(cell, cabinet()), "top");
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  const double upper = left.chain.upper_limits()[0];
+  Eigen::VectorXd a = left.spec.home;
+  a[0] = upper - 0.01;
+  Eigen::VectorXd past = a;
+  past[0] = upper + 0.02;  // 0.03 rad on: shorter than the roadmap's 0.05
+  Eigen::VectorXd back = a;
+  back[0] -= 0.04;
+  planner.prepare(request(a, past));
+  ASSERT_TRUE(planner.valid(a));
+  ASSERT_FALSE(planner.valid(past));
+  EXPECT_TRUE(planner.segment_valid(a, past)) << "no sample between the ends";
+  EXPECT_FALSE(planner.step_valid(a, past));
+  ASSERT_TRUE(planner.valid(back));
+  EXPECT_TRUE(planner.step_valid(a, back));
+}

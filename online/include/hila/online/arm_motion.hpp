@@ -163,6 +163,12 @@ class ArmMotionPlanner {
   bool valid(const Eigen::VectorXd& q);
   std::string why_invalid(const Eigen::VectorXd& q);
   bool segment_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+  // b and the segment from a to it (a checked already): a step onto a configuration nothing has
+  // checked yet, as a smoothed path's points are. segment_valid() alone samples only between
+  // the ends, which a segment no longer than the resolution leaves unchecked.
+  bool step_valid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    return valid(b) && segment_valid(a, b);
+  }
   // Validity checks of single configurations since construction (every query's unit of work).
   long checks() const { return checks_; }
 

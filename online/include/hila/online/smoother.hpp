@@ -29,10 +29,11 @@ struct SmoothResult {
 // `spacing` and its points minimise the sum of squared second differences (a discrete
 // acceleration) plus the weighted squared distance to the resampled path, ends fixed;
 // the banded normal equations are factorised with CHOLMOD (SuiteSparse) for all joints at once.
-// Every segment of the result is checked with `segment_valid` (the planner's collisions, slip,
-// joint limits); where one fails, the points around it are pinned harder to the original and
-// the system is solved again. When no valid smoothing is found within the rounds, or the path
-// has nothing to smooth, the input is returned.
+// Every segment of the result is checked with `segment_valid(a, b)` (the planner's collisions,
+// slip, joint limits), which must judge b as well as the motion to it: the points are new
+// configurations, and a is the start or the previous segment's b. Where one fails, the points
+// around it are pinned harder to the original and the system is solved again. When no valid
+// smoothing is found within the rounds, or the path has nothing to smooth, the input is returned.
 SmoothResult smooth_path(
     const std::vector<Eigen::VectorXd>& path,
     const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& segment_valid,
