@@ -247,7 +247,7 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
   online::BoardPlanSettings strict_in_order = strict;
   strict_in_order.overlap_validation = false;
   int rejected = 0;
-  for (const std::string& name : {"lateral_right", "top"}) {
+  for (const std::string name : {"lateral_right", "top"}) {
     SCOPED_TRACE(name);
     const online::Scene& s = scene_of.at(name);
     const auto overlapped = online::BoardPlanner(*model, strict).plan(s, name, in_seconds(120.0));
