@@ -1,9 +1,11 @@
 #include "hila/online/board_planner.hpp"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <tuple>
 
 #include "hila/core/bridge.hpp"
@@ -79,8 +81,17 @@ struct ArmsState {
   bool tool_in_hand = true;
 };
 
-// A step planned and timed whose validator report is still to come (ValidationQueue), with
-// what its fallbacks need when the report is a rejection.
+// What a queued step's finish made of the found path, on whichever thread took the job: the
+// path smoothed (or as found) and timed. Read once the job's report is in.
+struct FinishedPath {
+  std::vector<Eigen::VectorXd> path;
+  TimedPath timed;
+  bool smoothed = false;
+  double smoothing_seconds = 0.0;
+};
+
+// A step planned whose smoothing, timing and validator report are still to come
+// (ValidationQueue), with what its fallbacks need when the report is a rejection.
 struct PendingCheck {
   std::size_t job = 0;    // the queue's
   std::size_t step = 0;   // in Stage::steps
@@ -89,6 +100,7 @@ struct PendingCheck {
   ArmMotionPlanner* planner = nullptr;
   const core::Arm* arm = nullptr;
   MotionResult found;  // the planner's path, before smoothing
+  std::shared_ptr<const FinishedPath> finished;
 };
 
 // A stage of the chain (e.g. the suction pick for one cup): its timed steps (from 0) and where
@@ -97,6 +109,9 @@ struct PendingCheck {
 struct Stage {
   std::string failure;
   std::vector<PlanStep> steps;
+  // Each step's path as executed, or, for a queued step whose smoothing is still to come, as
+  // found: known before the step's timing is.
+  std::vector<std::vector<Eigen::VectorXd>> paths;
   ArmsState end;
   // The stage re-plans the one before it in another order (the receiving arm waits at its
   // pre-grasp before the board is brought): the previous stage's steps are dropped.
@@ -109,6 +124,12 @@ struct Stage {
 };
 
 using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
+
+// The steps whose paths, reversed, lead the receiving arm home after the release (Run::leave):
+// needed before a queued step's smoothing would be in, so they are smoothed on the planner's
+// thread.
+constexpr std::array<std::string_view, 3> kWayBackSteps = {"transfer_to_human", "receiving_grasp",
+                                                           "receiving_approach"};
 
 // Adds the time from its construction to its destruction to `into`.
 class Stopwatch {
@@ -366,44 +387,52 @@ class Run {
     }
     if (!motion.solved()) return name + ": " + to_string(motion.status) + ": " + motion.reason;
     PlanStep s;
-    // Smoothed (SuiteSparse) under the planner's checks for this request; the found path when
-    // the smoothing fails or the validator rejects it.
-    std::vector<Eigen::VectorXd> path = motion.path;
-    if (settings_.smooth && path.size() > 2 && !request.start_in_contact) {
-      const Stopwatch watch(times_.smoothing);
-      SmoothResult smooth = smooth_path(
-          path,
-          // Its points are new configurations, 0.05 rad apart: each is checked with the
-          // segment reaching it (an empty arm's segment has no sample between its ends).
-          [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-            return planner.step_valid(a, b);
-          },
-          settings_.smoother);
-      if (smooth.smoothed) {
-        path = std::move(smooth.path);
-        s.smoothed = true;
-      }
-    }
     const Motion frame = motion_frame(stage, arm, request);
+    const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();
+    std::vector<Eigen::VectorXd> path = motion.path;
     TimedPath timed;
+    // While the other thread is behind, a queued step is smoothed here (the same result
+    // either way: the plan does not depend on which thread smoothed).
+    const bool smooth_here =
+        !speculate_ || queue_->backlog() > 0 ||
+        std::find(kWayBackSteps.begin(), kWayBackSteps.end(), name) != kWayBackSteps.end();
+    if (smooth_here && smooths(path, request)) {
+      const Stopwatch watch(times_.smoothing);
+      s.smoothed = smoothed(planner, path);
+    }
     if (speculate_) {
-      // Planned on as if the validator passes it: settle() reads the report.
-      Motion check = frame;
-      {
-        const Stopwatch watch(times_.validation);
-        timed = timed_path(arm, path);
-        check.time = timed.time;
-        check.q = timed.q;
-      }
-      PendingCheck pending{queue_->submit(std::move(check)),
+      // Smoothed, timed and validated on whichever thread takes the job while the next steps
+      // are planned; until settle() reads the report, the step stands for its ends.
+      MotionRequest checked = request;
+      checked.hints.clear();
+      auto finished = std::make_shared<FinishedPath>();
+      const bool smooth = !smooth_here && smooths(path, request);
+      auto finish = [this, finished, &arm, checked = std::move(checked), found = path, smooth,
+                     smoothed_here = s.smoothed](std::size_t slot, Motion& m) {
+        finished->path = found;
+        finished->smoothed = smoothed_here;
+        if (smooth) {
+          const Stopwatch watch(finished->smoothing_seconds);
+          ArmMotionPlanner& checks = smoothing_checks(slot, arm);
+          checks.prepare(checked);
+          finished->smoothed = smoothed(checks, finished->path);
+        }
+        finished->timed = timed_path(arm, finished->path);
+        m.time = finished->timed.time;
+        m.q = finished->timed.q;
+      };
+      PendingCheck pending{queue_->submit(frame, std::move(finish)),
                            stage.steps.size(),
                            frame,
                            request,
                            &planner,
                            &arm,
-                           std::move(motion)};
+                           std::move(motion),
+                           finished};
       pending.request.hints.clear();
       s.via = pending.found.via;
+      timed.time = {0.0, 0.0};
+      timed.q = {path.front(), path.back()};
       stage.pending.push_back(std::move(pending));
     } else {
       const bool valid = timed_and_valid(frame, arm, path, timed, s.validation);
@@ -415,7 +444,6 @@ class Run {
       }
       s.via = motion.via;
     }
-    const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();
     s.name = name;
     s.arm = arm.spec.name;
     for (const double t : timed.time) s.time.push_back(clock + t);
@@ -424,8 +452,59 @@ class Run {
         start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
     s.path_length = path_length(path);
     cell_.set_arm(stage.end.robot_q, arm, path.back());
+    stage.paths.push_back(std::move(path));
     stage.steps.push_back(std::move(s));
     return "";
+  }
+
+  // Whether a found path is smoothed: every one with more than one segment, unless its start
+  // touches by design (a lift).
+  bool smooths(const std::vector<Eigen::VectorXd>& path, const MotionRequest& request) const {
+    return settings_.smooth && path.size() > 2 && !request.start_in_contact;
+  }
+
+  // Smooths `path` in place (SuiteSparse) under `checks`, prepared for the motion's request;
+  // whether it did (else the path is left as found).
+  bool smoothed(ArmMotionPlanner& checks, std::vector<Eigen::VectorXd>& path) const {
+    SmoothResult smooth = smooth_path(
+        path,
+        // Its points are new configurations, 0.05 rad apart: each is checked with the
+        // segment reaching it (an empty arm's segment has no sample between its ends).
+        [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return checks.step_valid(a, b); },
+        settings_.smoother);
+    if (!smooth.smoothed) return false;
+    path = std::move(smooth.path);
+    return true;
+  }
+
+  // The smoother's validity checks for a queued step of `arm`, on the queue's thread `slot`:
+  // the planner's checks at the planner's resolutions, with their own collision data.
+  ArmMotionPlanner& smoothing_checks(std::size_t slot, const core::Arm& arm) {
+    auto& checks = smoothing_checks_[slot][&arm == &suction_ ? 0 : 1];
+    if (!checks) {
+      MotionSettings motion = settings_.motion;
+      motion.planner = MotionPlannerKind::kRoadmap;  // only its checks are used
+      checks = std::make_unique<ArmMotionPlanner>(world_, model_.roadmap(arm.spec.name),
+                                                  arm.spec.name, motion);
+    }
+    return *checks;
+  }
+
+  // The step's path, timing and length as `path`, timed: the stage's later steps move by the
+  // change in its duration.
+  static void retime(Stage& st, std::size_t step, const std::vector<Eigen::VectorXd>& path,
+                     const TimedPath& timed) {
+    PlanStep& s = st.steps[step];
+    const double begin = s.time.front();
+    const double shift = timed.time.back() - (s.time.back() - begin);
+    s.time.clear();
+    for (const double t : timed.time) s.time.push_back(begin + t);
+    s.q = timed.q;
+    s.path_length = path_length(path);
+    st.paths[step] = path;
+    for (std::size_t later = step + 1; later < st.steps.size(); ++later) {
+      for (double& t : st.steps[later].time) t += shift;
+    }
   }
 
   // After the validator rejected the step's path (`s.validation`): the found path when the
@@ -495,9 +574,13 @@ class Run {
       for (PendingCheck& p : st->pending) {
         PlanStep& s = st->steps[p.step];
         s.validation = queue_->wait(p.job);
+        const FinishedPath& finished = *p.finished;
+        times_.queued_smoothing += finished.smoothing_seconds;
+        s.smoothed = finished.smoothed;
+        retime(*st, p.step, finished.path, finished.timed);
         if (s.validation.valid()) continue;
-        std::vector<Eigen::VectorXd> path;
-        TimedPath timed;
+        std::vector<Eigen::VectorXd> path = finished.path;
+        TimedPath timed = finished.timed;
         const std::string e =
             recover(p.frame, p.request, *p.planner, *p.arm, s.name, p.found, path, timed, s);
         if (!e.empty()) {
@@ -506,17 +589,9 @@ class Run {
           all_passed = false;
           break;
         }
-        // Another path between the same ends: the later steps move by its change in duration.
-        const double begin = s.time.front();
-        const double shift = timed.time.back() - (s.time.back() - begin);
-        s.time.clear();
-        for (const double t : timed.time) s.time.push_back(begin + t);
-        s.q = timed.q;
+        // Another path between the same ends (the found one, or a new plan).
+        retime(*st, p.step, path, timed);
         s.via = p.found.via;
-        s.path_length = path_length(path);
-        for (std::size_t later = p.step + 1; later < st->steps.size(); ++later) {
-          for (double& t : st->steps[later].time) t += shift;
-        }
       }
       st->pending.clear();
     }
@@ -1049,10 +1124,12 @@ class Run {
     // reaches no roadmap node, while the arm's own way in, now empty-handed, is clear for a
     // while.
     std::vector<Eigen::VectorXd> way_back;
-    const auto add_reversed = [&](const Stage& from, const std::string& name) {
-      for (const auto& step : from.steps) {
-        if (step.name != name) continue;
-        for (auto q = step.q.rbegin(); q != step.q.rend(); ++q) {
+    // As executed (resampled as timed): these steps were smoothed here (kWayBackSteps).
+    const auto add_reversed = [&](const Stage& from, std::string_view name) {
+      for (std::size_t i = 0; i < from.steps.size(); ++i) {
+        if (from.steps[i].name != name) continue;
+        const auto came = resample_path(from.paths[i], settings_.timing_step);
+        for (auto q = came.rbegin(); q != came.rend(); ++q) {
           if (way_back.empty() || (*q - way_back.back()).norm() >= settings_.way_back_spacing) {
             way_back.push_back(*q);
           }
@@ -1060,9 +1137,9 @@ class Run {
       }
     };
     if (settings_.way_back_spacing > 0.0) {
-      add_reversed(present(rr, grasp, goal), "transfer_to_human");
-      add_reversed(receive(rr, grasp), "receiving_grasp");
-      add_reversed(receive(rr, grasp), "receiving_approach");
+      add_reversed(present(rr, grasp, goal), kWayBackSteps[0]);
+      add_reversed(receive(rr, grasp), kWayBackSteps[1]);
+      add_reversed(receive(rr, grasp), kWayBackSteps[2]);
     }
     if (way_back.size() > 1) release.hints = {&way_back};
     // Only where the retreat attaches to no roadmap node: mostly the roadmap's way is shorter.
@@ -1087,6 +1164,10 @@ class Run {
   const core::Arm& receiving_;
   ArmMotionPlanner suction_planner_;
   ArmMotionPlanner receiving_planner_;
+  // The smoother's checks for queued steps, per queue slot (ValidationQueue::kWorkerSlot,
+  // kCallerSlot) and arm (suction, receiving); made when first needed. Before the queue, whose
+  // worker uses them until it is joined.
+  std::array<std::array<std::unique_ptr<ArmMotionPlanner>, 2>, 2> smoothing_checks_;
   std::vector<std::unique_ptr<core::CollisionData>> validation_data_;  // one per thread
   std::vector<core::CollisionData*> validation_threads_;
   // Validates the steps on the second thread while the next are planned (after the data).

@@ -27,12 +27,12 @@ ValidationQueue::~ValidationQueue() {
   if (worker_.joinable()) worker_.join();
 }
 
-std::size_t ValidationQueue::submit(Motion motion) {
+std::size_t ValidationQueue::submit(Motion motion, Finish finish) {
   std::size_t job = 0;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     job = jobs_.size();
-    jobs_.push_back({std::move(motion), {}, false, false});
+    jobs_.push_back({std::move(motion), std::move(finish), {}, false, false});
   }
   changed_.notify_all();
   return job;
@@ -43,7 +43,7 @@ const ValidationReport& ValidationQueue::wait(std::size_t job) {
   assert(job < jobs_.size());
   while (!jobs_[job].done) {
     if (has_next()) {
-      run_next(lock, caller_data_);
+      run_next(lock, caller_data_, kCallerSlot);
     } else {
       changed_.wait(lock);
     }
@@ -51,11 +51,17 @@ const ValidationReport& ValidationQueue::wait(std::size_t job) {
   return jobs_[job].report;
 }
 
+const Motion& ValidationQueue::motion(std::size_t job) const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  assert(job < jobs_.size() && jobs_[job].done);
+  return jobs_[job].motion;
+}
+
 void ValidationQueue::drain() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     if (has_next()) {
-      run_next(lock, caller_data_);
+      run_next(lock, caller_data_, kCallerSlot);
     } else if (running_ > 0) {
       changed_.wait(lock);
     } else {
@@ -78,6 +84,11 @@ bool ValidationQueue::has_next() {
   return next_ < jobs_.size();
 }
 
+std::size_t ValidationQueue::backlog() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return jobs_.size() - next_;
+}
+
 double ValidationQueue::seconds() const {
   const std::lock_guard<std::mutex> lock(mutex_);
   return seconds_;
@@ -88,17 +99,22 @@ void ValidationQueue::run_worker() {
   for (;;) {
     changed_.wait(lock, [this] { return stopping_ || has_next(); });
     if (stopping_) return;
-    run_next(lock, worker_data_);
+    run_next(lock, worker_data_, kWorkerSlot);
   }
 }
 
-void ValidationQueue::run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data) {
+void ValidationQueue::run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data,
+                               std::size_t slot) {
   Job& job = jobs_[next_++];
   ++running_;
   lock.unlock();
-  const auto started = std::chrono::steady_clock::now();
+  auto started = std::chrono::steady_clock::now();
   ValidationReport report;
   try {
+    if (job.finish) {
+      job.finish(slot, job.motion);
+      started = std::chrono::steady_clock::now();  // seconds() counts the validation only
+    }
     report = validate_motion(world_, data, job.motion, settings_);
   } catch (const std::exception& e) {
     // Out of memory, say: the motion is not known to be valid, so it is not.

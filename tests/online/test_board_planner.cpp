@@ -142,6 +142,29 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
     for (const auto& step : plan.steps) smoothed += step.smoothed ? 1 : 0;
   }
   EXPECT_GT(smoothed, 0);
+  // With the overlap on, steps are smoothed on either thread (queued, or on the planner's while
+  // the queue is behind): the plans are exactly those smoothed and validated in order.
+  online::BoardPlanSettings in_order_settings;
+  in_order_settings.overlap_validation = false;
+  online::BoardPlanner in_order_planner(*model, in_order_settings);
+  double queued_smoothing = 0.0;
+  for (const auto& [name, plan] : plan_of) {
+    SCOPED_TRACE(name);
+    queued_smoothing += plan.times.queued_smoothing;
+    const auto in_order = in_order_planner.plan(scene_of.at(name), name, in_seconds(120.0));
+    EXPECT_EQ(in_order.times.queued_smoothing, 0.0);
+    ASSERT_EQ(in_order.steps.size(), plan.steps.size());
+    for (std::size_t i = 0; i < plan.steps.size(); ++i) {
+      EXPECT_EQ(in_order.steps[i].name, plan.steps[i].name);
+      EXPECT_EQ(in_order.steps[i].smoothed, plan.steps[i].smoothed) << plan.steps[i].name;
+      EXPECT_EQ(in_order.steps[i].time, plan.steps[i].time) << plan.steps[i].name;
+      ASSERT_EQ(in_order.steps[i].q.size(), plan.steps[i].q.size()) << plan.steps[i].name;
+      for (std::size_t k = 0; k < plan.steps[i].q.size(); ++k) {
+        ASSERT_EQ(in_order.steps[i].q[k], plan.steps[i].q[k]) << plan.steps[i].name << " " << k;
+      }
+    }
+  }
+  EXPECT_GT(queued_smoothing, 0.0) << "some smoothing must have left the planner's thread";
   // The receiving arm's way home after the release follows its way in, reversed, on some
   // board; the same board without that hint goes home some other way (the hint was the cause).
   const auto home_via = [](const online::BoardPlan& plan) {

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <array>
+#include <atomic>
+#include <stdexcept>
+
 #include "hila/core/product.hpp"
 #include "hila/online/validation_queue.hpp"
 #include "util/test_util.hpp"
@@ -111,4 +115,56 @@ TEST(ValidationQueue, DiscardedJobsAreNotValidatedAndDrainWaitsForTheRest) {
   const std::size_t again = queue.submit(motions.front());
   EXPECT_EQ(describe(queue.wait(again)),
             describe(online::validate_motion(f.world, caller, motions.front())));
+}
+
+// A job's finish (the board planner's smoothing and timing) runs once, before the validation,
+// on the thread that validates the job, with that thread's slot; the report is the one the
+// finished motion gets validated alone. A finish that throws is a violation, not a crash.
+TEST(ValidationQueue, AFinishCompletesTheMotionOnTheThreadThatValidatesIt) {
+  Fixture f;
+  const auto motions = f.motions();
+  core::CollisionData alone_data = f.world.make_data();
+  std::vector<std::string> alone;
+  for (const auto& m : motions) {
+    alone.push_back(describe(online::validate_motion(f.world, alone_data, m)));
+  }
+  core::CollisionData worker = f.world.make_data();
+  core::CollisionData caller = f.world.make_data();
+  online::ValidationQueue queue(f.world, {}, worker, caller);
+  constexpr int kRounds = 3;
+  std::vector<std::atomic<int>> calls(motions.size() * kRounds);
+  std::array<std::atomic<int>, 2> by_slot{};
+  std::atomic<int> bad_slot{0};
+  std::vector<std::size_t> jobs;
+  for (int round = 0; round < kRounds; ++round) {
+    for (std::size_t i = 0; i < motions.size(); ++i) {
+      online::Motion frame = motions[i];
+      frame.q.clear();  // only the finish knows the trajectory
+      frame.time.clear();
+      const std::size_t index = jobs.size();
+      jobs.push_back(queue.submit(frame, [&, i, index](std::size_t slot, online::Motion& m) {
+        ++calls[index];
+        if (slot > 1) {
+          ++bad_slot;
+        } else {
+          ++by_slot[slot];
+        }
+        m.q = motions[i].q;
+        m.time = motions[i].time;
+      }));
+    }
+  }
+  const std::size_t failing = queue.submit(motions.front(), [](std::size_t, online::Motion&) {
+    throw std::runtime_error("no memory left");
+  });
+  for (std::size_t i = jobs.size(); i-- > 0;) {
+    EXPECT_EQ(describe(queue.wait(jobs[i])), alone[i % motions.size()]) << "job " << i;
+    EXPECT_EQ(calls[i].load(), 1) << "job " << i;
+  }
+  EXPECT_EQ(bad_slot.load(), 0);
+  EXPECT_EQ(by_slot[0] + by_slot[1], static_cast<int>(jobs.size()));
+  const auto& report = queue.wait(failing);
+  ASSERT_EQ(report.violations.size(), 1u);
+  EXPECT_EQ(report.violations.front().kind, "internal");
+  EXPECT_NE(report.violations.front().detail.find("no memory left"), std::string::npos);
 }

@@ -60,7 +60,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                        {{"motions", 1e3 * plan.times.motions},
                         {"smoothing", 1e3 * plan.times.smoothing},
                         {"validation", 1e3 * plan.times.validation},
-                        {"queued_validation", 1e3 * plan.times.queued_validation}}},
+                        {"queued_validation", 1e3 * plan.times.queued_validation},
+                        {"queued_smoothing", 1e3 * plan.times.queued_smoothing}}},
                       {"attempts", attempts},
                       {"rejected_motions", plan.rejected_motions}};
   if (plan.solved()) {

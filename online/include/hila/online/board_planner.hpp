@@ -76,9 +76,11 @@ struct PlanTimes {
   double motions = 0.0;
   double smoothing = 0.0;
   double validation = 0.0;  // timing and validating, or waiting for the queue's reports
-  // The queue's validation on either thread (BoardPlanSettings::overlap_validation), most of it
-  // alongside the planning: not a part of planning_seconds.
+  // The queue's validation, and its smoothing and timing of the queued steps, on either thread
+  // (BoardPlanSettings::overlap_validation), most of it alongside the planning: not a part of
+  // planning_seconds.
   double queued_validation = 0.0;
+  double queued_smoothing = 0.0;
 };
 
 struct BoardPlan {

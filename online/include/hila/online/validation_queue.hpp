@@ -3,6 +3,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -18,8 +19,17 @@ namespace hila::online {
 // jobs itself meanwhile (with its own CollisionData), so nothing stands idle at the end. A
 // report depends only on its motion (validate_motion poses everything it checks), never on which
 // thread made it or when: plans stay deterministic.
+//
+// A job may first finish its motion (`Finish`: e.g. smooth the found path and time it) on the
+// thread that takes it, so that work leaves the planner's thread as well. The finish gets the
+// thread's slot, 0 on the worker and 1 on the caller, for per-thread state it keeps (the
+// smoother's validity checks): a slot is used by one thread at a time.
 class ValidationQueue {
  public:
+  static constexpr std::size_t kWorkerSlot = 0;
+  static constexpr std::size_t kCallerSlot = 1;
+  using Finish = std::function<void(std::size_t slot, Motion& motion)>;
+
   // `worker_data` is the worker thread's, `caller_data` the waiting caller's: each from
   // World::make_data(), used by nothing else while the queue lives. Without a thread to be had,
   // the caller validates every job when it waits.
@@ -29,20 +39,27 @@ class ValidationQueue {
   ValidationQueue(const ValidationQueue&) = delete;
   ValidationQueue& operator=(const ValidationQueue&) = delete;
 
-  // Queues the motion; the job's number for wait().
-  std::size_t submit(Motion motion);
+  // Queues the motion, to be finished by `finish` (when given) before it is validated; the job's
+  // number for wait(). `finish` must not throw for want of a valid result (an exception is
+  // reported as an "internal" violation).
+  std::size_t submit(Motion motion, Finish finish = {});
   // The job's report once it is done (a reference that stays valid while the queue lives).
   const ValidationReport& wait(std::size_t job);
+  // The motion the job validated, as its finish left it (after wait()).
+  const Motion& motion(std::size_t job) const;
   // Returns once every job is done: neither thread validates until the next submit().
   void drain();
   // The job's report is no longer wanted: it is not validated unless it already started.
   void discard(std::size_t job);
+  // Jobs submitted and not yet started (discarded ones included).
+  std::size_t backlog() const;
   // Seconds spent validating so far, on either thread.
   double seconds() const;
 
  private:
   struct Job {
     Motion motion;
+    Finish finish;
     ValidationReport report;
     bool done = false;
     bool discarded = false;
@@ -51,7 +68,7 @@ class ValidationQueue {
   // Whether a job waits to be started (discarded ones are passed over). Under the lock.
   bool has_next();
   // Validates the first job not yet started; the lock is released meanwhile.
-  void run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data);
+  void run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data, std::size_t slot);
 
   const World& world_;
   ValidatorSettings settings_;
