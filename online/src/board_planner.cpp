@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <tuple>
 
@@ -151,7 +152,7 @@ class Stopwatch {
 class Run {
  public:
   Run(const PlannerModel& model, const BoardPlanSettings& settings, const Scene& scene,
-      const core::PartSpec& part, const db::PartRecord& record,
+      const core::PartSpec& part, const BoardRecords& records,
       std::chrono::steady_clock::time_point deadline,
       std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>>& lazy_prm)
       : model_(model),
@@ -159,8 +160,14 @@ class Run {
         settings_(settings),
         scene_(scene),
         part_(part),
-        record_(record),
+        record_(records.part),
         deadline_(deadline),
+        robot_grasps_(records.robot_grasps),
+        suction_grasps_(records.suction_grasps),
+        handovers_(records.robot_handovers),
+        filters_(records.filters),
+        node_by_id_(records.node_by_id),
+        edges_(records.regrasp_edges),
         world_(cell_, model.product(), scene, part.name),
         suction_(cell_.arms()[static_cast<std::size_t>(world_.stage().suction_arm)]),
         receiving_(cell_.arms()[world_.stage().suction_arm == 0 ? 1u : 0u]),
@@ -179,16 +186,6 @@ class Run {
       queue_.emplace(world_, settings.validator, *validation_data_[0], *validation_data_[1]);
       speculate_ = true;
     }
-    const db::Database& db = model.database();
-    for (const auto& g : db.robot_grasps(record.id)) robot_grasps_[g.id] = g;
-    for (const auto& g : db.suction_grasps(record.id)) suction_grasps_[g.id] = g;
-    for (const auto& h : db.robot_handovers(record.id)) handovers_[h.id] = h;
-    for (const auto& f : db.roadmap_filters(record.id)) {
-      filters_[{f.grasp_kind, f.grasp_id}] = f.edges;
-    }
-    nodes_ = db.regrasp_nodes(record.id);
-    for (const auto& n : nodes_) node_by_id_[n.id] = &n;
-    edges_ = db.regrasp_edges(record.id);
     start_.robot_q = cell_.home_configuration();
     for (const auto& arm : cell_.arms()) {
       const auto it = scene.robot.find(arm.spec.name);
@@ -1159,6 +1156,13 @@ class Run {
   const core::PartSpec& part_;
   const db::PartRecord& record_;
   std::chrono::steady_clock::time_point deadline_;
+  // The board's records (PlannerModel::board_records).
+  const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps_;
+  const std::map<std::int64_t, db::SuctionGraspRecord>& suction_grasps_;
+  const std::map<std::int64_t, db::RobotHandoverRecord>& handovers_;
+  const std::map<std::pair<std::string, std::int64_t>, std::vector<bool>>& filters_;
+  const std::map<std::int64_t, const db::RegraspNodeRecord*>& node_by_id_;
+  const std::vector<db::RegraspEdgeRecord>& edges_;
   World world_;
   const core::Arm& suction_;
   const core::Arm& receiving_;
@@ -1178,14 +1182,6 @@ class Run {
   Eigen::Vector3d opening_tcp_;
   Eigen::Vector3d approach_tcp_;
   ArmsState start_;
-
-  std::map<std::int64_t, db::RobotGraspRecord> robot_grasps_;
-  std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps_;
-  std::map<std::int64_t, db::RobotHandoverRecord> handovers_;
-  std::map<std::pair<std::string, std::int64_t>, std::vector<bool>> filters_;
-  std::vector<db::RegraspNodeRecord> nodes_;
-  std::map<std::int64_t, const db::RegraspNodeRecord*> node_by_id_;
-  std::vector<db::RegraspEdgeRecord> edges_;
 
   PlanTimes times_;
   std::optional<Stage> tool_;
@@ -1221,7 +1217,6 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return result;
   };
-  const db::Database& db = model_.database();
   const core::PartSpec* part = nullptr;
   for (const auto& p : model_.product().parts) {
     if (p.name == board) part = &p;
@@ -1230,28 +1225,23 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (scene.is_finished(board)) {
     return finish(BoardPlanStatus::kNoGoal, "'" + board + "' is already finished in the scene");
   }
-  const db::PartRecord* record = nullptr;
-  for (const auto& p : db.parts()) {
-    if (p.name == board) record = &p;
-  }
-  if (record == nullptr) {
+  const BoardRecords* records = model_.board_records(board);
+  if (records == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
-  std::vector<db::HandoverCandidateRecord> goals = db.handover_goals(record->id);
-  std::sort(goals.begin(), goals.end(),
-            [](const auto& a, const auto& b) { return a.rank < b.rank; });
-  if (goals.size() > static_cast<std::size_t>(std::max(0, settings_.goals))) {
-    goals.resize(static_cast<std::size_t>(std::max(0, settings_.goals)));
-  }
+  // The first goals in Eq. 8 order.
+  const std::size_t goal_count =
+      std::min(records->goals.size(), static_cast<std::size_t>(std::max(0, settings_.goals)));
+  const auto goals = std::span(records->goals).first(goal_count);
   bool any_connected_offline = false;
   // Every goal in order under `settings`; true when one is planned (result filled in).
-  Run run(model_, settings_, scene, *part, *record, deadline, lazy_prm_);
+  Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
   running = &run;
   auto try_goals = [&](const std::string& round) {
     for (const auto& goal : goals) {
       // The shared grasps the offline regrasp graph connected for this goal first: their
       // stored paths and IK branches are what the motions re-validate.
-      std::vector<db::SharedGraspRecord> shared = db.shared_grasps(goal.id);
+      std::vector<db::SharedGraspRecord> shared = records->shared_grasps.at(goal.id);
       const auto connected =
           std::stable_partition(shared.begin(), shared.end(),
                                 [&](const auto& s) { return run.connected_offline(goal, s); });

@@ -35,6 +35,26 @@ PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::Product
     }
     roadmaps_[arm.spec.name] = std::make_unique<ArmRoadmap>(*record);
   }
+  for (const auto& part : database_.parts()) {
+    auto& b = *(boards_[part.name] = std::make_unique<BoardRecords>());
+    b.part = part;
+    b.goals = database_.handover_goals(part.id);
+    for (const auto& goal : b.goals) b.shared_grasps[goal.id] = database_.shared_grasps(goal.id);
+    for (auto& g : database_.robot_grasps(part.id)) b.robot_grasps[g.id] = std::move(g);
+    for (auto& g : database_.suction_grasps(part.id)) b.suction_grasps[g.id] = std::move(g);
+    for (auto& h : database_.robot_handovers(part.id)) b.robot_handovers[h.id] = std::move(h);
+    for (auto& f : database_.roadmap_filters(part.id)) {
+      b.filters[{f.grasp_kind, f.grasp_id}] = std::move(f.edges);
+    }
+    b.regrasp_nodes = database_.regrasp_nodes(part.id);
+    for (const auto& n : b.regrasp_nodes) b.node_by_id[n.id] = &n;
+    b.regrasp_edges = database_.regrasp_edges(part.id);
+  }
+}
+
+const BoardRecords* PlannerModel::board_records(const std::string& board) const {
+  const auto it = boards_.find(board);
+  return it == boards_.end() ? nullptr : it->second.get();
 }
 
 const ArmRoadmap& PlannerModel::roadmap(const std::string& arm) const {

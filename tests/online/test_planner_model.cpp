@@ -47,6 +47,37 @@ TEST(PlannerModel, LoadsItsDatabaseAndRefusesOnesBuiltFromOtherInputs) {
     EXPECT_GT(roadmap.graph.edge_count(), 0) << arm.spec.name;
   }
   test::expect_input_error([&] { model->roadmap("middle"); }, {database, "'middle'"});
+  // Each board's records, indexed at load, are the database's for that board.
+  const db::Database& db = model->database();
+  EXPECT_EQ(model->board_records("drawer"), nullptr);
+  for (const auto& part : db.parts()) {
+    SCOPED_TRACE(part.name);
+    const online::BoardRecords* b = model->board_records(part.name);
+    ASSERT_NE(b, nullptr);
+    EXPECT_EQ(b->part.id, part.id);
+    const auto goals = db.handover_goals(part.id);
+    ASSERT_EQ(b->goals.size(), goals.size());
+    for (std::size_t i = 0; i < goals.size(); ++i) {
+      EXPECT_EQ(b->goals[i].id, goals[i].id);
+      EXPECT_EQ(b->shared_grasps.at(goals[i].id).size(), db.shared_grasps(goals[i].id).size());
+    }
+    for (std::size_t i = 1; i < b->goals.size(); ++i) {
+      EXPECT_LE(b->goals[i - 1].rank, b->goals[i].rank);
+    }
+    EXPECT_EQ(b->robot_grasps.size(), db.robot_grasps(part.id).size());
+    for (const auto& g : db.robot_grasps(part.id)) {
+      EXPECT_EQ(b->robot_grasps.at(g.id).theta_c_deg, g.theta_c_deg);
+    }
+    EXPECT_EQ(b->suction_grasps.size(), db.suction_grasps(part.id).size());
+    EXPECT_EQ(b->robot_handovers.size(), db.robot_handovers(part.id).size());
+    const auto filters = db.roadmap_filters(part.id);
+    EXPECT_EQ(b->filters.size(), filters.size());
+    for (const auto& f : filters) EXPECT_EQ(b->filters.at({f.grasp_kind, f.grasp_id}), f.edges);
+    const auto nodes = db.regrasp_nodes(part.id);
+    ASSERT_EQ(b->regrasp_nodes.size(), nodes.size());
+    for (const auto& n : nodes) EXPECT_EQ(b->node_by_id.at(n.id)->id, n.id);
+    EXPECT_EQ(b->regrasp_edges.size(), db.regrasp_edges(part.id).size());
+  }
 
   // The product file changed since the build (one comment added): refused, with the fix.
   const std::string cabinet =

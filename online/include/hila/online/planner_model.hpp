@@ -1,8 +1,11 @@
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "hila/core/cell.hpp"
 #include "hila/core/product.hpp"
@@ -10,6 +13,21 @@
 #include "hila/online/arm_motion.hpp"
 
 namespace hila::online {
+
+// One board's database records as the planner reads them, indexed once when the model is loaded
+// (a query copies none of them).
+struct BoardRecords {
+  db::PartRecord part;
+  std::vector<db::HandoverCandidateRecord> goals;  // Eq. 8 order: by rank (then id)
+  std::map<std::int64_t, std::vector<db::SharedGraspRecord>> shared_grasps;  // by goal, id order
+  std::map<std::int64_t, db::RobotGraspRecord> robot_grasps;
+  std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps;
+  std::map<std::int64_t, db::RobotHandoverRecord> robot_handovers;
+  std::map<std::pair<std::string, std::int64_t>, std::vector<bool>> filters;  // by grasp kind, id
+  std::vector<db::RegraspNodeRecord> regrasp_nodes;
+  std::map<std::int64_t, const db::RegraspNodeRecord*> node_by_id;  // into regrasp_nodes
+  std::vector<db::RegraspEdgeRecord> regrasp_edges;
+};
 
 // Everything the online planner reads, loaded once: the cell, the product and the database
 // built from exactly these files (refused otherwise), with each arm's roadmap ready to search.
@@ -29,6 +47,8 @@ class PlannerModel {
   const db::Database& database() const { return database_; }
   // Throws core::InputError naming the database for an arm without a roadmap.
   const ArmRoadmap& roadmap(const std::string& arm) const;
+  // The board's records; nullptr when the database has no such board.
+  const BoardRecords* board_records(const std::string& board) const;
 
  private:
   PlannerModel(std::shared_ptr<const core::Cell> cell, core::ProductSpec product,
@@ -38,6 +58,7 @@ class PlannerModel {
   core::ProductSpec product_;
   db::Database database_;
   std::map<std::string, std::unique_ptr<ArmRoadmap>> roadmaps_;
+  std::map<std::string, std::unique_ptr<BoardRecords>> boards_;  // in place: node_by_id points in
 };
 
 }  // namespace hila::online
