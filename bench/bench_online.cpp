@@ -48,7 +48,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_online [--db FILE] [--scene FILE] [--variations N] [--boards a,b]\n"
     "                    [--deadline S] [--planners hila,rrt_connect,lazy_prm] [--seed N]\n"
-    "                    [--overlap-validation yes|no] [--json FILE]\n"
+    "                    [--overlap-validation yes|no] [--held-resolution RAD] [--json FILE]\n"
     "  --db          the cabinet database (default: $HILA_BENCH_DATABASE, else\n"
     "                out/cabinet.hila)\n"
     "  --scene       the nominal scene (default: meshes/cabinet/scene.yaml)\n"
@@ -60,6 +60,9 @@ constexpr const char* kUsage =
     "  --overlap-validation\n"
     "                validate each motion on a second thread while the next is planned\n"
     "                (BoardPlanSettings::overlap_validation, default yes)\n"
+    "  --held-resolution\n"
+    "                rad between the checked samples of a held board's motions, for every\n"
+    "                planner (MotionSettings::held_resolution, default 0.04)\n"
     "  --json        also write every problem's figures to FILE\n";
 
 constexpr const char* kBuildHint =
@@ -73,6 +76,7 @@ struct Options {
   int variations = 20;
   std::vector<std::string> boards;
   double deadline = 10.0;
+  double held_resolution = online::MotionSettings{}.held_resolution;
   std::vector<online::MotionPlannerKind> planners = {online::MotionPlannerKind::kRoadmap,
                                                      online::MotionPlannerKind::kRrtConnect,
                                                      online::MotionPlannerKind::kLazyPrm};
@@ -120,6 +124,11 @@ Options parse(int argc, char** argv) {
         if (opt.variations < 1) usage_error("--variations: expected at least 1, got " + value);
       } else if (arg == "--boards") {
         opt.boards = split_list(value);
+      } else if (arg == "--held-resolution") {
+        opt.held_resolution = std::stod(value);
+        if (!(opt.held_resolution > 0.0 && opt.held_resolution <= 0.05)) {
+          usage_error("--held-resolution: expected rad in (0, 0.05], got " + value);
+        }
       } else if (arg == "--deadline") {
         opt.deadline = std::stod(value);
         if (!(opt.deadline > 0.0)) usage_error("--deadline: expected seconds > 0, got " + value);
@@ -394,6 +403,7 @@ int main(int argc, char** argv) {
     online::BoardPlanSettings s;
     s.motion.planner = kind;
     s.overlap_validation = opt.overlap_validation;
+    s.motion.held_resolution = opt.held_resolution;
     settings.push_back(s);
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
     names.emplace_back(online::to_string(kind));
@@ -443,7 +453,8 @@ int main(int argc, char** argv) {
   std::vector<Summary> summary;
   for (std::size_t k = 0; k < planners.size(); ++k) summary.push_back(summarise(problems, k));
   std::cout << "## bench_online: " << boards.size() << " boards x " << opt.variations
-            << " variations, deadline " << fixed(opt.deadline, 1) << " s per board, "
+            << " variations, deadline " << fixed(opt.deadline, 1) << " s per board, held-board "
+            << "checks every " << fixed(opt.held_resolution, 3) << " rad, "
             << std::thread::hardware_concurrency() << " hardware threads, wall "
             << fixed(wall / 60.0, 1) << " min\n\n"
             << "Plan times are full-board BoardPlan::planning_seconds over the solved problems; "
@@ -572,6 +583,7 @@ int main(int argc, char** argv) {
                           {"variations", opt.variations},
                           {"deadline_s", opt.deadline},
                           {"seed", opt.seed},
+                          {"held_resolution", opt.held_resolution},
                           {"overlap_validation", opt.overlap_validation},
                           {"hardware_threads", std::thread::hardware_concurrency()},
                           {"wall_s", wall},
