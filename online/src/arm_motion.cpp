@@ -442,18 +442,6 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd&
   return out;
 }
 
-// An end wedged where no straight segment reaches a roadmap node (a held board out where the
-// slip-filtered roadmap does not go, say) enters it where a stored path that held leads: `via`
-// becomes the start and the stored path's valid beginning, or its valid end and the goal.
-std::vector<core::GraphEndpoint> ArmMotionPlanner::attach_end(const Hints& hints,
-                                                              const Eigen::VectorXd& q,
-                                                              bool is_start,
-                                                              std::vector<Eigen::VectorXd>& via) {
-  auto out = attach(q, true);
-  if (!out.empty()) return out;
-  return attach_along_stored(hints, q, is_start, via);
-}
-
 std::vector<core::GraphEndpoint> ArmMotionPlanner::attach_along_stored(
     const Hints& hints, const Eigen::VectorXd& q, bool is_start,
     std::vector<Eigen::VectorXd>& via) {
@@ -466,6 +454,7 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach_along_stored(
 }
 
 MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
+  assert(!request.late_hints || !request.follow_hints);  // late paths only lead wedged ends in
   const auto started = std::chrono::steady_clock::now();
   MotionResult r;
   auto finish = [&](MotionStatus status, std::string reason) {
@@ -557,13 +546,30 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   bool exits_checked = false;
   std::vector<core::GraphEndpoint> entries;
   std::vector<core::GraphEndpoint> exits;
+  // The stored paths that lead a wedged end in: the request's, or its late ones, fetched once.
+  Hints fetched;
+  bool was_fetched = false;
+  const auto hints = [&]() -> const Hints& {
+    if (!request.late_hints) return request.hints;
+    if (!was_fetched) {
+      fetched = request.late_hints();
+      was_fetched = true;
+    }
+    return fetched;
+  };
+  // An end wedged where no straight segment reaches a roadmap node (a held board out where the
+  // slip-filtered roadmap does not go, say) enters it where a stored path that held leads: the
+  // lead becomes the start and the stored path's valid beginning, the tail its valid end and
+  // the goal.
   const auto check_entries = [&] {
     entries_checked = true;
-    entries = attach_end(request.hints, request.start, true, lead);
+    entries = attach(request.start, true);
+    if (entries.empty()) entries = attach_along_stored(hints(), request.start, true, lead);
   };
   const auto check_exits = [&] {
     exits_checked = true;
-    exits = attach_end(request.hints, request.goal, false, tail);
+    exits = attach(request.goal, true);
+    if (exits.empty()) exits = attach_along_stored(hints(), request.goal, false, tail);
   };
   // A start in contact leaves straight up first (its lift is the request's goal, in practice):
   // the roadmap is entered from the goal side only when the direct segment failed.
@@ -643,13 +649,14 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   // beginning (or end) leads into another part of it (the way the arm came, say), the search
   // starts there before any bridge. The moved end's joins are checked; the other's stay as
   // they were.
-  if (!entries.empty() && !exits.empty() && !request.hints.empty() && !late()) {
+  if (!entries.empty() && !exits.empty() && (request.late_hints || !request.hints.empty()) &&
+      !late()) {
     const auto reenter = [&](const Eigen::VectorXd& q, bool is_start,
                              std::vector<Eigen::VectorXd>& along,
                              std::vector<core::GraphEndpoint>& ends, bool& checked) {
       if (along.size() != 1) return false;  // already along a stored path
       std::vector<Eigen::VectorXd> via;
-      auto e = attach_along_stored(request.hints, q, is_start, via);
+      auto e = attach_along_stored(hints(), q, is_start, via);
       if (e.empty()) return false;
       along = std::move(via);
       ends = std::move(e);

@@ -126,9 +126,8 @@ struct Stage {
 
 using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
 
-// The steps whose paths, reversed, lead the receiving arm home after the release (Run::leave):
-// needed before a queued step's smoothing would be in, so they are smoothed on the planner's
-// thread.
+// The steps whose paths, reversed, lead the receiving arm home after the release (Run::leave),
+// where its retreat attaches to no roadmap node.
 constexpr std::array<std::string_view, 3> kWayBackSteps = {"transfer_to_human", "receiving_grasp",
                                                            "receiving_approach"};
 
@@ -390,9 +389,7 @@ class Run {
     TimedPath timed;
     // While the other thread is behind, a queued step is smoothed here (the same result
     // either way: the plan does not depend on which thread smoothed).
-    const bool smooth_here =
-        !speculate_ || queue_->backlog() > 0 ||
-        std::find(kWayBackSteps.begin(), kWayBackSteps.end(), name) != kWayBackSteps.end();
+    const bool smooth_here = !speculate_ || queue_->backlog() > 0;
     if (smooth_here && smooths(path, request)) {
       const Stopwatch watch(times_.smoothing);
       s.smoothed = smoothed(planner, path);
@@ -402,6 +399,7 @@ class Run {
       // are planned; until settle() reads the report, the step stands for its ends.
       MotionRequest checked = request;
       checked.hints.clear();
+      checked.late_hints = nullptr;  // refers to the caller's frame
       auto finished = std::make_shared<FinishedPath>();
       const bool smooth = !smooth_here && smooths(path, request);
       auto finish = [this, finished, &arm, checked = std::move(checked), found = path, smooth,
@@ -427,6 +425,7 @@ class Run {
                            std::move(motion),
                            finished};
       pending.request.hints.clear();
+      pending.request.late_hints = nullptr;
       s.via = pending.found.via;
       timed.time = {0.0, 0.0};
       timed.q = {path.front(), path.back()};
@@ -485,6 +484,17 @@ class Run {
                                                   arm.spec.name, motion);
     }
     return *checks;
+  }
+
+  // The stage's step `i` as executed: for a queued step, once its smoothing is in (waited for).
+  const std::vector<Eigen::VectorXd>& executed_path(const Stage& st, std::size_t i) {
+    for (const PendingCheck& p : st.pending) {
+      if (p.step != i) continue;
+      const Stopwatch watch(times_.validation);
+      queue_->wait(p.job);
+      return p.finished->path;
+    }
+    return st.paths[i];
   }
 
   // The step's path, timing and length as `path`, timed: the stage's later steps move by the
@@ -1120,12 +1130,16 @@ class Run {
     // that leads into the roadmap: from beside the human's hands a straight segment often
     // reaches no roadmap node, while the arm's own way in, now empty-handed, is clear for a
     // while.
+    // Asked for only where the retreat attaches to no roadmap node (late_hints): a queued
+    // step's smoothing is then waited for, not done on this thread for every board.
     std::vector<Eigen::VectorXd> way_back;
-    // As executed (resampled as timed): these steps were smoothed here (kWayBackSteps).
+    const Stage& presented = present(rr, grasp, goal);
+    const Stage& received = receive(rr, grasp);
+    // As executed (resampled as timed).
     const auto add_reversed = [&](const Stage& from, std::string_view name) {
       for (std::size_t i = 0; i < from.steps.size(); ++i) {
         if (from.steps[i].name != name) continue;
-        const auto came = resample_path(from.paths[i], settings_.timing_step);
+        const auto came = resample_path(executed_path(from, i), settings_.timing_step);
         for (auto q = came.rbegin(); q != came.rend(); ++q) {
           if (way_back.empty() || (*q - way_back.back()).norm() >= settings_.way_back_spacing) {
             way_back.push_back(*q);
@@ -1134,11 +1148,14 @@ class Run {
       }
     };
     if (settings_.way_back_spacing > 0.0) {
-      add_reversed(present(rr, grasp, goal), kWayBackSteps[0]);
-      add_reversed(receive(rr, grasp), kWayBackSteps[1]);
-      add_reversed(receive(rr, grasp), kWayBackSteps[2]);
+      release.late_hints = [&]() -> Hints {
+        way_back.clear();  // asked again by a re-plan of the same step
+        add_reversed(presented, kWayBackSteps[0]);
+        add_reversed(received, kWayBackSteps[1]);
+        add_reversed(received, kWayBackSteps[2]);
+        return way_back.size() > 1 ? Hints{&way_back} : Hints{};
+      };
     }
-    if (way_back.size() > 1) release.hints = {&way_back};
     // Only where the retreat attaches to no roadmap node: mostly the roadmap's way is shorter.
     release.follow_hints = false;
     // The board is the human's now; it no longer stands where the arm goes home.

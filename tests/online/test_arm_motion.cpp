@@ -434,6 +434,31 @@ TEST(ArmMotion, AWedgedStartEntersTheRoadmapAlongAStoredPath) {
     const auto report =
         online::validate_motion(world, data, timed(led.path, cabinet().part("top").initial));
     EXPECT_TRUE(report.valid()) << describe(report);
+
+    // The same stored path given late (MotionRequest::late_hints): fetched once, when the
+    // start is found wedged, and the same path; a motion whose ends attach never asks for it.
+    online::MotionRequest late = request(a, b);
+    late.allow_bridge = false;
+    late.follow_hints = false;
+    int asked = 0;
+    late.late_hints = [&] {
+      ++asked;
+      return std::vector<const std::vector<Eigen::VectorXd>*>{&stored};
+    };
+    const auto led_late = cut.plan(late);
+    ASSERT_TRUE(led_late.solved()) << led_late.reason;
+    EXPECT_EQ(asked, 1);
+    EXPECT_EQ(led_late.via, led.via);
+    ASSERT_EQ(led_late.path.size(), led.path.size());
+    for (std::size_t k = 0; k < led.path.size(); ++k) {
+      EXPECT_TRUE(led_late.path[k].isApprox(led.path[k], 0.0)) << k;
+    }
+    online::MotionRequest attached = request(a, b);
+    attached.follow_hints = false;
+    attached.late_hints = late.late_hints;
+    asked = 0;
+    EXPECT_TRUE(planner.plan(attached).solved());
+    EXPECT_EQ(asked, 0) << "both ends attach to the whole roadmap";
     return;
   }
   FAIL() << "no far node pair gave a roadmap path of four waypoints with a wedged start";

@@ -58,6 +58,11 @@ struct MotionRequest {
   // Whether the hints are followed whole before the roadmap is searched; false keeps them for
   // leading a wedged end into the roadmap only (a hint that seldom holds whole).
   bool follow_hints = true;
+  // Stored paths known only when asked for (the way an arm came, while that motion's smoothing
+  // is still queued): fetched once, the first time a wedged end needs a way into the roadmap,
+  // and used there as `hints` are with follow_hints false (set when this is). Must stay callable
+  // while plan() runs.
+  std::function<std::vector<const std::vector<Eigen::VectorXd>*>()> late_hints;
   bool allow_bridge = true;  // false: roadmap (and stored paths) only, e.g. for a staging try
   // Every segment at MotionSettings::fine_resolution (the validator's): a retry after the
   // validator found a thin collision between the planner's coarser samples.
@@ -208,10 +213,6 @@ class ArmMotionPlanner {
   // The nearest valid roadmap nodes (MotionSettings::attachments of the attach_neighbours
   // nearest), with `check_joins` only those the straight segment from q reaches.
   std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q, bool check_joins);
-  // attach() with checked joins for the start (`is_start`) or the goal, along a stored path
-  // (`via`) where no join holds.
-  std::vector<core::GraphEndpoint> attach_end(const Hints& hints, const Eigen::VectorXd& q,
-                                              bool is_start, std::vector<Eigen::VectorXd>& via);
   // The roadmap entered (checked joins) where a stored path's longest valid beginning from q
   // (`is_start`), or end into q, takes the arm: `via` becomes that stretch. Empty when none.
   std::vector<core::GraphEndpoint> attach_along_stored(const Hints& hints, const Eigen::VectorXd& q,
