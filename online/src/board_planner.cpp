@@ -487,12 +487,20 @@ class Run {
   }
 
   // The stage's step `i` as executed: for a queued step, once its smoothing is in (waited for).
+  // Asked for while a motion is planned (MotionRequest::late_hints): the wait is counted as
+  // validation, not as the motion's planning.
   const std::vector<Eigen::VectorXd>& executed_path(const Stage& st, std::size_t i) {
     for (const PendingCheck& p : st.pending) {
       if (p.step != i) continue;
-      const Stopwatch watch(times_.validation);
-      queue_->wait(p.job);
-      return p.finished->path;
+      double waited = 0.0;
+      {
+        const Stopwatch watch(waited);
+        queue_->wait(p.job);
+      }
+      times_.validation += waited;
+      times_.motions -= waited;
+      if (!p.finished->path.empty()) return p.finished->path;
+      break;  // a discarded job never finished: as found
     }
     return st.paths[i];
   }

@@ -51,12 +51,6 @@ const ValidationReport& ValidationQueue::wait(std::size_t job) {
   return jobs_[job].report;
 }
 
-const Motion& ValidationQueue::motion(std::size_t job) const {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  assert(job < jobs_.size() && jobs_[job].done);
-  return jobs_[job].motion;
-}
-
 void ValidationQueue::drain() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {

@@ -45,8 +45,6 @@ class ValidationQueue {
   std::size_t submit(Motion motion, Finish finish = {});
   // The job's report once it is done (a reference that stays valid while the queue lives).
   const ValidationReport& wait(std::size_t job);
-  // The motion the job validated, as its finish left it (after wait()).
-  const Motion& motion(std::size_t job) const;
   // Returns once every job is done: neither thread validates until the next submit().
   void drain();
   // The job's report is no longer wanted: it is not validated unless it already started.
