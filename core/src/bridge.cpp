@@ -83,7 +83,8 @@ std::vector<Eigen::VectorXd> plan_bridge_to_any(
     low = low.cwiseMin(*t);
     high = high.cwiseMax(*t);
   }
-  const auto space = detail::joint_space(arm, settings.joint_range, settings.seed, &low, &high);
+  const auto space =
+      detail::joint_space(arm, settings.joint_range, settings.seed, &low, &high, settings.project);
   auto si = std::make_shared<ob::SpaceInformation>(space);
   long checks = 0;
   si->setStateValidityChecker([&](const ob::State* s) {

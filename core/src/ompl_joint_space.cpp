@@ -8,10 +8,35 @@ namespace ob = ompl::base;
 
 namespace hila::core::detail {
 
-SeededSampler::SeededSampler(const ob::StateSpace* space, std::uint64_t seed)
-    : ob::StateSampler(space), rng_(seed) {}
+SeededSampler::SeededSampler(const ob::StateSpace* space, std::uint64_t seed, Projection project)
+    : ob::StateSampler(space), rng_(seed), project_(std::move(project)) {}
 
 void SeededSampler::sampleUniform(ob::State* state) {
+  if (!project_) {
+    draw(state);
+    return;
+  }
+  const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
+  auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+  const auto dof = static_cast<Eigen::Index>(bounds.low.size());
+  scratch_.resize(dof);
+  constexpr int kTries = 8;
+  for (int t = 0; t < kTries; ++t) {
+    draw(state);
+    for (Eigen::Index i = 0; i < dof; ++i) scratch_[i] = v->values[i];
+    if (!project_(scratch_)) continue;
+    bool inside = true;
+    for (Eigen::Index i = 0; i < dof && inside; ++i) {
+      inside = scratch_[i] >= bounds.low[static_cast<std::size_t>(i)] &&
+               scratch_[i] <= bounds.high[static_cast<std::size_t>(i)];
+    }
+    if (!inside) continue;
+    for (Eigen::Index i = 0; i < dof; ++i) v->values[i] = scratch_[i];
+    return;
+  }
+}
+
+void SeededSampler::draw(ob::State* state) {
   const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
   auto* v = state->as<ob::RealVectorStateSpace::StateType>();
   for (std::size_t i = 0; i < bounds.low.size(); ++i) {
@@ -36,7 +61,8 @@ void SeededSampler::sampleGaussian(ob::State* state, const ob::State* mean, doub
 std::shared_ptr<ob::RealVectorStateSpace> joint_space(const Arm& arm, double joint_range,
                                                       std::uint64_t seed,
                                                       const Eigen::VectorXd* include_a,
-                                                      const Eigen::VectorXd* include_b) {
+                                                      const Eigen::VectorXd* include_b,
+                                                      SeededSampler::Projection project) {
   const int dof = arm.chain.dof();
   auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
   ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
@@ -53,8 +79,9 @@ std::shared_ptr<ob::RealVectorStateSpace> joint_space(const Arm& arm, double joi
     bounds.setHigh(static_cast<unsigned>(i), high);
   }
   space->setBounds(bounds);
-  space->setStateSamplerAllocator(
-      [seed](const ob::StateSpace* s) { return std::make_shared<SeededSampler>(s, seed); });
+  space->setStateSamplerAllocator([seed, project = std::move(project)](const ob::StateSpace* s) {
+    return std::make_shared<SeededSampler>(s, seed, project);
+  });
   return space;
 }
 

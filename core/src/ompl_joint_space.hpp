@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <random>
 
@@ -19,7 +20,11 @@ namespace hila::core::detail {
 // seed, which would make plans depend on what ran before).
 class SeededSampler : public ompl::base::StateSampler {
  public:
-  SeededSampler(const ompl::base::StateSpace* space, std::uint64_t seed);
+  // `project` (optional) moves each uniform sample onto a constraint, or rejects it (false):
+  // the sample is then drawn again, a few times at most (the last one is kept as drawn).
+  using Projection = std::function<bool(Eigen::VectorXd&)>;
+  SeededSampler(const ompl::base::StateSpace* space, std::uint64_t seed,
+                Projection project = nullptr);
   void sampleUniform(ompl::base::State* state) override;
   void sampleUniformNear(ompl::base::State* state, const ompl::base::State* near,
                          double distance) override;
@@ -28,14 +33,17 @@ class SeededSampler : public ompl::base::StateSampler {
 
  private:
   double uniform() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
+  void draw(ompl::base::State* state);
   std::mt19937_64 rng_;
+  Projection project_;
+  Eigen::VectorXd scratch_;
 };
 
 // The arm's joints in core::joint_box(arm, joint_range), widened to include
-// `include_a` and `include_b` (valid ends, hence within the limits) when given.
-std::shared_ptr<ompl::base::RealVectorStateSpace> joint_space(const Arm& arm, double joint_range,
-                                                              std::uint64_t seed,
-                                                              const Eigen::VectorXd* include_a,
-                                                              const Eigen::VectorXd* include_b);
+// `include_a` and `include_b` (valid ends, hence within the limits) when given; its uniform
+// samples go through `project` when given (SeededSampler).
+std::shared_ptr<ompl::base::RealVectorStateSpace> joint_space(
+    const Arm& arm, double joint_range, std::uint64_t seed, const Eigen::VectorXd* include_a,
+    const Eigen::VectorXd* include_b, SeededSampler::Projection project = nullptr);
 
 }  // namespace hila::core::detail

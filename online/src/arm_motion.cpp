@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "hila/core/bridge.hpp"
+#include "hila/core/slip_projection.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 
@@ -144,6 +145,21 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
   checked_ = 0;
   invalidated_ = 0;
   blocked_segments_.clear();
+}
+
+core::BridgeSettings ArmMotionPlanner::bridge_settings(
+    long checks, std::chrono::steady_clock::time_point deadline) const {
+  core::BridgeSettings bridge;
+  bridge.max_checks = checks;
+  bridge.resolution = resolution_;
+  bridge.seed = settings_.seed;
+  bridge.deadline = deadline;
+  if (settings_.project_slip && held_.held && held_.theta_c_deg < 90.0) {
+    const core::SlipProjection slip(arm_, base_, held_.axis_tcp, held_.lever_tcp,
+                                    held_.theta_c_deg);
+    if (slip.active()) bridge.project = slip;
+  }
+  return bridge;
 }
 
 bool ArmMotionPlanner::valid(const Eigen::VectorXd& q) {
@@ -309,11 +325,7 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(
         index.push_back(k);
       }
     }
-    core::BridgeSettings bridge;
-    bridge.max_checks = repair_checks;
-    bridge.resolution = resolution_;
-    bridge.seed = settings_.seed;
-    bridge.deadline = deadline;
+    const core::BridgeSettings bridge = bridge_settings(repair_checks, deadline);
     const auto around = core::plan_bridge_to_any(arm_, valid_here, at(i), targets, bridge);
     if (around.empty()) return {};
     path.insert(path.end(), around.begin() + 1, around.end());
@@ -693,11 +705,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     }
   }
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
-  core::BridgeSettings bridge;
-  bridge.max_checks = settings_.bridge_checks;
-  bridge.resolution = resolution_;
-  bridge.seed = settings_.seed;
-  bridge.deadline = request.deadline;
+  const core::BridgeSettings bridge = bridge_settings(settings_.bridge_checks, request.deadline);
   r.path = core::plan_bridge(arm_, valid_here, request.start, request.goal, bridge);
   if (!r.path.empty()) {
     r.via = "bridge";

@@ -23,6 +23,10 @@ struct BridgeSettings {
   double joint_range = 3.14159265358979323846;
   // Online queries also stop at a deadline (the check budget keeps offline builds deterministic).
   std::optional<std::chrono::steady_clock::time_point> deadline;
+  // Moves a uniform sample onto a constraint the valid states keep (a held board's slip limit,
+  // SlipProjection), or rejects it: in a thin constrained set nearly every uniform sample is
+  // invalid, and RRT-Connect by rejection alone spends its budget there. Optional.
+  std::function<bool(Eigen::VectorXd&)> project;
 };
 
 // A path from `from` to `to` where every state satisfies `valid`, for where a filtered roadmap

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hila/core/arm_poser.hpp"
+#include "hila/core/bridge.hpp"
 #include "hila/core/collision.hpp"
 #include "hila/core/lazy_prm.hpp"
 #include "hila/core/roadmap_graph.hpp"
@@ -147,6 +148,9 @@ struct MotionSettings {
   // A board whose every goal failed within bridge_checks is tried once more, time permitting,
   // with bridges this large (the baselines' from-scratch budget).
   long escalated_bridge_checks = 200000;
+  // A held board's bridges sample on its slip limit (core::SlipProjection) rather than by
+  // rejection alone (the baselines keep rejection, as the issue specifies).
+  bool project_slip = true;
   long baseline_checks = 200000;  // the baselines' budget per motion (and the deadline)
   int join_waypoints = 4;         // a stored path's first / last waypoints tried for the joins
   long shortcut_checks = 1500;    // validity checks spent shortening a found path
@@ -188,6 +192,10 @@ class ArmMotionPlanner {
 
  private:
   enum class Verdict { kValid, kOutsideLimits, kSlips, kCollides };
+  // A bridge's settings for the current request: its budget, the resolution, and for a held
+  // board under a slip limit, samples projected onto it (core::SlipProjection).
+  core::BridgeSettings bridge_settings(long checks,
+                                       std::chrono::steady_clock::time_point deadline) const;
   Verdict check(const Eigen::VectorXd& q, core::CollisionPair* pair);
   // A roadmap node's verdict (kept); a blocked node's edges are all blocked with it.
   bool node_valid(int node);
