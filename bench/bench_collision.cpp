@@ -5,6 +5,7 @@
 // --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <random>
 
 #include "hila/core/arm_poser.hpp"
@@ -89,6 +90,30 @@ void BM_ArmPoserCheckFree(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ArmPoserCheckFree);
+
+// The same along straight joint-space segments between those configurations at 0.01 rad, the
+// way the validator and a segment check walk a motion: consecutive samples close together.
+void BM_ArmPoserCheckAlongPath(benchmark::State& state) {
+  const auto& p = problem();
+  core::CollisionData data(p.scene.model);
+  core::set_cell_state(*p.cell, p.scene, data, p.cell->home_configuration(),
+                       p.cell->human_neutral());
+  core::ArmPoser poser(*p.cell, p.scene, p.cell->arm("left"));
+  poser.pose_robot(data, p.cell->home_configuration());
+  std::vector<Eigen::VectorXd> samples;
+  for (std::size_t k = 1; k < 64; ++k) {
+    const Eigen::VectorXd& a = p.free_configs[k - 1];
+    const Eigen::VectorXd& b = p.free_configs[k];
+    const int steps = static_cast<int>(std::ceil((b - a).norm() / 0.01));
+    for (int s = 0; s < steps; ++s) samples.push_back(a + (b - a) * (double(s) / steps));
+  }
+  std::size_t i = 0;
+  for (auto _ : state) {
+    poser.pose_arm(data, samples[i++ % samples.size()]);
+    benchmark::DoNotOptimize(arm_query(data));
+  }
+}
+BENCHMARK(BM_ArmPoserCheckAlongPath);
 
 // Every pair in the scene (both arms, human static) through the broad-phase trees.
 void BM_WholeSceneCheckFree(benchmark::State& state) {

@@ -6,6 +6,43 @@
 
 namespace hila::core {
 
+// Whether `axis` separates p and q, computing only the relative rotation's entries that axis
+// reads (3 or 4 of 9): the cached axis usually separates, and then the rest is never needed.
+inline bool axis_separates(const fcl::OBBd& p, const fcl::OBBd& q, const Eigen::Vector3d& t,
+                           int axis) {
+  const auto r = [&](int i, int j) { return p.axis.col(i).dot(q.axis.col(j)); };
+  const Eigen::Vector3d& a = p.extent;
+  const Eigen::Vector3d& b = q.extent;
+  if (axis < 3) {
+    const double r0 = r(axis, 0);
+    const double r1 = r(axis, 1);
+    const double r2 = r(axis, 2);
+    return std::abs(t[axis]) > a[axis] + (std::abs(r0) + 1e-6) * b[0] +
+                                   (std::abs(r1) + 1e-6) * b[1] + (std::abs(r2) + 1e-6) * b[2];
+  }
+  if (axis < 6) {
+    const int j = axis - 3;
+    const double r0 = r(0, j);
+    const double r1 = r(1, j);
+    const double r2 = r(2, j);
+    return std::abs(r0 * t[0] + r1 * t[1] + r2 * t[2]) > b[j] + (std::abs(r0) + 1e-6) * a[0] +
+                                                             (std::abs(r1) + 1e-6) * a[1] +
+                                                             (std::abs(r2) + 1e-6) * a[2];
+  }
+  const int i = (axis - 6) / 3;
+  const int j = (axis - 6) % 3;
+  const int i1 = (i + 1) % 3;
+  const int i2 = (i + 2) % 3;
+  const int j1 = (j + 1) % 3;
+  const int j2 = (j + 2) % 3;
+  const double r_i1j = r(i1, j);
+  const double r_i2j = r(i2, j);
+  const double s = t[i2] * r_i1j - t[i1] * r_i2j;
+  return std::abs(s) > a[i1] * (std::abs(r_i2j) + 1e-6) + a[i2] * (std::abs(r_i1j) + 1e-6) +
+                           b[j1] * (std::abs(r(i, j2)) + 1e-6) +
+                           b[j2] * (std::abs(r(i, j1)) + 1e-6);
+}
+
 // The separating-axis test of two oriented boxes, as fcl::OBB::overlap computes it (the same
 // relative rotation and translation, each of the 15 axes' inequality as in fcl::obbDisjoint,
 // rotation magnitudes padded by 1e-6), but starting with the axis `first` and returning the axis
@@ -16,6 +53,7 @@ namespace hila::core {
 inline int separating_axis(const fcl::OBBd& p, const fcl::OBBd& q, int first) {
   const Eigen::Vector3d d = q.To - p.To;
   const Eigen::Vector3d t(p.axis.col(0).dot(d), p.axis.col(1).dot(d), p.axis.col(2).dot(d));
+  if (first >= 0 && first < 15 && axis_separates(p, q, t, first)) return first;
   const Eigen::Matrix3d r = p.axis.transpose() * q.axis;
   Eigen::Matrix3d f = r.cwiseAbs();
   f.array() += 1e-6;
@@ -37,7 +75,6 @@ inline int separating_axis(const fcl::OBBd& p, const fcl::OBBd& q, int first) {
     const double s = t[i2] * r(i1, j) - t[i1] * r(i2, j);
     return std::abs(s) > a[i1] * f(i2, j) + a[i2] * f(i1, j) + b[j1] * f(i, j2) + b[j2] * f(i, j1);
   };
-  if (first >= 0 && first < 15 && separates(first)) return first;
   for (int axis = 0; axis < 15; ++axis) {
     if (axis != first && separates(axis)) return axis;
   }
