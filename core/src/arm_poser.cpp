@@ -23,6 +23,12 @@ ArmPoser::ArmPoser(const Cell& cell, const CellScene& scene, const Arm& arm)
   }
   // The model's joint order has every parent before its children (RobotModel::link_poses).
   std::sort(joints_.begin(), joints_.end());
+  for (const int j : joints_) {
+    const Pose& origin = robot_.joints()[static_cast<std::size_t>(j)].origin;
+    const bool unrotated = origin.linear() == Eigen::Matrix3d::Identity();
+    origin_unrotated_.push_back(unrotated);
+    origin_identity_.push_back(unrotated && origin.translation().isZero(0.0));
+  }
 }
 
 void ArmPoser::pose_robot(CollisionData& data, const Eigen::VectorXd& robot_q) {
@@ -32,10 +38,21 @@ void ArmPoser::pose_robot(CollisionData& data, const Eigen::VectorXd& robot_q) {
 
 void ArmPoser::pose_arm(CollisionData& data, const Eigen::VectorXd& robot_q) {
   assert(poses_.size() == robot_.links().size());  // pose_robot() first
-  for (const int j : joints_) {
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    const int j = joints_[k];
     const Joint& joint = robot_.joints()[static_cast<std::size_t>(j)];
     Pose& child = poses_[static_cast<std::size_t>(joint.child_link)];
-    child = poses_[static_cast<std::size_t>(joint.parent_link)] * joint.origin;
+    const Pose& parent = poses_[static_cast<std::size_t>(joint.parent_link)];
+    // The same values as parent * origin: a product with an identity rotation is exact.
+    if (origin_identity_[k]) {
+      child = parent;
+    } else if (origin_unrotated_[k]) {
+      child.linear() = parent.linear();
+      child.translation().noalias() = parent.linear() * joint.origin.translation();
+      child.translation() += parent.translation();
+    } else {
+      child = parent * joint.origin;
+    }
     if (joint.type == JointType::Fixed) continue;
     const double value = robot_.joint_value(robot_q, j);
     if (joint.type == JointType::Prismatic) {

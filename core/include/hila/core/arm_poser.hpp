@@ -29,7 +29,11 @@ class ArmPoser {
  private:
   const RobotModel& robot_;
   const RobotBodies& bodies_;
-  std::vector<int> joints_;                       // below the arm's base, parents first
+  std::vector<int> joints_;  // below the arm's base, parents first
+  // Per joint of joints_: its origin has no rotation (most of an arm's: the product with it is
+  // a translation, and exactly the product's result), and no translation either.
+  std::vector<char> origin_unrotated_;
+  std::vector<char> origin_identity_;
   std::vector<std::pair<int, int>> link_bodies_;  // (link, body) below the arm's base
   std::vector<Pose> poses_;                       // every link, root frame
 };
