@@ -17,30 +17,42 @@ double SlipProjection::constraint(const Eigen::VectorXd& q) const {
   return -(base_.linear() * (arm_->chain.fk(q).linear() * normal_tcp_)).z();
 }
 
+double SlipProjection::evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& gradient) const {
+  Pose tip;
+  Jacobian jac;
+  arm_->chain.fk_and_jacobian(q, tip, jac);
+  const Eigen::Vector3d v = base_.linear() * (tip.linear() * normal_tcp_);
+  // d(R n)/dq_j = w_j x (R n), w_j the joint's world axis; the constraint is -(R n).z.
+  gradient.resize(q.size());
+  for (Eigen::Index j = 0; j < q.size(); ++j) {
+    const Eigen::Vector3d w = base_.linear() * jac.block<3, 1>(3, j);
+    gradient[j] = -(w.x() * v.y() - w.y() * v.x());
+  }
+  return -v.z();
+}
+
+Eigen::VectorXd SlipProjection::gradient(const Eigen::VectorXd& q) const {
+  Eigen::VectorXd g;
+  evaluate(q, g);
+  return g;
+}
+
 bool SlipProjection::operator()(Eigen::VectorXd& q) const {
   if (!active_) return true;
   const double band = fill_ * limit_;
   Eigen::VectorXd x = q;
-  Pose tip;
-  Jacobian jac;
+  Eigen::VectorXd gradient;
   constexpr int kSteps = 6;
   for (int step = 0; step <= kSteps; ++step) {
-    arm_->chain.fk_and_jacobian(x, tip, jac);
-    const Eigen::Vector3d v = base_.linear() * (tip.linear() * normal_tcp_);
-    const double f = -v.z();
+    const double f = evaluate(x, gradient);
     if (std::abs(f) <= limit_ && (step > 0 || std::abs(f) <= band)) {
       q = x;
       return true;
     }
     if (step == kSteps) break;
-    // d(R n)/dq_j = w_j x (R n), w_j the joint's world axis; f = -(R n).z.
-    Eigen::VectorXd gradient(x.size());
-    for (Eigen::Index j = 0; j < x.size(); ++j) {
-      const Eigen::Vector3d w = base_.linear() * jac.block<3, 1>(3, j);
-      gradient[j] = -(w.x() * v.y() - w.y() * v.x());
-    }
     const double g2 = gradient.squaredNorm();
     if (g2 < 1e-12) break;
+    // A minimum-norm Newton step onto the band's near edge.
     const double target = f > 0.0 ? band : -band;
     x -= ((f - target) / g2) * gradient;
   }

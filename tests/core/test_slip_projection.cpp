@@ -53,6 +53,25 @@ TEST(SlipProjection, ConstraintIsTheSineOfTheSlipAngle) {
   }
 }
 
+TEST(SlipProjection, GradientMatchesFiniteDifferences) {
+  const core::SlipProjection slip(arm(), base(), kAxis, kLever, 17.0);
+  std::mt19937_64 rng(13);
+  const double h = 1e-6;
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::VectorXd q = uniform(rng);
+    const Eigen::VectorXd analytic = slip.gradient(q);
+    ASSERT_EQ(analytic.size(), q.size());
+    for (Eigen::Index j = 0; j < q.size(); ++j) {
+      Eigen::VectorXd up = q;
+      Eigen::VectorXd down = q;
+      up[j] += h;
+      down[j] -= h;
+      const double numeric = (slip.constraint(up) - slip.constraint(down)) / (2.0 * h);
+      EXPECT_NEAR(analytic[j], numeric, 1e-7) << "joint " << j << " at " << q.transpose();
+    }
+  }
+}
+
 TEST(SlipProjection, ProjectedSamplesHoldTheLimit) {
   for (const double theta_c : {5.0, 17.0, 45.0}) {
     SCOPED_TRACE("theta_c " + std::to_string(theta_c));

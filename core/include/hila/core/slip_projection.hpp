@@ -24,10 +24,15 @@ class SlipProjection {
   bool active() const { return active_; }
   // The slip-limited scalar g . (R n) at q, whose magnitude is sin(theta_s).
   double constraint(const Eigen::VectorXd& q) const;
+  // Its gradient over the arm's joints (analytic, from the geometric Jacobian).
+  Eigen::VectorXd gradient(const Eigen::VectorXd& q) const;
   // Projects q in place; false when the steps do not reach the limit (q is then unchanged).
   bool operator()(Eigen::VectorXd& q) const;
 
  private:
+  // The constraint at q, and its gradient into `gradient`.
+  double evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& gradient) const;
+
   const Arm* arm_;
   Pose base_;
   Eigen::Vector3d normal_tcp_;  // opening axis x lever, TCP frame
