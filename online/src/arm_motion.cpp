@@ -133,6 +133,7 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
     node_state_.assign(roadmap_.record.nodes.size(), -1);
     edge_state_.assign(edges, -1);
     blocked_edges_.clear();
+    failed_bridges_.clear();
   }
   // No filter: every edge (a held board's slip and clearance are then checked lazily, as all).
   assert(request.filter == nullptr || request.filter->size() == edges);
@@ -706,12 +707,20 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   }
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
   const core::BridgeSettings bridge = bridge_settings(settings_.bridge_checks, request.deadline);
-  r.path = core::plan_bridge(arm_, valid_here, request.start, request.goal, bridge);
+  // The bridge is deterministic: the same ends under the same checks and budget fail again.
+  const FailedBridge asked{request.start, request.goal, bridge.max_checks,
+                           request.start_in_contact};
+  const bool failed_before =
+      std::find(failed_bridges_.begin(), failed_bridges_.end(), asked) != failed_bridges_.end();
+  if (!failed_before) {
+    r.path = core::plan_bridge(arm_, valid_here, request.start, request.goal, bridge);
+  }
   if (!r.path.empty()) {
     r.via = "bridge";
     return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the bridge");
+  if (!failed_before) failed_bridges_.push_back(asked);
   return finish(
       MotionStatus::kNoPath,
       r.wedged

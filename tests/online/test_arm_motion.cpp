@@ -624,3 +624,44 @@ TEST(ArmMotion, AStepOntoAnUncheckedConfigurationChecksIt) {
   ASSERT_TRUE(planner.valid(back));
   EXPECT_TRUE(planner.step_valid(a, back));
 }
+
+// A bridge that failed within its budget is not run again for the same ends under the same
+// checks (another goal with the same configuration asks the same): the same failure, without
+// its checks. A larger budget runs it again.
+TEST(ArmMotion, AFailedBridgeIsNotRunAgainForTheSameEnds) {
+  const auto& cell = *test::reference_cell();
+  const auto crated = crate_on_a_roadmap_path();
+  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
+  const auto& [a, b, before, blocked] = *crated;
+  const online::World world(cell, cabinet(), blocked, "top");
+  online::MotionRequest r = request(a, b);
+  online::MotionSettings settings;
+  settings.attach_neighbours = 0;  // both ends wedged: straight to the bridge
+  settings.wedged_repair_checks = 0;
+  settings.bridge_checks = 30;  // too few to get around the crate
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left", settings);
+  planner.prepare(r);
+  ASSERT_FALSE(planner.segment_valid(a, b)) << "the crate must block the straight motion";
+
+  const long before_first = planner.checks();
+  const auto first = planner.plan(r);
+  const long first_checks = planner.checks() - before_first;
+  ASSERT_FALSE(first.solved()) << "a 30-check bridge should not get around the crate";
+  const auto second = planner.plan(r);
+  const long second_checks = planner.checks() - before_first - first_checks;
+  EXPECT_EQ(second.status, first.status);
+  EXPECT_EQ(second.reason, first.reason);
+  EXPECT_LT(second_checks, first_checks - 25) << "the bridge's checks were spent again";
+
+  // A fresh planner fails the same way, spending the bridge.
+  online::ArmMotionPlanner fresh(world, left_roadmap(), "left", settings);
+  const auto again = fresh.plan(r);
+  EXPECT_EQ(again.reason, first.reason);
+  EXPECT_EQ(fresh.checks(), first_checks);
+
+  // Another budget is another bridge.
+  planner.set_bridge_checks(60);
+  const long before_larger = planner.checks();
+  planner.plan(r);
+  EXPECT_GE(planner.checks() - before_larger, first_checks);
+}

@@ -257,6 +257,21 @@ class ArmMotionPlanner {
   std::vector<signed char> edge_state_;
   std::vector<int> blocked_edges_;  // the edges whose verdict is blocked, for prepare()
   std::vector<double> context_;     // what the verdicts were found under
+  // Bridges across a whole motion that failed within their budget (not the deadline) since
+  // the verdicts were last reset: asked again (another goal whose configuration is the same),
+  // the bridge would fail again, check for check, so it is not run.
+  struct FailedBridge {
+    Eigen::VectorXd start;
+    Eigen::VectorXd goal;
+    long checks = 0;
+    bool start_in_contact = false;
+    bool operator==(const FailedBridge& o) const {
+      return checks == o.checks && start_in_contact == o.start_in_contact &&
+             start.size() == o.start.size() && goal.size() == o.goal.size() && start == o.start &&
+             goal == o.goal;
+    }
+  };
+  std::vector<FailedBridge> failed_bridges_;
   // The last segments found blocked since prepare() (segment_valid()), oldest first.
   static constexpr std::size_t kBlockedSegmentsKept = 8;
   std::vector<std::pair<Eigen::VectorXd, Eigen::VectorXd>> blocked_segments_;
