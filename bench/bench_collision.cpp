@@ -76,7 +76,9 @@ BENCHMARK(BM_FullArmCheckColliding);
 
 // The same query with only the moving arm re-posed (core::ArmPoser), as the online planner and
 // validator check each sample: the other arm, the torso and the human stay where they are.
-void BM_ArmPoserCheckFree(benchmark::State& state) {
+// Poses the left arm alone at each of `configs` in turn (core::ArmPoser), the rest of the cell
+// at home, and runs the planner's query.
+void arm_poser_loop(benchmark::State& state, const std::vector<Eigen::VectorXd>& configs) {
   const auto& p = problem();
   core::CollisionData data(p.scene.model);
   core::set_cell_state(*p.cell, p.scene, data, p.cell->home_configuration(),
@@ -85,9 +87,13 @@ void BM_ArmPoserCheckFree(benchmark::State& state) {
   poser.pose_robot(data, p.cell->home_configuration());
   std::size_t i = 0;
   for (auto _ : state) {
-    poser.pose_arm(data, p.free_configs[i++ % p.free_configs.size()]);
+    poser.pose_arm(data, configs[i++ % configs.size()]);
     benchmark::DoNotOptimize(arm_query(data));
   }
+}
+
+void BM_ArmPoserCheckFree(benchmark::State& state) {
+  arm_poser_loop(state, problem().free_configs);
 }
 BENCHMARK(BM_ArmPoserCheckFree);
 
@@ -95,11 +101,6 @@ BENCHMARK(BM_ArmPoserCheckFree);
 // way the validator and a segment check walk a motion: consecutive samples close together.
 void BM_ArmPoserCheckAlongPath(benchmark::State& state) {
   const auto& p = problem();
-  core::CollisionData data(p.scene.model);
-  core::set_cell_state(*p.cell, p.scene, data, p.cell->home_configuration(),
-                       p.cell->human_neutral());
-  core::ArmPoser poser(*p.cell, p.scene, p.cell->arm("left"));
-  poser.pose_robot(data, p.cell->home_configuration());
   std::vector<Eigen::VectorXd> samples;
   for (std::size_t k = 1; k < 64; ++k) {
     const Eigen::VectorXd& a = p.free_configs[k - 1];
@@ -107,11 +108,7 @@ void BM_ArmPoserCheckAlongPath(benchmark::State& state) {
     const int steps = static_cast<int>(std::ceil((b - a).norm() / 0.01));
     for (int s = 0; s < steps; ++s) samples.push_back(a + (b - a) * (double(s) / steps));
   }
-  std::size_t i = 0;
-  for (auto _ : state) {
-    poser.pose_arm(data, samples[i++ % samples.size()]);
-    benchmark::DoNotOptimize(arm_query(data));
-  }
+  arm_poser_loop(state, samples);
 }
 BENCHMARK(BM_ArmPoserCheckAlongPath);
 
