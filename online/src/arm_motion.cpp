@@ -133,7 +133,6 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
     node_state_.assign(roadmap_.record.nodes.size(), -1);
     edge_state_.assign(edges, -1);
     blocked_edges_.clear();
-    failed_bridges_.clear();
   }
   // No filter: every edge (a held board's slip and clearance are then checked lazily, as all).
   assert(request.filter == nullptr || request.filter->size() == edges);
@@ -232,6 +231,11 @@ bool ArmMotionPlanner::segment_valid(const Eigen::VectorXd& a, const Eigen::Vect
   }
   blocked_segments_.emplace_back(a, b);
   return false;
+}
+
+void ArmMotionPlanner::remember_failure(const FailedBridge& failure) {
+  if (failed_bridges_.size() == kFailedBridgesKept) failed_bridges_.erase(failed_bridges_.begin());
+  failed_bridges_.push_back(failure);
 }
 
 bool ArmMotionPlanner::node_valid(int node) {
@@ -696,20 +700,29 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   const long repair_budget = r.wedged
                                  ? std::max(settings_.repair_checks, settings_.wedged_repair_checks)
                                  : settings_.repair_checks;
+  // A repair is as deterministic as a bridge: one that failed within its budget is not run again
+  // (the larger bridges' round repeats a wedged motion's repairs at the same budget).
   for (const auto* hint : request.hints) {
     if (!request.follow_hints || repair_budget <= 0 || late()) break;
+    const FailedBridge repair{request.start, request.goal, repair_budget, request.start_in_contact,
+                              hint,          context_};
+    if (std::find(failed_bridges_.begin(), failed_bridges_.end(), repair) !=
+        failed_bridges_.end()) {
+      continue;
+    }
     r.path = follow(*hint, request.start, request.goal, repair_budget, valid_here, request.deadline,
                     settings_.max_repairs);
     if (!r.path.empty()) {
       r.via = "stored+repair";
       return finish(MotionStatus::kSolved, "");
     }
+    if (!late()) remember_failure(repair);
   }
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
   const core::BridgeSettings bridge = bridge_settings(settings_.bridge_checks, request.deadline);
   // The bridge is deterministic: the same ends under the same checks and budget fail again.
-  const FailedBridge asked{request.start, request.goal, bridge.max_checks,
-                           request.start_in_contact};
+  const FailedBridge asked{request.start, request.goal, bridge.max_checks, request.start_in_contact,
+                           nullptr,       context_};
   const bool failed_before =
       std::find(failed_bridges_.begin(), failed_bridges_.end(), asked) != failed_bridges_.end();
   if (!failed_before) {
@@ -720,7 +733,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the bridge");
-  if (!failed_before) failed_bridges_.push_back(asked);
+  if (!failed_before) remember_failure(asked);
   return finish(
       MotionStatus::kNoPath,
       r.wedged
