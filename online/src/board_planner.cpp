@@ -251,7 +251,7 @@ class Run {
       if (stages[5] != nullptr && stages[5]->ok()) stages[6] = &leave(rr, grasp, goal);
     };
     plan_stages();
-    if (!settle()) {
+    if (!settle(stages)) {
       // A stage planned past a step the validator then rejected, fallbacks and all, is planned
       // again in order, validating as it goes: after a rejection it may take another branch or
       // route. The stages after it stand (a memoised stage ends where its key says).
@@ -565,12 +565,26 @@ class Run {
   // step's fallbacks (recover()) as step() would have run them. False when a stage's step is
   // still rejected: that stage (marked rejected_late) must be planned again in order, since
   // its alternatives come after a rejection.
-  bool settle() {
+  // Only the chain's stages are settled, and only once it is planned through: the stages of
+  // attempts that failed further on are settled when a chain that plans through uses them, and
+  // until then their jobs wait for the worker instead of holding up this chain.
+  bool settle(std::span<const Stage* const> chain) {
     if (!queue_) return true;
+    auto drop_failed = [&](Stage& st) {
+      if (!st.ok()) abandon(st);  // failed as planned: its reports do not matter
+    };
+    if (tool_) drop_failed(*tool_);
+    each_memo([&](auto& stages) {
+      for (auto& entry : stages) drop_failed(entry.second);
+    });
+    for (const Stage* st : chain) {
+      if (st == nullptr || !st->ok()) return true;
+    }
     std::vector<Stage*> waiting;
     auto add = [&](Stage& st) {
-      if (!st.ok()) abandon(st);  // failed as planned: its reports do not matter
-      if (!st.pending.empty()) waiting.push_back(&st);
+      if (!st.pending.empty() && std::find(chain.begin(), chain.end(), &st) != chain.end()) {
+        waiting.push_back(&st);
+      }
     };
     if (tool_) add(*tool_);
     each_memo([&](auto& stages) {
@@ -580,9 +594,14 @@ class Run {
       return a->pending.front().job < b->pending.front().job;
     });
     {
-      // Every report in before any fallback: those validate here, with the worker's data too.
+      // Every report of the chain in before any fallback: the caller validates those the worker
+      // has not started.
+      std::vector<std::size_t> jobs;
+      for (const Stage* st : waiting) {
+        for (const PendingCheck& p : st->pending) jobs.push_back(p.job);
+      }
       const Stopwatch watch(times_.validation);
-      queue_->drain();
+      queue_->wait_all(jobs);
     }
     bool all_passed = true;
     for (Stage* st : waiting) {

@@ -32,10 +32,37 @@ std::size_t ValidationQueue::submit(Motion motion, Finish finish) {
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     job = jobs_.size();
-    jobs_.push_back({std::move(motion), std::move(finish), {}, false, false});
+    jobs_.push_back({std::move(motion), std::move(finish), {}, false, false, false});
+    ++waiting_;
   }
   changed_.notify_all();
   return job;
+}
+
+void ValidationQueue::wait_all(const std::vector<std::size_t>& jobs) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    std::size_t first = jobs_.size();  // the lowest waited-for job not started
+    bool all_done = true;
+    for (const std::size_t j : jobs) {
+      assert(j < jobs_.size());
+      Job& job = jobs_[j];
+      if (!job.started && job.discarded) {  // done, unvalidated
+        job.started = true;
+        job.done = true;
+        --waiting_;
+      }
+      if (job.done) continue;
+      all_done = false;
+      if (!job.started) first = std::min(first, j);
+    }
+    if (all_done) return;
+    if (first < jobs_.size()) {
+      run(lock, first, caller_data_, kCallerSlot);
+    } else {
+      changed_.wait(lock);  // the worker has the rest
+    }
+  }
 }
 
 const ValidationReport& ValidationQueue::wait(std::size_t job) {
@@ -71,8 +98,12 @@ void ValidationQueue::discard(std::size_t job) {
 }
 
 bool ValidationQueue::has_next() {
-  while (next_ < jobs_.size() && jobs_[next_].discarded) {
-    jobs_[next_].done = true;
+  while (next_ < jobs_.size() && (jobs_[next_].started || jobs_[next_].discarded)) {
+    if (!jobs_[next_].started) {  // discarded before it started: done, unvalidated
+      jobs_[next_].started = true;
+      jobs_[next_].done = true;
+      --waiting_;
+    }
     ++next_;
   }
   return next_ < jobs_.size();
@@ -80,7 +111,7 @@ bool ValidationQueue::has_next() {
 
 std::size_t ValidationQueue::backlog() const {
   const std::lock_guard<std::mutex> lock(mutex_);
-  return jobs_.size() - next_;
+  return waiting_;
 }
 
 double ValidationQueue::seconds() const {
@@ -99,7 +130,15 @@ void ValidationQueue::run_worker() {
 
 void ValidationQueue::run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data,
                                std::size_t slot) {
-  Job& job = jobs_[next_++];
+  run(lock, next_, data, slot);
+}
+
+void ValidationQueue::run(std::unique_lock<std::mutex>& lock, std::size_t index,
+                          core::CollisionData& data, std::size_t slot) {
+  Job& job = jobs_[index];
+  assert(!job.started && !job.discarded);
+  job.started = true;
+  --waiting_;
   ++running_;
   lock.unlock();
   auto started = std::chrono::steady_clock::now();

@@ -168,3 +168,49 @@ TEST(ValidationQueue, AFinishCompletesTheMotionOnTheThreadThatValidatesIt) {
   EXPECT_EQ(report.violations.front().kind, "internal");
   EXPECT_NE(report.violations.front().detail.find("no memory left"), std::string::npos);
 }
+
+// wait_all: the jobs waited for come back with the reports they have alone; the caller runs
+// only those (each job's finish records the slot that ran it), the rest stay with the worker,
+// and a waited-for job discarded before it started comes back unvalidated instead of hanging.
+TEST(ValidationQueue, WaitAllRunsOnlyTheJobsItWaitsFor) {
+  Fixture f;
+  const auto motions = f.motions();
+  core::CollisionData data = f.world.make_data();
+  std::vector<std::string> alone;
+  for (const auto& m : motions)
+    alone.push_back(describe(online::validate_motion(f.world, data, m)));
+
+  core::CollisionData worker = f.world.make_data();
+  core::CollisionData caller = f.world.make_data();
+  online::ValidationQueue queue(f.world, {}, worker, caller);
+  constexpr int kRounds = 4;
+  std::vector<std::atomic<int>> ran_on(kRounds * motions.size());
+  for (auto& r : ran_on) r = -1;
+  std::vector<std::size_t> jobs;
+  for (int round = 0; round < kRounds; ++round) {
+    for (std::size_t i = 0; i < motions.size(); ++i) {
+      const std::size_t n = jobs.size();
+      jobs.push_back(queue.submit(motions[i], [&ran_on, n](std::size_t slot, online::Motion&) {
+        ran_on[n] = static_cast<int>(slot);
+      }));
+    }
+  }
+  // The last round's, and one of them discarded straight away.
+  std::vector<std::size_t> wanted(jobs.end() - static_cast<std::ptrdiff_t>(motions.size()),
+                                  jobs.end());
+  queue.discard(wanted.front());
+  queue.wait_all(wanted);
+  for (std::size_t k = 1; k < wanted.size(); ++k) {
+    EXPECT_EQ(describe(queue.wait(wanted[k])), alone[k]) << "job " << wanted[k];
+  }
+  const auto& discarded = queue.wait(wanted.front());
+  if (discarded.samples == 0) EXPECT_TRUE(discarded.violations.empty());
+  for (std::size_t j = 0; j + motions.size() < jobs.size(); ++j) {
+    EXPECT_NE(ran_on[j].load(), static_cast<int>(online::ValidationQueue::kCallerSlot))
+        << "job " << j << " was not waited for, yet the caller ran it";
+  }
+  // The rest are still validated, by the worker or by a later wait.
+  for (std::size_t j = 0; j + motions.size() < jobs.size(); ++j) {
+    EXPECT_EQ(describe(queue.wait(jobs[j])), alone[j % motions.size()]) << "job " << j;
+  }
+}

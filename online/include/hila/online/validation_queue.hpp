@@ -6,6 +6,7 @@
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 #include "hila/core/collision.hpp"
 #include "hila/online/validator.hpp"
@@ -47,6 +48,10 @@ class ValidationQueue {
   const ValidationReport& wait(std::size_t job);
   // Returns once every job is done: neither thread validates until the next submit().
   void drain();
+  // Returns once every one of `jobs` is done. The caller validates those of them not yet
+  // started itself, lowest first, and no others: the jobs it does not wait for stay queued for
+  // the worker (the attempts a plan did not use, say, need not hold up the one it did).
+  void wait_all(const std::vector<std::size_t>& jobs);
   // The job's report is no longer wanted: it is not validated unless it already started.
   void discard(std::size_t job);
   // Jobs submitted and not yet started (discarded ones included).
@@ -59,6 +64,7 @@ class ValidationQueue {
     Motion motion;
     Finish finish;
     ValidationReport report;
+    bool started = false;
     bool done = false;
     bool discarded = false;
   };
@@ -67,6 +73,9 @@ class ValidationQueue {
   bool has_next();
   // Validates the first job not yet started; the lock is released meanwhile.
   void run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data, std::size_t slot);
+  // Validates job `index` (not started, not discarded); the lock is released meanwhile.
+  void run(std::unique_lock<std::mutex>& lock, std::size_t index, core::CollisionData& data,
+           std::size_t slot);
 
   const World& world_;
   ValidatorSettings settings_;
@@ -75,7 +84,8 @@ class ValidationQueue {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Job> jobs_;     // references to elements stay valid as it grows
-  std::size_t next_ = 0;     // the first job not yet started
+  std::size_t next_ = 0;     // no job before it waits to be started
+  std::size_t waiting_ = 0;  // jobs not started (discarded ones included)
   std::size_t running_ = 0;  // jobs being validated
   double seconds_ = 0.0;
   bool stopping_ = false;
