@@ -522,7 +522,8 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.quality = s.next_double();
         r.one_hand_stable = s.next_int64() != 0;
       });
-  db.comfort_maps_ = load_comfort_maps(*connection, path, fix);
+  db.comfort_maps_loaded_ = options.comfort_maps;
+  if (options.comfort_maps) db.comfort_maps_ = load_comfort_maps(*connection, path, fix);
 
   db.handover_stages_ = load_rows<HandoverStageRecord>(
       *connection, "handover_stages",
@@ -674,6 +675,11 @@ const PartRecord& Database::part(const std::string& name) const {
 }
 
 const ComfortMapRecord& Database::comfort_map(const std::string& arm) const {
+  if (!comfort_maps_loaded_) {
+    throw core::InputError(
+        path_, "comfort_maps", "the comfort map for arm '" + arm + "' loaded",
+        "a database opened without its comfort maps (OpenOptions::comfort_maps)");
+  }
   for (const auto& map : comfort_maps_) {
     if (map.arm == arm) return map;
   }

@@ -13,6 +13,7 @@ std::shared_ptr<const PlannerModel> PlannerModel::load(const std::string& databa
   db::OpenOptions options;
   options.expected_cell_hash = db::cell_hash(cell->spec());
   options.expected_product_hash = db::product_hash(product);
+  options.comfort_maps = false;  // offline work: planning never reads them
   db::Database database = db::Database::open(database_path, options);
   if (database.meta().product_name != product.name) {
     throw db::DatabaseError(database_path, "meta.product_name",

@@ -297,6 +297,31 @@ TEST(Reader, LargeComfortMapRoundTrip) {
   EXPECT_EQ(at(got, 7, 3, 11, 500), at(map, 7, 3, 11, 500));
 }
 
+// Opened without the comfort maps (the online planner's way): everything else is as a full open
+// reads it, the maps are not there, and asking for one says why rather than "no such arm".
+TEST(Reader, ComfortMapsAreLeftOutWhenNotWanted) {
+  const std::string dir = temp_dir("db_reader_comfort_skipped");
+  const std::string path = dir + "/p.db";
+  const ComfortMapRecord map = make_comfort_map("right", 11, {4, 3, 2}, 10, 0.5);
+  {
+    DatabaseWriter writer(path);
+    writer.write_meta(make_sample().meta);
+    writer.add_comfort_map(map);
+    writer.commit();
+  }
+  OpenOptions without;
+  without.comfort_maps = false;
+  const Database lean = Database::open(path, without);
+  const Database full = Database::open(path);
+  ASSERT_EQ(full.comfort_maps().size(), 1u);
+  EXPECT_TRUE(lean.comfort_maps().empty());
+  EXPECT_EQ(lean.meta().product_name, full.meta().product_name);
+  EXPECT_EQ(lean.meta().cell_hash, full.meta().cell_hash);
+  EXPECT_EQ(full.comfort_map("right").values, map.values);
+  expect_input_error([&] { lean.comfort_map("right"); },
+                     {path, "comfort_maps", "opened without its comfort maps"});
+}
+
 TEST(Reader, EmptyDatabaseOpens) {
   const std::string path = temp_dir("db_reader_empty") + "/p.db";
   {

@@ -129,6 +129,10 @@ struct OpenOptions {
   // says which input changed and how to rebuild.
   std::optional<std::string> expected_cell_hash;
   std::optional<std::string> expected_product_hash;
+  // The human comfort maps (about 13 MB per arm, most of the file and of the time to open it) are
+  // read only when wanted: the online planner does not use them. Left out, comfort_maps() is
+  // empty and comfort_map() says they were not loaded.
+  bool comfort_maps = true;
 };
 
 // A read-only, fully loaded product database (small, except the comfort maps: about 13 MB per arm
@@ -147,7 +151,8 @@ class Database {
   std::vector<RobotGraspRecord> robot_grasps(std::int64_t part_id) const;
   std::vector<SuctionGraspRecord> suction_grasps(std::int64_t part_id) const;
   std::vector<HumanGraspRecord> human_grasps(std::int64_t part_id) const;
-  // In the order they were written (id order).
+  // In the order they were written (id order); empty when opened without them
+  // (OpenOptions::comfort_maps).
   const std::vector<ComfortMapRecord>& comfort_maps() const { return comfort_maps_; }
   const ComfortMapRecord& comfort_map(const std::string& arm) const;  // throws core::InputError
 
@@ -180,6 +185,7 @@ class Database {
   std::vector<SuctionGraspRecord> suction_grasps_;
   std::vector<HumanGraspRecord> human_grasps_;
   std::vector<ComfortMapRecord> comfort_maps_;
+  bool comfort_maps_loaded_ = true;
   std::vector<HandoverStageRecord> handover_stages_;
   std::vector<RobotHandoverRecord> robot_handovers_;
   std::vector<HandoverCandidateRecord> handover_candidates_;
