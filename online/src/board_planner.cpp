@@ -199,8 +199,20 @@ class Run {
   int rejected_motions() const { return rejected_motions_; }
   PlanTimes times() const {
     PlanTimes t = times_;
-    if (queue_) t.queued_validation = queue_->seconds();
+    t.queued_validation = queue_ ? queue_->seconds() : queued_seconds_;
     return t;
+  }
+
+  // The plan is decided: the queued validations no chain used are dropped and the worker is
+  // joined (after the job it is on, if any), so that the plan's time includes the wait.
+  void stop_validation() {
+    if (!queue_) return;
+    if (tool_) abandon(*tool_);
+    each_memo([&](auto& stages) {
+      for (auto& entry : stages) abandon(entry.second);
+    });
+    queued_seconds_ = queue_->seconds();  // the job it is on when joined is not counted
+    queue_.reset();
   }
 
   // Bridges of `checks` and stored-path repairs of `repair_checks` from now on. The stages that
@@ -495,7 +507,7 @@ class Run {
       double waited = 0.0;
       {
         const Stopwatch watch(waited);
-        queue_->wait(p.job);
+        queue_->wait_all({p.job});  // not the other attempts' jobs queued before it
       }
       times_.validation += waited;
       times_.motions -= waited;
@@ -627,7 +639,7 @@ class Run {
         retime(*st, p.step, path, timed);
         s.via = p.found.via;
       }
-      st->pending.clear();
+      abandon(*st);  // after a step it could not recover, the rest are not wanted either
     }
     return all_passed;
   }
@@ -678,8 +690,21 @@ class Run {
     Motion check = frame;
     check.time = timed.time;
     check.q = timed.q;
-    report = validate_motion(world_, validation_threads_, check, settings_.validator);
+    report = validate_motion(world_, inline_validation(), check, settings_.validator);
     return report.valid();
+  }
+
+  // The data a step validated here and now uses. With a queue, not the worker's: it may still be
+  // validating other attempts' steps (settle() waits for the chain's only). Made when first
+  // needed (a rejected step's fallbacks, a stage planned again in order: rare).
+  const std::vector<core::CollisionData*>& inline_validation() {
+    if (!queue_) return validation_threads_;
+    if (!inline_data_) {
+      inline_data_ = std::make_unique<core::CollisionData>(world_.make_data());
+      // The queue's caller data is this thread's, and this thread is not waiting on the queue.
+      inline_threads_ = {inline_data_.get(), validation_data_[1].get()};
+    }
+    return inline_threads_;
   }
 
   // The first of `candidates` valid for the planner under `request` in the stage's state.
@@ -1218,6 +1243,9 @@ class Run {
   std::array<std::array<std::unique_ptr<ArmMotionPlanner>, 2>, 2> smoothing_checks_;
   std::vector<std::unique_ptr<core::CollisionData>> validation_data_;  // one per thread
   std::vector<core::CollisionData*> validation_threads_;
+  std::unique_ptr<core::CollisionData> inline_data_;  // inline_validation()
+  std::vector<core::CollisionData*> inline_threads_;
+  double queued_seconds_ = 0.0;  // the queue's, once stop_validation() dropped it
   // Validates the steps on the second thread while the next are planned (after the data).
   std::optional<ValidationQueue> queue_;
   bool speculate_ = false;  // step() queues its motion's validation and plans on
@@ -1249,9 +1277,10 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   const auto started = std::chrono::steady_clock::now();
   BoardPlan result;
   result.board = board;
-  const Run* running = nullptr;  // once it is under way
+  Run* running = nullptr;  // once it is under way
   auto finish = [&](BoardPlanStatus status, std::string reason) {
     if (running != nullptr) {
+      running->stop_validation();
       result.times = running->times();
       result.rejected_motions = running->rejected_motions();
     }

@@ -703,9 +703,9 @@ TEST(ArmMotion, AFailedRepairIsNotRunAgainUnderTheSameContext) {
   EXPECT_EQ(second.status, first.status);
   EXPECT_EQ(second.reason, first.reason);
   // Neither the repair (two bridges of 40 checks, and the stored path walked to each) nor the
-  // whole-motion bridge runs again: what is left is the ends and the straight motion. Measured
-  // 465 then 198; with the bridge kept and the repair run again, 375.
-  EXPECT_LT(second_checks, first_checks - 150) << first_checks << " then " << second_checks;
+  // whole-motion bridge (30) runs again: what is left is the ends and the straight motion.
+  // Measured 465 then 198; with the repair run again, 375; with the bridge run again, 288.
+  EXPECT_LT(second_checks, first_checks - 250) << first_checks << " then " << second_checks;
 
   // A fresh planner spends them all again, and fails the same way.
   online::ArmMotionPlanner fresh(world, left_roadmap(), "left", settings);

@@ -54,7 +54,9 @@ struct MotionRequest {
   bool start_in_contact = false;
   // Paths stored offline for this motion (the regrasp graph's, for the nominal scene), tried in
   // order before the roadmap: each is joined to the start and goal by straight segments within
-  // its first and last few waypoints and re-validated against the scene as it is.
+  // its first and last few waypoints and re-validated against the scene as it is. A repair of
+  // one that failed is remembered by the path's address (ArmMotionPlanner::failed_bridges_):
+  // a path must not change while the planner that was given it lives (the database's do not).
   std::vector<const std::vector<Eigen::VectorXd>*> hints;
   // Whether the hints are followed whole before the roadmap is searched; false keeps them for
   // leading a wedged end into the roadmap only (a hint that seldom holds whole).
