@@ -92,9 +92,18 @@ void ValidationQueue::drain() {
 }
 
 void ValidationQueue::discard(std::size_t job) {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  assert(job < jobs_.size());
-  jobs_[job].discarded = true;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    assert(job < jobs_.size());
+    Job& j = jobs_[job];
+    j.discarded = true;
+    if (!j.started) {  // done, unvalidated: no longer waiting (backlog()), never to be run
+      j.started = true;
+      j.done = true;
+      --waiting_;
+    }
+  }
+  changed_.notify_all();
 }
 
 bool ValidationQueue::has_next() {

@@ -52,9 +52,10 @@ class ValidationQueue {
   // started itself, lowest first, and no others: the jobs it does not wait for stay queued for
   // the worker (the attempts a plan did not use, say, need not hold up the one it did).
   void wait_all(const std::vector<std::size_t>& jobs);
-  // The job's report is no longer wanted: it is not validated unless it already started.
+  // The job's report is no longer wanted: it is not validated unless it already started (then
+  // it finishes); one not started is done at once, with an empty report.
   void discard(std::size_t job);
-  // Jobs submitted and not yet started (discarded ones included).
+  // Jobs submitted and not yet started, discarded ones left out.
   std::size_t backlog() const;
   // Seconds spent validating so far, on either thread.
   double seconds() const;
@@ -85,7 +86,7 @@ class ValidationQueue {
   std::condition_variable changed_;
   std::deque<Job> jobs_;     // references to elements stay valid as it grows
   std::size_t next_ = 0;     // no job before it waits to be started
-  std::size_t waiting_ = 0;  // jobs not started (discarded ones included)
+  std::size_t waiting_ = 0;  // jobs not started and not discarded
   std::size_t running_ = 0;  // jobs being validated
   double seconds_ = 0.0;
   bool stopping_ = false;
