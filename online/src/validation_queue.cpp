@@ -32,7 +32,7 @@ std::size_t ValidationQueue::submit(Motion motion, Finish finish) {
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     job = jobs_.size();
-    jobs_.push_back({std::move(motion), std::move(finish), {}, false, false, false});
+    jobs_.push_back({std::move(motion), std::move(finish), {}, false, false});
     ++waiting_;
   }
   changed_.notify_all();
@@ -46,12 +46,7 @@ void ValidationQueue::wait_all(const std::vector<std::size_t>& jobs) {
     bool all_done = true;
     for (const std::size_t j : jobs) {
       assert(j < jobs_.size());
-      Job& job = jobs_[j];
-      if (!job.started && job.discarded) {  // done, unvalidated
-        job.started = true;
-        job.done = true;
-        --waiting_;
-      }
+      const Job& job = jobs_[j];
       if (job.done) continue;
       all_done = false;
       if (!job.started) first = std::min(first, j);
@@ -96,7 +91,6 @@ void ValidationQueue::discard(std::size_t job) {
     const std::lock_guard<std::mutex> lock(mutex_);
     assert(job < jobs_.size());
     Job& j = jobs_[job];
-    j.discarded = true;
     if (!j.started) {  // done, unvalidated: no longer waiting (backlog()), never to be run
       j.started = true;
       j.done = true;
@@ -107,14 +101,7 @@ void ValidationQueue::discard(std::size_t job) {
 }
 
 bool ValidationQueue::has_next() {
-  while (next_ < jobs_.size() && (jobs_[next_].started || jobs_[next_].discarded)) {
-    if (!jobs_[next_].started) {  // discarded before it started: done, unvalidated
-      jobs_[next_].started = true;
-      jobs_[next_].done = true;
-      --waiting_;
-    }
-    ++next_;
-  }
+  while (next_ < jobs_.size() && jobs_[next_].started) ++next_;
   return next_ < jobs_.size();
 }
 
@@ -145,7 +132,7 @@ void ValidationQueue::run_next(std::unique_lock<std::mutex>& lock, core::Collisi
 void ValidationQueue::run(std::unique_lock<std::mutex>& lock, std::size_t index,
                           core::CollisionData& data, std::size_t slot) {
   Job& job = jobs_[index];
-  assert(!job.started && !job.discarded);
+  assert(!job.started);
   job.started = true;
   --waiting_;
   ++running_;

@@ -210,7 +210,9 @@ TEST(ValidationQueue, WaitAllRunsOnlyTheJobsItWaitsFor) {
     EXPECT_EQ(describe(queue.wait(wanted[k])), alone[k]) << "job " << wanted[k];
   }
   const auto& discarded = queue.wait(wanted.front());
-  if (discarded.samples == 0) EXPECT_TRUE(discarded.violations.empty());
+  if (discarded.samples == 0) {
+    EXPECT_TRUE(discarded.violations.empty());
+  }
   for (std::size_t j = 0; j + motions.size() < jobs.size(); ++j) {
     EXPECT_NE(ran_on[j].load(), static_cast<int>(online::ValidationQueue::kCallerSlot))
         << "job " << j << " was not waited for, yet the caller ran it";

@@ -67,14 +67,14 @@ class ValidationQueue {
     ValidationReport report;
     bool started = false;
     bool done = false;
-    bool discarded = false;
   };
   void run_worker();
-  // Whether a job waits to be started (discarded ones are passed over). Under the lock.
+  // Whether a job waits to be started (a discarded one counts as started and done). Under the
+  // lock.
   bool has_next();
   // Validates the first job not yet started; the lock is released meanwhile.
   void run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data, std::size_t slot);
-  // Validates job `index` (not started, not discarded); the lock is released meanwhile.
+  // Validates job `index` (not started); the lock is released meanwhile.
   void run(std::unique_lock<std::mutex>& lock, std::size_t index, core::CollisionData& data,
            std::size_t slot);
 
