@@ -43,6 +43,11 @@ struct CollisionModelImpl {
   // Bumped by every change of the pairs: what per-thread data derived from them is keyed on.
   std::uint64_t version = 0;
 
+  bool pair_testable(std::size_t a, std::size_t b) const {
+    return a != b && bodies[a].enabled && bodies[b].enabled &&
+           !(bodies[a].is_static && bodies[b].is_static) && !allowed[a][b];
+  }
+
   void refresh_pairs() {
     ++version;
     const std::size_t n = bodies.size();
@@ -54,10 +59,29 @@ struct CollisionModelImpl {
       if (bodies[a].enabled && !bodies[a].geometries.empty()) {
         shaped_bodies.push_back(static_cast<int>(a));
       }
-      for (std::size_t b = 0; b < n; ++b) {
-        testable[a * n + b] = a != b && bodies[a].enabled && bodies[b].enabled &&
-                              !(bodies[a].is_static && bodies[b].is_static) && !allowed[a][b];
-      }
+      for (std::size_t b = 0; b < n; ++b) testable[a * n + b] = pair_testable(a, b);
+    }
+  }
+
+  // The same for a body just appended (the highest index), touching only its row and column: a
+  // world adds some sixty bodies one by one, and a full refresh each time was half its build.
+  void append_pairs() {
+    ++version;
+    const std::size_t n = bodies.size();
+    const std::size_t last = n - 1;
+    std::vector<unsigned char> grown(n * n, 0);
+    for (std::size_t a = 0; a < last; ++a) {
+      std::copy_n(testable.begin() + static_cast<std::ptrdiff_t>(a * last), last,
+                  grown.begin() + static_cast<std::ptrdiff_t>(a * n));
+      grown[a * n + last] = pair_testable(a, last);
+      grown[last * n + a] = pair_testable(last, a);
+    }
+    testable.swap(grown);
+    if (bodies[last].enabled && !bodies[last].is_static) {
+      moving_bodies.push_back(static_cast<int>(last));
+    }
+    if (bodies[last].enabled && !bodies[last].geometries.empty()) {
+      shaped_bodies.push_back(static_cast<int>(last));
     }
   }
 };
@@ -129,6 +153,29 @@ FclGeometry make_geometry(const GeometrySpec& spec) {
   return g;
 }
 
+// Appends a body with its shapes in place, so that the pairs know it has shapes (a mesh body
+// added last once went untested by the subset query: its shape came after the refresh).
+int append_body(CollisionModelImpl& m, const std::string& name, std::vector<FclGeometry> geometries,
+                std::vector<Pose> offsets, bool is_static, const Pose& pose) {
+  for (const auto& b : m.bodies) {
+    if (b.name == name) {
+      throw InputError("collision scene", "body '" + name + "'", "a unique body name",
+                       "a duplicate");
+    }
+  }
+  BodyModel body;
+  body.name = name;
+  body.is_static = is_static;
+  body.initial_pose = pose;
+  body.geometries = std::move(geometries);
+  body.offsets = std::move(offsets);
+  m.bodies.push_back(std::move(body));
+  for (auto& row : m.allowed) row.push_back(false);
+  m.allowed.emplace_back(m.bodies.size(), false);
+  m.append_pairs();
+  return static_cast<int>(m.bodies.size()) - 1;
+}
+
 }  // namespace
 
 CollisionModel::CollisionModel() : impl_(std::make_unique<CollisionModelImpl>()) {}
@@ -138,30 +185,19 @@ CollisionModel& CollisionModel::operator=(CollisionModel&&) noexcept = default;
 
 int CollisionModel::add_body(const std::string& name, const std::vector<GeometrySpec>& shapes,
                              bool is_static, const Pose& pose) {
-  if (find_body(name)) {
-    throw InputError("collision scene", "body '" + name + "'", "a unique body name", "a duplicate");
-  }
-  BodyModel body;
-  body.name = name;
-  body.is_static = is_static;
-  body.initial_pose = pose;
+  std::vector<FclGeometry> geometries;
+  std::vector<Pose> offsets;
   for (const auto& s : shapes) {
-    body.geometries.push_back(make_geometry(s));
-    body.offsets.push_back(s.origin);
+    geometries.push_back(make_geometry(s));
+    offsets.push_back(s.origin);
   }
-  impl_->bodies.push_back(std::move(body));
-  for (auto& row : impl_->allowed) row.push_back(false);
-  impl_->allowed.emplace_back(impl_->bodies.size(), false);
-  impl_->refresh_pairs();
-  return num_bodies() - 1;
+  return append_body(*impl_, name, std::move(geometries), std::move(offsets), is_static, pose);
 }
 
 int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& mesh, bool is_static,
                                   const Pose& pose) {
-  const int id = add_body(name, {}, is_static, pose);
-  impl_->bodies[id].geometries.push_back(make_mesh_geometry(mesh, Eigen::Vector3d::Ones()));
-  impl_->bodies[id].offsets.push_back(Pose::Identity());
-  return id;
+  return append_body(*impl_, name, {make_mesh_geometry(mesh, Eigen::Vector3d::Ones())},
+                     {Pose::Identity()}, is_static, pose);
 }
 
 void CollisionModel::allow(int a, int b) {

@@ -408,6 +408,23 @@ TEST(Collision, AllowedStaticAndDisabledPairsAreSkipped) {
   test::expect_input_error([&] { model.allow("c", "nope"); }, {"nope"});
 }
 
+// A scene's mesh obstacle is the last body the world adds: the subset query (the planner's and
+// the validator's) must see it as it sees one added earlier.
+TEST(Collision, AMeshBodyAddedLastIsSeenByTheSubsetQuery) {
+  core::CollisionModel model;
+  const int link = model.add_body("link", {box(0.2, 0.2, 0.2)}, false);
+  const int obstacle = model.add_mesh_body("obstacle", core::make_box_mesh({0.3, 0.3, 0.3}), true,
+                                           core::make_pose({0.1, 0.0, 0.0}));
+  core::CollisionData data(model);
+  core::CollisionPair pair;
+  EXPECT_TRUE(core::in_collision_brute_force(model, data, std::vector<int>{link}));
+  ASSERT_TRUE(core::in_collision(model, data, std::vector<int>{link}, &pair));
+  EXPECT_EQ(pair.body_b, obstacle);
+  EXPECT_TRUE(core::in_collision(model, data));
+  data.set_body_pose(link, core::make_pose({1.0, 0.0, 0.0}));
+  EXPECT_FALSE(core::in_collision(model, data, std::vector<int>{link}));
+}
+
 TEST(Collision, ARigidPartsOwnContactIsFoundByTheAmongQueryOnly) {
   core::CollisionModel model;
   const int palm = model.add_body("palm", {box(0.1, 0.1, 0.1)}, false);

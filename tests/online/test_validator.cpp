@@ -217,6 +217,26 @@ TEST(Validator, ASceneObstacleOnThePathIsACollisionAndItsAbsenceIsNot) {
       << describe(report);
 }
 
+// The same with a mesh obstacle: the world adds it last, and it once went unchecked.
+TEST(Validator, AMeshObstacleOnThePathIsACollision) {
+  Fixture f;
+  const Eigen::VectorXd a = f.left_at({0.40, 0.25, 1.35});
+  const Eigen::VectorXd b = f.left_at({0.40, 0.05, 1.35});
+  const online::Motion m = slow_motion("left", {a, b});
+  const core::Pose mid = core::arm_base_in_world(*f.cell, f.left) * f.left.chain.fk(0.5 * (a + b));
+  online::Scene s = f.scene;
+  online::SceneObstacle jig;
+  jig.name = "jig";
+  jig.mesh_file = "jig.stl";  // as loaded from a scene file
+  jig.mesh = core::make_box_mesh({0.06, 0.06, 0.06});
+  jig.pose = core::Pose(Eigen::Translation3d(mid.translation()));
+  s.obstacles.push_back(jig);
+  const auto report = f.run(m, s);
+  ASSERT_TRUE(has(report, "collision")) << describe(report);
+  EXPECT_NE(report.violations.front().detail.find("obstacle/jig"), std::string::npos)
+      << describe(report);
+}
+
 TEST(Validator, FinishedBoardsStandWhereTheSceneSays) {
   Fixture f;
   // The base finished at a measured pose (not its target): lying on the table under the
