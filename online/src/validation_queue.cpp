@@ -1,5 +1,6 @@
 #include "hila/online/validation_queue.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <exception>
@@ -32,7 +33,9 @@ std::size_t ValidationQueue::submit(Motion motion, Finish finish) {
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     job = jobs_.size();
-    jobs_.push_back({std::move(motion), std::move(finish), {}, false, false});
+    Job& added = jobs_.emplace_back();
+    added.motion = std::move(motion);
+    added.finish = std::move(finish);
     ++waiting_;
   }
   changed_.notify_all();
@@ -42,20 +45,20 @@ std::size_t ValidationQueue::submit(Motion motion, Finish finish) {
 void ValidationQueue::wait_all(const std::vector<std::size_t>& jobs) {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
-    std::size_t first = jobs_.size();  // the lowest waited-for job not started
+    std::size_t first = jobs_.size();  // the lowest waited-for job with work
     bool all_done = true;
     for (const std::size_t j : jobs) {
       assert(j < jobs_.size());
       const Job& job = jobs_[j];
       if (job.done) continue;
       all_done = false;
-      if (!job.started) first = std::min(first, j);
+      if (has_work(job)) first = std::min(first, j);
     }
     if (all_done) return;
     if (first < jobs_.size()) {
       run(lock, first, caller_data_, kCallerSlot);
     } else {
-      changed_.wait(lock);  // the worker has the rest
+      changed_.wait(lock);  // the worker has the rest under way
     }
   }
 }
@@ -64,8 +67,9 @@ const ValidationReport& ValidationQueue::wait(std::size_t job) {
   std::unique_lock<std::mutex> lock(mutex_);
   assert(job < jobs_.size());
   while (!jobs_[job].done) {
-    if (has_next()) {
-      run_next(lock, caller_data_, kCallerSlot);
+    const std::size_t next = next_work();
+    if (next < jobs_.size()) {
+      run(lock, next, caller_data_, kCallerSlot);
     } else {
       changed_.wait(lock);
     }
@@ -76,8 +80,9 @@ const ValidationReport& ValidationQueue::wait(std::size_t job) {
 void ValidationQueue::drain() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
-    if (has_next()) {
-      run_next(lock, caller_data_, kCallerSlot);
+    const std::size_t next = next_work();
+    if (next < jobs_.size()) {
+      run(lock, next, caller_data_, kCallerSlot);
     } else if (running_ > 0) {
       changed_.wait(lock);
     } else {
@@ -91,18 +96,39 @@ void ValidationQueue::discard(std::size_t job) {
     const std::lock_guard<std::mutex> lock(mutex_);
     assert(job < jobs_.size());
     Job& j = jobs_[job];
-    if (!j.started) {  // done, unvalidated: no longer waiting (backlog()), never to be run
-      j.started = true;
-      j.done = true;
-      --waiting_;
+    if (!j.done && !j.discarded) {
+      j.discarded = true;  // has_work() no longer hands out any of it
+      if (!j.started) {    // no longer waiting (backlog()), never to be run
+        j.started = true;
+        --waiting_;
+        complete(j);
+      } else if (j.check && j.parts_done == j.parts_out) {
+        complete(j);
+      }  // else its start or a part is under way, and completes it when done
     }
   }
   changed_.notify_all();
 }
 
-bool ValidationQueue::has_next() {
-  while (next_ < jobs_.size() && jobs_[next_].started) ++next_;
-  return next_ < jobs_.size();
+bool ValidationQueue::has_work(const Job& job) {
+  if (job.done || job.discarded) return false;
+  if (!job.started) return true;
+  return job.check && job.parts_out < job.check->parts();
+}
+
+std::size_t ValidationQueue::next_work() {
+  // Jobs before scan_from_ are done or have every part handed out.
+  while (scan_from_ < jobs_.size()) {
+    const Job& job = jobs_[scan_from_];
+    const bool spent =
+        job.done || job.discarded || (job.check && job.parts_out == job.check->parts());
+    if (!spent) break;
+    ++scan_from_;
+  }
+  for (std::size_t j = scan_from_; j < jobs_.size(); ++j) {
+    if (has_work(jobs_[j])) return j;
+  }
+  return jobs_.size();
 }
 
 std::size_t ValidationQueue::backlog() const {
@@ -118,44 +144,83 @@ double ValidationQueue::seconds() const {
 void ValidationQueue::run_worker() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
-    changed_.wait(lock, [this] { return stopping_ || has_next(); });
+    std::size_t next = jobs_.size();
+    changed_.wait(lock, [&] {
+      if (stopping_) return true;
+      next = next_work();
+      return next < jobs_.size();
+    });
     if (stopping_) return;
-    run_next(lock, worker_data_, kWorkerSlot);
+    run(lock, next, worker_data_, kWorkerSlot);
   }
 }
 
-void ValidationQueue::run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data,
-                               std::size_t slot) {
-  run(lock, next_, data, slot);
+void ValidationQueue::complete(Job& job) {
+  if (job.discarded) {
+    job.report = {};
+  } else if (!job.error.empty()) {
+    // Out of memory, say: the motion is not known to be valid, so it is not.
+    job.report = {};
+    job.report.violations.push_back({"internal", 0.0, job.error});
+  } else {
+    job.report = job.check->report();
+  }
+  job.check.reset();  // the samples are no longer needed
+  job.done = true;
 }
 
 void ValidationQueue::run(std::unique_lock<std::mutex>& lock, std::size_t index,
                           core::CollisionData& data, std::size_t slot) {
   Job& job = jobs_[index];
-  assert(!job.started);
-  job.started = true;
-  --waiting_;
+  assert(has_work(job));
   ++running_;
-  lock.unlock();
-  auto started = std::chrono::steady_clock::now();
-  ValidationReport report;
-  try {
-    if (job.finish) {
-      job.finish(slot, job.motion);
-      started = std::chrono::steady_clock::now();  // seconds() counts the validation only
+  if (!job.started) {
+    // Its start: the finish, then the samples made; its parts follow, taken by either thread.
+    job.started = true;
+    --waiting_;
+    lock.unlock();
+    double took = 0.0;
+    std::string error;
+    try {
+      if (job.finish) job.finish(slot, job.motion);
+      const auto started = std::chrono::steady_clock::now();  // seconds() counts validation only
+      job.check.emplace(world_, job.motion, settings_);
+      took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    } catch (const std::exception& e) {
+      error = e.what();
     }
-    report = validate_motion(world_, data, job.motion, settings_);
+    lock.lock();
+    --running_;
+    seconds_ += took;
+    if (!error.empty()) job.error = error;
+    if (!job.check || job.discarded || job.check->parts() == 0) complete(job);
+    changed_.notify_all();
+    return;
+  }
+  // A quarter of the parts left (at least one): a thread alone on a long motion poses the robot
+  // a few times rather than once per part, and another thread arriving still finds parts.
+  const std::size_t left = job.check->parts() - job.parts_out;
+  const std::size_t first = job.parts_out;
+  const std::size_t last = first + std::max<std::size_t>(1, (left + 3) / 4);
+  job.parts_out = last;
+  lock.unlock();
+  const auto started = std::chrono::steady_clock::now();
+  std::string error;
+  try {
+    job.check->check_parts(first, last, data);
   } catch (const std::exception& e) {
-    // Out of memory, say: the motion is not known to be valid, so it is not.
-    report.violations.push_back({"internal", 0.0, e.what()});
+    error = e.what();
   }
   const double took =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   lock.lock();
-  job.report = std::move(report);
-  job.done = true;
   --running_;
   seconds_ += took;
+  if (!error.empty()) job.error = error;
+  job.parts_done += last - first;
+  if (job.parts_done == job.parts_out && (job.discarded || job.parts_out == job.check->parts())) {
+    complete(job);
+  }
   changed_.notify_all();
 }
 

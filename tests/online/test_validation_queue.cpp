@@ -222,3 +222,55 @@ TEST(ValidationQueue, WaitAllRunsOnlyTheJobsItWaitsFor) {
     EXPECT_EQ(describe(queue.wait(jobs[j])), alone[j % motions.size()]) << "job " << j;
   }
 }
+
+// Long motions (several MotionValidation parts each), one into the table late in its path: the
+// caller waiting for the last job takes parts of whatever the worker has started. Each report is
+// the motion's alone, however the parts were shared; a long job discarded after it started
+// comes back unvalidated or whole, never half-validated, and the queue goes on.
+TEST(ValidationQueue, ALongMotionsPartsSharedByBothThreadsGiveItsReport) {
+  Fixture f;
+  const Eigen::VectorXd above = f.left_at({0.40, 0.20, 1.30});
+  const Eigen::VectorXd inside = f.left_at({0.40, 0.20, 1.084});
+  std::vector<online::Motion> motions;
+  for (const auto& path : std::vector<std::vector<Eigen::VectorXd>>{
+           {f.left.spec.home, above, f.left.spec.home, above, inside},
+           {f.left.spec.home, above, f.left.spec.home, above, f.left.spec.home, above}}) {
+    online::Motion m = f.motions().front();
+    m.q = path;
+    m.time.clear();
+    for (std::size_t i = 0; i < path.size(); ++i) m.time.push_back(4.0 * static_cast<double>(i));
+    motions.push_back(m);
+  }
+  core::CollisionData data = f.world.make_data();
+  std::vector<std::string> alone;
+  for (const auto& m : motions) {
+    const auto report = online::validate_motion(f.world, data, m);
+    ASSERT_GE(report.samples, static_cast<int>(3 * online::MotionValidation::kPartSamples));
+    alone.push_back(describe(report));
+  }
+  ASSERT_NE(alone[0].find("collision"), std::string::npos) << alone[0];
+  ASSERT_EQ(alone[1].find('@'), std::string::npos) << alone[1];
+
+  core::CollisionData worker = f.world.make_data();
+  core::CollisionData caller = f.world.make_data();
+  online::ValidationQueue queue(f.world, {}, worker, caller);
+  for (int round = 0; round < 6; ++round) {
+    std::vector<std::size_t> jobs;
+    for (int k = 0; k < 3; ++k) {
+      for (const auto& m : motions) jobs.push_back(queue.submit(m));
+    }
+    if (round % 2 == 1) {
+      queue.discard(jobs[1]);  // likely under way on the worker by now
+      const auto& r = queue.wait(jobs[1]);
+      EXPECT_TRUE(r.samples == 0 ? r.violations.empty() : describe(r) == alone[1]) << describe(r);
+      jobs.erase(jobs.begin() + 1);
+    }
+    queue.wait_all({jobs.back()});
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      const std::size_t which = round % 2 == 1 && i >= 1 ? (i + 1) % 2 : i % 2;
+      EXPECT_EQ(describe(queue.wait(jobs[i])), alone[which]) << "round " << round << " job " << i;
+    }
+  }
+  queue.drain();
+  EXPECT_EQ(queue.backlog(), 0u);
+}

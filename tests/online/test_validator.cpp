@@ -112,6 +112,46 @@ TEST(Validator, ALongMotionSplitOverThreadsReportsTheSameFirstContact) {
   }
 }
 
+// MotionValidation's parts checked one by one in reverse order, alternating between two
+// CollisionData (as the queue's two threads may take them), or in uneven ranges: the report is
+// validate_motion's, the first contact and the worst slip included. A held board over a long
+// motion into the table and back, so that collisions and slip fall in several parts.
+TEST(Validator, PartsCheckedInAnyOrderGiveTheWholeMotionsReport) {
+  Fixture f;
+  const Eigen::VectorXd above = f.left_at({0.40, 0.20, 1.30});
+  const Eigen::VectorXd inside = f.left_at({0.40, 0.20, 1.084});
+  Eigen::VectorXd tilted = above;
+  tilted[4] += 0.8;
+  online::Motion m =
+      slow_motion("left", {f.left.spec.home, above, inside, above, tilted, f.left.spec.home});
+  m.holds_board = true;
+  m.board_in_tcp = core::Pose(Eigen::Translation3d(0.0, 0.0, 0.15));
+  m.slip_axis_tcp = Eigen::Vector3d::UnitY();
+  m.slip_lever_tcp = Eigen::Vector3d::UnitZ();
+  m.theta_c_deg = 20.0;
+  const online::World world(*f.cell, cabinet(), f.scene, "top");
+  core::CollisionData a = world.make_data();
+  core::CollisionData b = world.make_data();
+  const std::string whole = describe(online::validate_motion(world, a, m));
+  ASSERT_NE(whole.find("collision"), std::string::npos) << whole;
+  ASSERT_NE(whole.find("slip"), std::string::npos) << whole;
+
+  online::MotionValidation reversed(world, m, {});
+  ASSERT_GE(reversed.parts(), 4u) << "long enough for several parts";
+  for (std::size_t p = reversed.parts(); p-- > 0;) reversed.check_parts(p, p + 1, p % 2 ? a : b);
+  const online::ValidationReport r = reversed.report();
+  EXPECT_EQ(describe(r), whole);
+  EXPECT_EQ(r.samples, online::validate_motion(world, b, m).samples);
+  EXPECT_EQ(r.worst_slip_deg, online::validate_motion(world, b, m).worst_slip_deg);
+
+  online::MotionValidation uneven(world, m, {});
+  const std::size_t n = uneven.parts();
+  uneven.check_parts(n - 1, n, a);
+  uneven.check_parts(1, n - 1, b);
+  uneven.check_parts(0, 1, b);
+  EXPECT_EQ(describe(uneven.report()), whole);
+}
+
 TEST(Validator, AJointJumpIsAVelocityViolation) {
   Fixture f;
   Eigen::VectorXd to = f.left.spec.home;

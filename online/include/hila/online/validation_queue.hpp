@@ -5,6 +5,8 @@
 #include <deque>
 #include <functional>
 #include <mutex>
+#include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -16,10 +18,12 @@ namespace hila::online {
 
 // Validates motions on a second thread while the caller plans the next ones: the planner uses
 // one core and the validator's dense pass is as much work again, so on two cores most of it
-// overlaps. Jobs run in submission order. A caller waiting for a report validates the queued
-// jobs itself meanwhile (with its own CollisionData), so nothing stands idle at the end. A
-// report depends only on its motion (validate_motion poses everything it checks), never on which
-// thread made it or when: plans stay deterministic.
+// overlaps. Jobs run in submission order. A caller waiting for a report validates queued work
+// itself meanwhile (with its own CollisionData): whole jobs not yet started, and the parts of a
+// started one (MotionValidation) the worker has not taken, so that at the end both threads share
+// the last long motion instead of one waiting for the other. A report depends only on its motion
+// (validate_motion poses everything it checks), never on which thread checked which part or
+// when: plans stay deterministic.
 //
 // A job may first finish its motion (`Finish`: e.g. smooth the found path and time it) on the
 // thread that takes it, so that work leaves the planner's thread as well. The finish gets the
@@ -52,8 +56,8 @@ class ValidationQueue {
   // started itself, lowest first, and no others: the jobs it does not wait for stay queued for
   // the worker (the attempts a plan did not use, say, need not hold up the one it did).
   void wait_all(const std::vector<std::size_t>& jobs);
-  // The job's report is no longer wanted: it is not validated unless it already started (then
-  // it finishes); one not started is done at once, with an empty report.
+  // The job's report is no longer wanted: one not started is done at once, one started stops
+  // after the parts under way; either comes back unvalidated (an empty report, no samples).
   void discard(std::size_t job);
   // Jobs submitted and not yet started, discarded ones left out.
   std::size_t backlog() const;
@@ -65,18 +69,26 @@ class ValidationQueue {
     Motion motion;
     Finish finish;
     ValidationReport report;
-    bool started = false;
+    std::optional<MotionValidation> check;  // made once finished; its parts are handed out
+    std::size_t parts_out = 0;              // parts handed out
+    std::size_t parts_done = 0;
+    std::string error;       // what threw, if anything did
+    bool started = false;    // taken: being finished, then its parts handed out
+    bool discarded = false;  // no part handed out from now on
     bool done = false;
   };
-  void run_worker();
-  // Whether a job waits to be started (a discarded one counts as started and done). Under the
+  // Whether the job has work for a thread: its start, or parts not yet handed out. Under the
   // lock.
-  bool has_next();
-  // Validates the first job not yet started; the lock is released meanwhile.
-  void run_next(std::unique_lock<std::mutex>& lock, core::CollisionData& data, std::size_t slot);
-  // Validates job `index` (not started); the lock is released meanwhile.
+  static bool has_work(const Job& job);
+  // The lowest job with work, or jobs_.size(). Under the lock.
+  std::size_t next_work();
+  void run_worker();
+  // Does one piece of job `index`'s work (has_work): its start (the finish and the
+  // MotionValidation), or some of its parts. The lock is released meanwhile.
   void run(std::unique_lock<std::mutex>& lock, std::size_t index, core::CollisionData& data,
            std::size_t slot);
+  // The job's report, once nothing of it is under way. Under the lock.
+  void complete(Job& job);
 
   const World& world_;
   ValidatorSettings settings_;
@@ -84,10 +96,10 @@ class ValidationQueue {
   core::CollisionData& caller_data_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::deque<Job> jobs_;     // references to elements stay valid as it grows
-  std::size_t next_ = 0;     // no job before it waits to be started
-  std::size_t waiting_ = 0;  // jobs not started and not discarded
-  std::size_t running_ = 0;  // jobs being validated
+  std::deque<Job> jobs_;       // references to elements stay valid as it grows
+  std::size_t scan_from_ = 0;  // no job before it has work or will have
+  std::size_t waiting_ = 0;    // jobs not started and not discarded
+  std::size_t running_ = 0;    // pieces of work under way
   double seconds_ = 0.0;
   bool stopping_ = false;
   std::thread worker_;

@@ -62,4 +62,42 @@ ValidationReport validate_motion(const World& world, core::CollisionData& data,
 ValidationReport validate_motion(const World& world, const std::vector<core::CollisionData*>& data,
                                  const Motion& motion, const ValidatorSettings& settings = {});
 
+// validate_motion in parts that separate threads may check (ValidationQueue shares a long
+// motion's parts between its two threads): made with the format and rate checks and the dense
+// samples; then each part of kPartSamples consecutive samples is checked on its own, with the
+// checking thread's CollisionData; the report once every part is. The parts depend on the motion
+// alone, and the report is validate_motion's however they are spread. `world` and `motion` must
+// outlive it.
+class MotionValidation {
+ public:
+  // A part's set-up (posing the whole robot, the tool, the rigid tip's own pairs) is some tens
+  // of samples' work: parts much smaller would cost more than they share.
+  static constexpr std::size_t kPartSamples = 256;
+
+  MotionValidation(const World& world, const Motion& motion, const ValidatorSettings& settings);
+  // 0 when the format is wrong (the report says why) or the arm unknown.
+  std::size_t parts() const { return findings_.size(); }
+  // Checks parts [first, last) in one pass. Disjoint ranges may be checked at once, each on its
+  // own thread with its own data.
+  void check_parts(std::size_t first, std::size_t last, core::CollisionData& data);
+  // Once every part is checked.
+  ValidationReport report() const;
+
+  struct Findings {  // one part's: the first violation of each kind, the worst slip
+    std::vector<Violation> violations;
+    double worst_slip_deg = 0.0;
+  };
+
+ private:
+  const World& world_;
+  const Motion& motion_;
+  ValidatorSettings settings_;
+  const core::Arm* arm_ = nullptr;
+  std::size_t arm_index_ = 0;
+  ValidationReport head_;    // the format and rate checks
+  Eigen::MatrixXd samples_;  // one column per sample, in time order
+  std::vector<double> times_;
+  std::vector<Findings> findings_;  // per part
+};
+
 }  // namespace hila::online
