@@ -4,6 +4,7 @@
 #include <cassert>
 #include <chrono>
 #include <exception>
+#include <memory>
 #include <system_error>
 #include <utility>
 
@@ -181,10 +182,11 @@ void ValidationQueue::run(std::unique_lock<std::mutex>& lock, std::size_t index,
     lock.unlock();
     double took = 0.0;
     std::string error;
+    std::unique_ptr<MotionValidation> made;  // handed to the job under the lock
     try {
       if (job.finish) job.finish(slot, job.motion);
       const auto started = std::chrono::steady_clock::now();  // seconds() counts validation only
-      job.check.emplace(world_, job.motion, settings_);
+      made = std::make_unique<MotionValidation>(world_, job.motion, settings_);
       took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     } catch (const std::exception& e) {
       error = e.what();
@@ -192,6 +194,7 @@ void ValidationQueue::run(std::unique_lock<std::mutex>& lock, std::size_t index,
     lock.lock();
     --running_;
     seconds_ += took;
+    job.check = std::move(made);
     if (!error.empty()) job.error = error;
     if (!job.check || job.discarded || job.check->parts() == 0) complete(job);
     changed_.notify_all();

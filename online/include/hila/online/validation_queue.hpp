@@ -4,8 +4,8 @@
 #include <cstddef>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <mutex>
-#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -69,8 +69,8 @@ class ValidationQueue {
     Motion motion;
     Finish finish;
     ValidationReport report;
-    std::optional<MotionValidation> check;  // made once finished; its parts are handed out
-    std::size_t parts_out = 0;              // parts handed out
+    std::unique_ptr<MotionValidation> check;  // made once finished; its parts are handed out
+    std::size_t parts_out = 0;                // parts handed out
     std::size_t parts_done = 0;
     std::string error;       // what threw, if anything did
     bool started = false;    // taken: being finished, then its parts handed out
