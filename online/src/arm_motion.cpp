@@ -133,7 +133,9 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
     node_state_.assign(roadmap_.record.nodes.size(), -1);
     edge_state_.assign(edges, -1);
     blocked_edges_.clear();
+    components_.clear();
   }
+  filter_ = request.filter;
   // No filter: every edge (a held board's slip and clearance are then checked lazily, as all).
   assert(request.filter == nullptr || request.filter->size() == edges);
   if (request.filter != nullptr) {
@@ -256,6 +258,37 @@ bool ArmMotionPlanner::node_valid(int node) {
     }
   }
   return false;
+}
+
+const std::vector<int>* ArmMotionPlanner::components() const {
+  for (const auto& c : components_) {
+    if (c.filter == filter_) return &c.label;
+  }
+  return nullptr;
+}
+
+void ArmMotionPlanner::learn_components() {
+  if (components() != nullptr) return;
+  components_.push_back({filter_, core::connected_components(roadmap_.graph.node_count(),
+                                                             roadmap_.record.edges, allowed_)});
+}
+
+bool ArmMotionPlanner::ends_apart(const std::vector<core::GraphEndpoint>& entries,
+                                  const std::vector<core::GraphEndpoint>& exits) const {
+  const std::vector<int>* label = components();
+  if (label == nullptr) return false;
+  const auto n = static_cast<int>(label->size());
+  for (const auto& a : entries) {
+    if (a.node < 0 || a.node >= n) continue;
+    for (const auto& b : exits) {
+      if (b.node >= 0 && b.node < n &&
+          (*label)[static_cast<std::size_t>(a.node)] ==
+              (*label)[static_cast<std::size_t>(b.node)]) {
+        return false;
+      }
+    }
+  }
+  return true;
 }
 
 bool ArmMotionPlanner::edge_valid(int edge) {
@@ -610,9 +643,13 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     while (!entries.empty() && !exits.empty() && r.searches < max_searches) {
       if (late()) return false;
       ++r.searches;
+      const bool apart = ends_apart(entries, exits);
       const core::GraphPath path =
-          core::shortest_path(roadmap_.graph, allowed_, entries, exits, search_);
+          apart ? core::GraphPath{}
+                : core::shortest_path(roadmap_.graph, allowed_, entries, exits, search_);
+      r.nodes_expanded += path.expanded;
       if (!path.found) {
+        if (!apart) learn_components();
         // Unchecked joins may stand in for nodes whose joins hold into another part of the roadmap.
         if (!entries_checked) {
           check_entries();

@@ -574,6 +574,71 @@ TEST(ArmMotion, ABlockedNodeIsDroppedWithAllItsEdgesAtOnce) {
   FAIL() << "no detour around the crated node holds (" << tried << " tried)";
 }
 
+// Two short chains of nodes, one around the start and one around the goal, joined by one edge
+// that the grasp's filter leaves out; a crate blocks the straight motion. The first plan
+// searches (A* expands the start's chain) and fails; asked again under the same context and
+// filter, it fails the same way without A* expanding a node: the filtered roadmap's components
+// are known, and no entry shares one with an exit. A fresh planner expands as the first did;
+// with every edge allowed the same planner searches anew (each filter has its own components).
+TEST(ArmMotion, EndsTheFilteredRoadmapDoesNotJoinAreNotSearchedAgain) {
+  const auto& cell = *test::reference_cell();
+  const core::Arm& left = cell.arm("left");
+  const Eigen::VectorXd s = left.spec.home;
+  Eigen::VectorXd g = s;
+  g[0] += 0.8;
+  online::Scene crated = online::nominal_scene(cell, cabinet());
+  const core::Pose tcp = core::arm_base_in_world(cell, left) * left.chain.fk(0.5 * (s + g));
+  crated.obstacles.push_back(crate_at(tcp.translation(), 0.12));
+  const online::World world(cell, cabinet(), crated, "top");
+  online::MotionSettings settings;
+  settings.repair_checks = 0;
+  for (int joint = 1; joint < 6; ++joint) {
+    std::vector<Eigen::VectorXd> nodes;
+    std::vector<std::pair<int, int>> edges;
+    for (const Eigen::VectorXd& end : {s, g}) {
+      const int first = static_cast<int>(nodes.size());
+      for (int k = 0; k < 7; ++k) {  // more than an end attaches to: all in its own chain
+        Eigen::VectorXd q = end;
+        q[joint] += 0.04 * k;
+        nodes.push_back(q);
+        if (k > 0) edges.emplace_back(first + k - 1, first + k);
+      }
+    }
+    edges.emplace_back(6, 13);  // the chains' far ends: the only way across
+    std::vector<bool> cut(edges.size(), true);
+    cut.back() = false;
+    const online::ArmRoadmap roadmap(roadmap_of(nodes, edges));
+    online::ArmMotionPlanner planner(world, roadmap, "left", settings);
+    online::MotionRequest r = request(s, g);
+    r.filter = &cut;
+    r.allow_bridge = false;
+    planner.prepare(r);
+    bool premises = !planner.segment_valid(s, g);
+    for (std::size_t k = 1; k < nodes.size(); ++k) {
+      premises = premises && planner.valid(nodes[k]) &&
+                 (k == 7 || planner.segment_valid(nodes[k - 1], nodes[k]));
+    }
+    if (!premises) continue;
+    const auto once = planner.plan(r);
+    ASSERT_FALSE(once.solved()) << once.via;
+    ASSERT_GT(once.nodes_expanded, 0);
+    const auto again = planner.plan(r);
+    EXPECT_EQ(again.status, once.status);
+    EXPECT_EQ(again.reason, once.reason);
+    EXPECT_EQ(again.searches, once.searches);
+    EXPECT_EQ(again.nodes_expanded, 0) << "searched again though its ends are apart";
+    online::ArmMotionPlanner fresh(world, roadmap, "left", settings);
+    const auto anew = fresh.plan(r);
+    EXPECT_EQ(anew.reason, once.reason);
+    EXPECT_EQ(anew.nodes_expanded, once.nodes_expanded);
+    online::MotionRequest every_edge = r;
+    every_edge.filter = nullptr;
+    EXPECT_GT(planner.plan(every_edge).nodes_expanded, 0);
+    return;
+  }
+  FAIL() << "no joint gives two valid chains around a blocked straight motion";
+}
+
 // A segment found blocked is not sampled again for the same request (the straight motion is
 // asked again as the first shortcut of the path found): the same verdict without a check, until
 // the next prepare(); the other direction is its own segment.
