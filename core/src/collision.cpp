@@ -155,14 +155,18 @@ FclGeometry make_geometry(const GeometrySpec& spec) {
 
 // Appends a body with its shapes in place, so that the pairs know it has shapes (a mesh body
 // added last once went untested by the subset query: its shape came after the refresh).
-int append_body(CollisionModelImpl& m, const std::string& name, std::vector<FclGeometry> geometries,
-                std::vector<Pose> offsets, bool is_static, const Pose& pose) {
+void require_new_name(const CollisionModelImpl& m, const std::string& name) {
   for (const auto& b : m.bodies) {
     if (b.name == name) {
       throw InputError("collision scene", "body '" + name + "'", "a unique body name",
                        "a duplicate");
     }
   }
+}
+
+int append_body(CollisionModelImpl& m, const std::string& name, std::vector<FclGeometry> geometries,
+                std::vector<Pose> offsets, bool is_static, const Pose& pose) {
+  require_new_name(m, name);
   BodyModel body;
   body.name = name;
   body.is_static = is_static;
@@ -185,6 +189,7 @@ CollisionModel& CollisionModel::operator=(CollisionModel&&) noexcept = default;
 
 int CollisionModel::add_body(const std::string& name, const std::vector<GeometrySpec>& shapes,
                              bool is_static, const Pose& pose) {
+  require_new_name(*impl_, name);  // before any mesh is loaded: the error names the real fault
   std::vector<FclGeometry> geometries;
   std::vector<Pose> offsets;
   for (const auto& s : shapes) {
@@ -196,6 +201,7 @@ int CollisionModel::add_body(const std::string& name, const std::vector<Geometry
 
 int CollisionModel::add_mesh_body(const std::string& name, const TriangleMesh& mesh, bool is_static,
                                   const Pose& pose) {
+  require_new_name(*impl_, name);
   return append_body(*impl_, name, {make_mesh_geometry(mesh, Eigen::Vector3d::Ones())},
                      {Pose::Identity()}, is_static, pose);
 }

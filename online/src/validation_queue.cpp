@@ -5,10 +5,26 @@
 #include <chrono>
 #include <exception>
 #include <memory>
+#include <optional>
 #include <system_error>
 #include <utility>
 
 namespace hila::online {
+
+namespace {
+
+// What a piece of work threw, never empty: an empty message must still count as a failure.
+std::string describe_current_exception() {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    return *e.what() != '\0' ? e.what() : "an exception without a message";
+  } catch (...) {
+    return "an exception of unknown type";
+  }
+}
+
+}  // namespace
 
 ValidationQueue::ValidationQueue(const World& world, const ValidatorSettings& settings,
                                  core::CollisionData& worker_data, core::CollisionData& caller_data)
@@ -112,7 +128,8 @@ void ValidationQueue::discard(std::size_t job) {
 }
 
 bool ValidationQueue::has_work(const Job& job) {
-  if (job.done || job.discarded) return false;
+  // A job that failed (job.failed) is not valid whatever its other parts find.
+  if (job.done || job.discarded || job.failed) return false;
   if (!job.started) return true;
   return job.check && job.parts_out < job.check->parts();
 }
@@ -121,8 +138,8 @@ std::size_t ValidationQueue::next_work() {
   // Jobs before scan_from_ are done or have every part handed out.
   while (scan_from_ < jobs_.size()) {
     const Job& job = jobs_[scan_from_];
-    const bool spent =
-        job.done || job.discarded || (job.check && job.parts_out == job.check->parts());
+    const bool spent = job.done || job.discarded || job.failed ||
+                       (job.check && job.parts_out == job.check->parts());
     if (!spent) break;
     ++scan_from_;
   }
@@ -156,10 +173,17 @@ void ValidationQueue::run_worker() {
   }
 }
 
+void ValidationQueue::fail(Job& job, const std::string& what) {
+  if (!job.failed) job.error = what;  // the first failure's
+  job.failed = true;
+}
+
 void ValidationQueue::complete(Job& job) {
   if (job.discarded) {
+    // Not validated: a report that says so, never one that passes.
     job.report = {};
-  } else if (!job.error.empty()) {
+    job.report.violations.push_back({"discarded", 0.0, "not validated: the job was discarded"});
+  } else if (job.failed) {
     // Out of memory, say: the motion is not known to be valid, so it is not.
     job.report = {};
     job.report.violations.push_back({"internal", 0.0, job.error});
@@ -181,22 +205,22 @@ void ValidationQueue::run(std::unique_lock<std::mutex>& lock, std::size_t index,
     --waiting_;
     lock.unlock();
     double took = 0.0;
-    std::string error;
+    std::optional<std::string> error;
     std::unique_ptr<MotionValidation> made;  // handed to the job under the lock
     try {
       if (job.finish) job.finish(slot, job.motion);
       const auto started = std::chrono::steady_clock::now();  // seconds() counts validation only
       made = std::make_unique<MotionValidation>(world_, job.motion, settings_);
       took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    } catch (const std::exception& e) {
-      error = e.what();
+    } catch (...) {
+      error = describe_current_exception();
     }
     lock.lock();
     --running_;
     seconds_ += took;
     job.check = std::move(made);
-    if (!error.empty()) job.error = error;
-    if (!job.check || job.discarded || job.check->parts() == 0) complete(job);
+    if (error) fail(job, *error);
+    if (job.failed || job.discarded || job.check->parts() == 0) complete(job);
     changed_.notify_all();
     return;
   }
@@ -208,20 +232,22 @@ void ValidationQueue::run(std::unique_lock<std::mutex>& lock, std::size_t index,
   job.parts_out = last;
   lock.unlock();
   const auto started = std::chrono::steady_clock::now();
-  std::string error;
+  std::optional<std::string> error;
   try {
     job.check->check_parts(first, last, data);
-  } catch (const std::exception& e) {
-    error = e.what();
+  } catch (...) {
+    error = describe_current_exception();
   }
   const double took =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   lock.lock();
   --running_;
   seconds_ += took;
-  if (!error.empty()) job.error = error;
+  if (error) fail(job, *error);
   job.parts_done += last - first;
-  if (job.parts_done == job.parts_out && (job.discarded || job.parts_out == job.check->parts())) {
+  // Done once nothing of it is under way and nothing more is handed out.
+  if (job.parts_done == job.parts_out &&
+      (job.discarded || job.failed || job.parts_out == job.check->parts())) {
     complete(job);
   }
   changed_.notify_all();

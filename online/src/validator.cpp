@@ -149,15 +149,28 @@ void MotionValidation::check_parts(std::size_t first, std::size_t last, core::Co
   poser.pose_robot(data, robot_q);
   const int tip_link = cell.robot().link_index(arm.spec.tip_link);  // the TCP, read off the pose
   // The arm's last link, gripper, tool in hand and held board move as one piece through the
-  // motion: their pairs are checked once (at the first sample), then left out of each sample's.
+  // motion: their pairs are checked once (at the motion's first sample), then left out of each
+  // sample's.
   std::vector<int> rigid = core::rigid_tip_bodies(cell.robot(), stage.cell.robot, tip_link);
   if (moves_tool) rigid.insert(rigid.end(), stage.tool_bodies.begin(), stage.tool_bodies.end());
   if (motion.holds_board) rigid.push_back(stage.board);
-  bool rigid_checked = false;
-  bool rigid_collides = false;
-  core::CollisionPair rigid_pair;
   const Eigen::Vector3d down(0.0, 0.0, -1.0);
   Eigen::VectorXd q(samples_.rows());
+  // This arm, the tool in its hand and the board it holds at sample i; the TCP.
+  const auto pose_sample = [&](std::size_t i) -> const core::Pose& {
+    q = samples_.col(static_cast<Eigen::Index>(i));
+    cell.set_arm(robot_q, arm, q);
+    poser.pose_arm(data, robot_q);
+    const core::Pose& tcp = poser.link_pose(tip_link);
+    if (moves_tool) core::set_tool_held(cell, stage, data, tcp);
+    if (motion.holds_board) data.set_body_pose(stage.board, tcp * motion.board_in_tcp);
+    return tcp;
+  };
+  // The rigid part's own verdict at the motion's first sample, whatever range this is: the
+  // same pose on every thread, so the report cannot depend on how the parts were spread.
+  pose_sample(0);
+  core::CollisionPair rigid_pair;
+  const bool rigid_collides = core::in_collision_among(stage.cell.model, data, rigid, &rigid_pair);
   for (std::size_t part = first; part < last; ++part) {
     ValidationReport local;
     Reporter violation(local);
@@ -165,17 +178,12 @@ void MotionValidation::check_parts(std::size_t first, std::size_t last, core::Co
     found.worst_slip_deg = 0.0;
     const std::size_t part_end = std::min(end, (part + 1) * kPartSamples);
     for (std::size_t i = part * kPartSamples; i < part_end; ++i) {
-      q = samples_.col(static_cast<Eigen::Index>(i));
+      const core::Pose& tcp = pose_sample(i);
       const double t = times_[i];
       if (!arm.chain.within_limits(q, settings_.limit_tolerance)) {
         violation.add("joint_limit", t, "outside the arm's joint limits");
       }
-      cell.set_arm(robot_q, arm, q);
-      poser.pose_arm(data, robot_q);
-      const core::Pose& tcp = poser.link_pose(tip_link);
-      if (moves_tool) core::set_tool_held(cell, stage, data, tcp);
       if (motion.holds_board) {
-        data.set_body_pose(stage.board, tcp * motion.board_in_tcp);
         if (motion.theta_c_deg < 90.0) {
           const double slip = core::slip_angle_deg(tcp.linear() * motion.slip_axis_tcp,
                                                    tcp.linear() * motion.slip_lever_tcp, down);
@@ -187,10 +195,6 @@ void MotionValidation::check_parts(std::size_t first, std::size_t last, core::Co
             violation.add("slip", t, s.str());
           }
         }
-      }
-      if (!rigid_checked) {
-        rigid_collides = core::in_collision_among(stage.cell.model, data, rigid, &rigid_pair);
-        rigid_checked = true;
       }
       core::CollisionPair pair = rigid_pair;
       const bool contact_allowed = motion.start_in_contact && i == 0;

@@ -100,8 +100,9 @@ TEST(ValidationQueue, DiscardedJobsAreNotValidatedAndDrainWaitsForTheRest) {
   online::ValidationQueue queue(f.world, {}, worker, caller);
   std::vector<std::size_t> jobs;
   for (const auto& m : motions) jobs.push_back(queue.submit(m));
-  // Discarded straight away: unless the worker already took it, it is never validated (its
-  // report stays empty: no samples), and it no longer counts as waiting.
+  // Discarded straight away: unless the worker already finished it, it is not validated (no
+  // samples, and a "discarded" violation: it never reads as passed), and it no longer counts as
+  // waiting.
   const std::size_t before = queue.backlog();
   queue.discard(jobs.back());
   EXPECT_LE(queue.backlog() + 1, std::max<std::size_t>(before, 1));
@@ -111,7 +112,9 @@ TEST(ValidationQueue, DiscardedJobsAreNotValidatedAndDrainWaitsForTheRest) {
   }
   const auto& discarded = queue.wait(jobs.back());
   if (discarded.samples == 0) {
-    EXPECT_TRUE(discarded.violations.empty());
+    ASSERT_EQ(discarded.violations.size(), 1u);
+    EXPECT_EQ(discarded.violations.front().kind, "discarded");
+    EXPECT_FALSE(discarded.valid());
   }
   // After a drain the queue takes new work as before.
   const std::size_t again = queue.submit(motions.front());
@@ -121,7 +124,8 @@ TEST(ValidationQueue, DiscardedJobsAreNotValidatedAndDrainWaitsForTheRest) {
 
 // A job's finish (the board planner's smoothing and timing) runs once, before the validation,
 // on the thread that validates the job, with that thread's slot; the report is the one the
-// finished motion gets validated alone. A finish that throws is a violation, not a crash.
+// finished motion gets validated alone. A finish that throws is a violation, not a crash,
+// whatever it throws.
 TEST(ValidationQueue, AFinishCompletesTheMotionOnTheThreadThatValidatesIt) {
   Fixture f;
   const auto motions = f.motions();
@@ -169,6 +173,18 @@ TEST(ValidationQueue, AFinishCompletesTheMotionOnTheThreadThatValidatesIt) {
   ASSERT_EQ(report.violations.size(), 1u);
   EXPECT_EQ(report.violations.front().kind, "internal");
   EXPECT_NE(report.violations.front().detail.find("no memory left"), std::string::npos);
+  // Nor does an exception without a message pass, or one that is not a std::exception.
+  const std::size_t silent = queue.submit(
+      motions.front(), [](std::size_t, online::Motion&) { throw std::runtime_error(""); });
+  const std::size_t odd =
+      queue.submit(motions.front(), [](std::size_t, online::Motion&) { throw 42; });
+  for (const std::size_t job : {silent, odd}) {
+    const auto& r = queue.wait(job);
+    ASSERT_EQ(r.violations.size(), 1u) << "job " << job;
+    EXPECT_EQ(r.violations.front().kind, "internal");
+    EXPECT_FALSE(r.violations.front().detail.empty());
+  }
+  queue.drain();
 }
 
 // wait_all: the jobs waited for come back with the reports they have alone; the caller runs
@@ -211,7 +227,8 @@ TEST(ValidationQueue, WaitAllRunsOnlyTheJobsItWaitsFor) {
   }
   const auto& discarded = queue.wait(wanted.front());
   if (discarded.samples == 0) {
-    EXPECT_TRUE(discarded.violations.empty());
+    ASSERT_EQ(discarded.violations.size(), 1u);
+    EXPECT_EQ(discarded.violations.front().kind, "discarded");
   }
   for (std::size_t j = 0; j + motions.size() < jobs.size(); ++j) {
     EXPECT_NE(ran_on[j].load(), static_cast<int>(online::ValidationQueue::kCallerSlot))
@@ -226,7 +243,8 @@ TEST(ValidationQueue, WaitAllRunsOnlyTheJobsItWaitsFor) {
 // Long motions (several MotionValidation parts each), one into the table late in its path: the
 // caller waiting for the last job takes parts of whatever the worker has started. Each report is
 // the motion's alone, however the parts were shared; a long job discarded after it started
-// comes back unvalidated or whole, never half-validated, and the queue goes on.
+// comes back unvalidated (reported as discarded) or whole, never half-validated, and the queue
+// goes on.
 TEST(ValidationQueue, ALongMotionsPartsSharedByBothThreadsGiveItsReport) {
   Fixture f;
   const Eigen::VectorXd above = f.left_at({0.40, 0.20, 1.30});
@@ -262,7 +280,9 @@ TEST(ValidationQueue, ALongMotionsPartsSharedByBothThreadsGiveItsReport) {
     if (round % 2 == 1) {
       queue.discard(jobs[1]);  // likely under way on the worker by now
       const auto& r = queue.wait(jobs[1]);
-      EXPECT_TRUE(r.samples == 0 ? r.violations.empty() : describe(r) == alone[1]) << describe(r);
+      EXPECT_TRUE(r.samples == 0 ? !r.valid() && r.violations.front().kind == "discarded"
+                                 : describe(r) == alone[1])
+          << describe(r);
       jobs.erase(jobs.begin() + 1);
     }
     queue.wait_all({jobs.back()});

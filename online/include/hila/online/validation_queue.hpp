@@ -52,12 +52,14 @@ class ValidationQueue {
   const ValidationReport& wait(std::size_t job);
   // Returns once every job is done: neither thread validates until the next submit().
   void drain();
-  // Returns once every one of `jobs` is done. The caller validates those of them not yet
-  // started itself, lowest first, and no others: the jobs it does not wait for stay queued for
-  // the worker (the attempts a plan did not use, say, need not hold up the one it did).
+  // Returns once every one of `jobs` is done. Meanwhile the caller works on those of them only,
+  // lowest first: it starts the ones not yet started and takes parts of started ones (the
+  // worker's too). The jobs it does not wait for stay queued for the worker (the attempts a
+  // plan did not use, say, need not hold up the one it did).
   void wait_all(const std::vector<std::size_t>& jobs);
   // The job's report is no longer wanted: one not started is done at once, one started stops
-  // after the parts under way; either comes back unvalidated (an empty report, no samples).
+  // after the parts under way; either comes back unvalidated: no samples, and a "discarded"
+  // violation, so that it never reads as passed. One already done keeps its report.
   void discard(std::size_t job);
   // Jobs submitted and not yet started, discarded ones left out.
   std::size_t backlog() const;
@@ -72,7 +74,8 @@ class ValidationQueue {
     std::unique_ptr<MotionValidation> check;  // made once finished; its parts are handed out
     std::size_t parts_out = 0;                // parts handed out
     std::size_t parts_done = 0;
-    std::string error;       // what threw, if anything did
+    std::string error;       // what threw first, when failed
+    bool failed = false;     // a piece threw: no part handed out from now on
     bool started = false;    // taken: being finished, then its parts handed out
     bool discarded = false;  // no part handed out from now on
     bool done = false;
@@ -89,6 +92,8 @@ class ValidationQueue {
            std::size_t slot);
   // The job's report, once nothing of it is under way. Under the lock.
   void complete(Job& job);
+  // Records that a piece of the job threw. Under the lock.
+  static void fail(Job& job, const std::string& what);
 
   const World& world_;
   ValidatorSettings settings_;
