@@ -153,8 +153,6 @@ FclGeometry make_geometry(const GeometrySpec& spec) {
   return g;
 }
 
-// Appends a body with its shapes in place, so that the pairs know it has shapes (a mesh body
-// added last once went untested by the subset query: its shape came after the refresh).
 void require_new_name(const CollisionModelImpl& m, const std::string& name) {
   for (const auto& b : m.bodies) {
     if (b.name == name) {
@@ -164,9 +162,11 @@ void require_new_name(const CollisionModelImpl& m, const std::string& name) {
   }
 }
 
+// Appends a body with its shapes in place, so that the pairs know it has shapes (a mesh body
+// added last once went untested by the subset query: its shape came after the refresh). The
+// caller has checked the name (require_new_name) before making the shapes.
 int append_body(CollisionModelImpl& m, const std::string& name, std::vector<FclGeometry> geometries,
                 std::vector<Pose> offsets, bool is_static, const Pose& pose) {
-  require_new_name(m, name);
   BodyModel body;
   body.name = name;
   body.is_static = is_static;

@@ -243,38 +243,25 @@ TEST(Validator, ASceneObstacleOnThePathIsACollisionAndItsAbsenceIsNot) {
   const online::Motion m = slow_motion("left", {a, b});
   const auto clear = f.run(m);
   ASSERT_TRUE(clear.valid()) << describe(clear);
-  // A crate where the TCP passes midway (FK of the joint midpoint).
+  // A crate where the TCP passes midway (FK of the joint midpoint), as a box and as a mesh
+  // (the world adds a scene's obstacles last, and a mesh added last once went unchecked).
   const core::Pose mid = core::arm_base_in_world(*f.cell, f.left) * f.left.chain.fk(0.5 * (a + b));
-  online::Scene s = f.scene;
   online::SceneObstacle crate;
   crate.name = "crate";
   crate.box_size = Eigen::Vector3d(0.06, 0.06, 0.06);
   crate.pose = core::Pose(Eigen::Translation3d(mid.translation()));
-  s.obstacles.push_back(crate);
-  const auto report = f.run(m, s);
-  ASSERT_TRUE(has(report, "collision")) << describe(report);
-  EXPECT_NE(report.violations.front().detail.find("obstacle/crate"), std::string::npos)
-      << describe(report);
-}
-
-// The same with a mesh obstacle: the world adds it last, and it once went unchecked.
-TEST(Validator, AMeshObstacleOnThePathIsACollision) {
-  Fixture f;
-  const Eigen::VectorXd a = f.left_at({0.40, 0.25, 1.35});
-  const Eigen::VectorXd b = f.left_at({0.40, 0.05, 1.35});
-  const online::Motion m = slow_motion("left", {a, b});
-  const core::Pose mid = core::arm_base_in_world(*f.cell, f.left) * f.left.chain.fk(0.5 * (a + b));
-  online::Scene s = f.scene;
-  online::SceneObstacle jig;
+  online::SceneObstacle jig = crate;
   jig.name = "jig";
   jig.mesh_file = "jig.stl";  // as loaded from a scene file
-  jig.mesh = core::make_box_mesh({0.06, 0.06, 0.06});
-  jig.pose = core::Pose(Eigen::Translation3d(mid.translation()));
-  s.obstacles.push_back(jig);
-  const auto report = f.run(m, s);
-  ASSERT_TRUE(has(report, "collision")) << describe(report);
-  EXPECT_NE(report.violations.front().detail.find("obstacle/jig"), std::string::npos)
-      << describe(report);
+  jig.mesh = core::make_box_mesh(crate.box_size);
+  for (const online::SceneObstacle& obstacle : {crate, jig}) {
+    online::Scene s = f.scene;
+    s.obstacles.push_back(obstacle);
+    const auto report = f.run(m, s);
+    ASSERT_TRUE(has(report, "collision")) << obstacle.name << ": " << describe(report);
+    EXPECT_NE(report.violations.front().detail.find("obstacle/" + obstacle.name), std::string::npos)
+        << describe(report);
+  }
 }
 
 TEST(Validator, FinishedBoardsStandWhereTheSceneSays) {
