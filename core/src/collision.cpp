@@ -276,9 +276,13 @@ inline void merge(WorldBox& into, const WorldBox& box) {
 }
 
 // Touching boxes overlap, as in FCL.
+// All six comparisons, then one branch: a query tests hundreds of box pairs that mostly miss
+// on some axis, and a branch per axis was mispredicted on many of them
+// (BM_ArmPoserCheckFree 2.3 -> 2.05 us).
 inline bool overlap(const WorldBox& a, const WorldBox& b) {
-  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
-         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+  const auto le = [](double x, double y) { return static_cast<unsigned>(x <= y); };
+  return (le(a.lo[0], b.hi[0]) & le(b.lo[0], a.hi[0]) & le(a.lo[1], b.hi[1]) &
+          le(b.lo[1], a.hi[1]) & le(a.lo[2], b.hi[2]) & le(b.lo[2], a.hi[2])) != 0U;
 }
 
 // What the subset query tests for one set of bodies, derived once from the model's pairs: the
