@@ -401,7 +401,8 @@ class Run {
     TimedPath timed;
     // While the other thread is behind, a queued step is smoothed here (the same result
     // either way: the plan does not depend on which thread smoothed).
-    const bool smooth_here = !speculate_ || queue_->backlog() > 0;
+    const bool smooth_here =
+        !speculate_ || (settings_.smooth_here_when_behind && queue_->backlog() > 0);
     if (smooth_here && smooths(path, request)) {
       const Stopwatch watch(times_.smoothing);
       s.smoothed = smoothed(planner, path);
