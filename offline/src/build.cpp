@@ -258,7 +258,8 @@ std::string settings_hash(const BuildSettings& s) {
        << m.vertical_cone_deg << ' ' << m.resolution << ' ' << m.joint_range << '\n';
   const auto& g = s.regrasp;
   text << "regrasp " << g.goals << ' ' << g.served_goals << ' ' << g.attach_neighbours << ' '
-       << g.bridge.max_checks << ' ' << g.transfer_bridges << '\n';
+       << g.bridge.max_checks << ' ' << g.transfer_bridges << ' ' << g.bridge_alternatives << ' '
+       << g.alternative_checks << '\n';
   return db::sha256_hex(text.str());
 }
 

@@ -10,6 +10,7 @@
 #include "hila/core/error.hpp"
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/roadmap_graph.hpp"
+#include "hila/core/slip_projection.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
@@ -118,8 +119,10 @@ Connection roadmap_path(ArmPlanning& arm, std::vector<bool> allowed, const Endpo
 
 // Where the filtered roadmap is cut (or an end does not attach): a bridge planned under the
 // same checks (the slip limit and the workspace as it currently holds).
+// With `project`, samples are projected onto the slip limit (as the online planner's bridges).
 Connection bridge_path(ArmPlanning& arm, const GraspSlip& slip, const Eigen::VectorXd& from,
-                       const Eigen::VectorXd& to, const core::BridgeSettings& bridge) {
+                       const Eigen::VectorXd& to, const core::BridgeSettings& bridge,
+                       bool project = false) {
   Connection c;
   const SlipTest holds(slip);
   const Eigen::Matrix3d base_rotation = arm.workspace.base().linear();
@@ -128,6 +131,11 @@ Connection bridge_path(ArmPlanning& arm, const GraspSlip& slip, const Eigen::Vec
   };
   core::BridgeSettings checked = bridge;
   checked.resolution = check_resolution(arm);
+  if (project) {
+    const core::SlipProjection projection(arm.workspace.arm(), arm.workspace.base(), slip.axis,
+                                          slip.lever, slip.theta_c_deg);
+    if (projection.active()) checked.project = projection;
+  }
   c.path = core::plan_bridge(arm.workspace.arm(), valid, from, to, checked);
   if (c.path.empty()) return c;
   c.connected = true;
@@ -315,6 +323,15 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     core::BridgeSettings b = settings.bridge;
     b.resolution = receiving_roadmap.resolution;
     b.seed = settings.seed + 0x9E3779B97F4A7C15ULL * ++bridges;
+    return b;
+  };
+  // Alternatives draw from a sequence of their own: the other bridges stay as they were.
+  std::uint64_t alternative_seeds = 0;
+  auto alternative_bridge = [&] {
+    core::BridgeSettings b = settings.bridge;
+    b.resolution = receiving_roadmap.resolution;
+    b.max_checks = settings.alternative_checks;
+    b.seed = settings.seed + 0xD1B54A32D192ED03ULL * ++alternative_seeds;
     return b;
   };
   const GraspSlip no_slip_limit;  // theta_c 90: any tilt
@@ -598,11 +615,26 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
           to_branch = b;
         }
       }
+      // Where the filtered roadmap is cut, the online planner has no roadmap way round what a
+      // scene puts on the bridge: other bridges between the same ends, stored as parallel
+      // edges, give it other ways to follow.
+      std::vector<Connection> alternatives;
+      for (int a = 0; transfer.connected && transfer.via == "bridge" &&
+                      a < settings.bridge_alternatives;
+           ++a) {
+        Connection other = bridge_path(receiving, slip, transfer.path.front(),
+                                       transfer.path.back(), alternative_bridge(), true);
+        if (other.connected && other.path != transfer.path) alternatives.push_back(other);
+      }
       receiving.workspace.release();
       const int rh_node =
           add_node("human_handover", settings.receiving_arm, "gripper", s.robot_grasp_id, -1,
                    s.candidate_id, candidate.board, {goals_rh[to_branch]});
       add_edge("transfer", settings.receiving_arm, from_node, rh_node, filter, transfer);
+      for (const auto& other : alternatives) {
+        add_edge("transfer", settings.receiving_arm, from_node, rh_node, filter, other);
+        ++result.alternatives;
+      }
       ++result.transfers;
       result.transfers_connected += transfer.connected ? 1 : 0;
       served = transfer.connected;

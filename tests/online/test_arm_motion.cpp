@@ -241,6 +241,52 @@ TEST(ArmMotion, AStoredPathBlockedMidwayIsRepairedLocally) {
   }
 }
 
+// Stored paths are tried in order, each followed whole: the one the crate blocks is passed
+// over for the next (the database stores other bridges of a transfer after the first, for
+// scenes that block it), whichever comes first.
+TEST(ArmMotion, AStoredPathTheSceneBlocksGivesWayToTheNextOne) {
+  const auto& cell = *test::reference_cell();
+  const auto crated = crate_on_a_roadmap_path();
+  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
+  const auto& [a, b, before, blocked] = *crated;
+  const online::World world(cell, cabinet(), blocked, "top");
+  core::CollisionData data = world.make_data();
+  const std::vector<Eigen::VectorXd>& stored = before.path;
+  // A way round the crate: planned in the crated scene without any stored path.
+  online::ArmMotionPlanner finder(world, left_roadmap(), "left");
+  const auto around = finder.plan(request(a, b));
+  ASSERT_TRUE(around.solved()) << around.reason;
+  ASSERT_GT(around.path.size(), 2u) << "a way round, not the straight motion";
+  const std::vector<Eigen::VectorXd> other = around.path;
+
+  for (const bool blocked_first : {true, false}) {
+    SCOPED_TRACE(blocked_first ? "the blocked path first" : "the clear path first");
+    online::MotionRequest r = request(a, b);
+    r.hints = blocked_first ? std::vector<const std::vector<Eigen::VectorXd>*>{&stored, &other}
+                            : std::vector<const std::vector<Eigen::VectorXd>*>{&other, &stored};
+    online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+    const auto found = planner.plan(r);
+    ASSERT_TRUE(found.solved()) << found.reason;
+    EXPECT_EQ(found.via, "stored");
+    EXPECT_EQ(found.searches, 0) << "no roadmap search when a stored path holds";
+    // The clear path's waypoints (shortcutting keeps a subset, in order, ends exact).
+    EXPECT_TRUE(found.path.front().isApprox(a, 0.0));
+    EXPECT_TRUE(found.path.back().isApprox(b, 0.0));
+    for (const auto& q : found.path) {
+      EXPECT_TRUE(std::find(other.begin(), other.end(), q) != other.end())
+          << "a waypoint not on the clear stored path";
+    }
+    const auto report =
+        online::validate_motion(world, data, timed(found.path, cabinet().part("top").initial));
+    EXPECT_TRUE(report.valid()) << describe(report);
+  }
+  // The blocked one alone is not followed.
+  online::MotionRequest alone = request(a, b);
+  alone.hints = {&stored};
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left");
+  EXPECT_NE(planner.plan(alone).via, "stored");
+}
+
 // A path the validator rejected (the crate planted on it after it was found): given back as
 // MotionRequest::rejected, it is mended where the crate blocks it, kept elsewhere, and the
 // mended path passes the validator; with no mending budget the motion is planned again instead.

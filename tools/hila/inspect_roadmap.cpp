@@ -4,6 +4,7 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "hila/core/error.hpp"
 #include "hila/core/roadmap_graph.hpp"
@@ -71,8 +72,24 @@ nlohmann::json board_json(const db::Database& database, const db::PartRecord& pa
       if (e.connected && reached[e.from_node]) reached[e.to_node] = true;
     }
   }
+  // A transfer's other bridges are parallel edges after the first (bridge_alternatives): counted
+  // apart, so that an edge count is a count of the connections tried.
+  std::map<std::int64_t, bool> alternative;  // edge id -> repeats an earlier edge's ends
+  {
+    std::map<std::tuple<std::string, std::int64_t, std::int64_t>, bool> seen;
+    for (const auto& e : edges) {
+      auto& s = seen[std::make_tuple(e.kind, e.from_node, e.to_node)];
+      alternative[e.id] = s;
+      s = true;
+    }
+  }
+  int alternatives = 0;
   for (const auto& e : edges) {
     if (!arm.empty() && e.arm != arm) continue;
+    if (alternative[e.id]) {
+      ++alternatives;
+      continue;
+    }
     auto& k = by_kind[e.kind + " " + e.arm];
     k.first += e.connected ? 1 : 0;
     ++k.second;
@@ -93,7 +110,7 @@ nlohmann::json board_json(const db::Database& database, const db::PartRecord& pa
   bool any = false;
   std::map<std::int64_t, nlohmann::json> goal_by_candidate;
   for (const auto& e : edges) {
-    if (e.kind != "transfer") continue;
+    if (e.kind != "transfer" || alternative[e.id]) continue;
     const auto* to = node_by_id[e.to_node];
     if (to->kind != "human_handover") continue;
     auto& g = goal_by_candidate[to->candidate_id];
@@ -124,7 +141,7 @@ nlohmann::json board_json(const db::Database& database, const db::PartRecord& pa
   for (const auto& [k, v] : by_kind) kinds[k] = {{"connected", v.first}, {"total", v.second}};
   return {{"part", part.name},      {"order", part.assembly_order},
           {"filters", filters},     {"regrasp_nodes", nodes.size()},
-          {"regrasp_edges", kinds}, {"bridges", bridges},
+          {"regrasp_edges", kinds}, {"bridges", bridges}, {"alternative_bridges", alternatives},
           {"goals", goals},         {"goal_connected", any}};
 }
 
@@ -175,7 +192,8 @@ int inspect_roadmap(const db::Database& database, const std::string& arm, const 
   for (const auto& b : boards) {
     std::cout << b["order"] << "  " << b["part"].get<std::string>() << ": " << b["filters"].size()
               << " filters, " << b["regrasp_nodes"] << " regrasp nodes, " << b["bridges"]
-              << " bridged edges; goal connected: "
+              << " bridged edges (" << b["alternative_bridges"]
+              << " more as alternatives); goal connected: "
               << (b["goal_connected"].get<bool>() ? "yes" : "NO") << "\n";
     for (const auto& f : b["filters"]) {
       std::cout << "     filter " << std::setw(4) << f["id"] << "  " << std::setw(5)

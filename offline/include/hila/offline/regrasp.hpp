@@ -27,6 +27,11 @@ struct RegraspSettings {
   // any at the goal: transits and transfers are tried through the roadmap for every branch
   // (pair), then bridged for at most this many.
   int transfer_bridges = 2;
+  // A receiving-arm transfer the filtered roadmap cannot make (a bridge) gets up to this many
+  // other bridges between the same ends (samples projected onto the slip limit), stored as
+  // parallel transfer edges after it: online, a scene that blocks one often leaves another.
+  int bridge_alternatives = 2;
+  long alternative_checks = 200000;  // each alternative's budget (lateral_left's needs > 40000)
   std::uint64_t seed = 1;  // bridges' samplers
   double lift = 0.15;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
   // The receiving arm's way in at the exchange: a pre-grasp this far (m) back from the grasp or
@@ -63,6 +68,7 @@ struct RegraspResult {
   int transfers = 0;  // receiving-arm robot-robot -> robot-human transfers tried
   int transfers_connected = 0;
   int bridges = 0;           // edges connected by a bridge rather than the roadmap
+  int alternatives = 0;      // of those, other bridges of a transfer (bridge_alternatives)
   int goals_considered = 0;  // goals examined (in Eq. 8 order)
   int goals_served = 0;      // goals with a connected chain home -> pick -> rr -> rh
   int first_served_rank = -1;
