@@ -619,11 +619,11 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       // scene puts on the bridge: other bridges between the same ends, stored as parallel
       // edges, give it other ways to follow.
       std::vector<Connection> alternatives;
-      for (int a = 0; transfer.connected && transfer.via == "bridge" &&
-                      a < settings.bridge_alternatives;
+      for (int a = 0;
+           transfer.connected && transfer.via == "bridge" && a < settings.bridge_alternatives;
            ++a) {
-        Connection other = bridge_path(receiving, slip, transfer.path.front(),
-                                       transfer.path.back(), alternative_bridge(), true);
+        Connection other = bridge_path(receiving, slip, transfer.path.front(), transfer.path.back(),
+                                       alternative_bridge(), true);
         if (other.connected && other.path != transfer.path) alternatives.push_back(other);
       }
       receiving.workspace.release();

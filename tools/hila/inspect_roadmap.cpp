@@ -139,10 +139,15 @@ nlohmann::json board_json(const db::Database& database, const db::PartRecord& pa
   for (auto& [r, g] : ordered) goals.push_back(g);
   nlohmann::json kinds = nlohmann::json::object();
   for (const auto& [k, v] : by_kind) kinds[k] = {{"connected", v.first}, {"total", v.second}};
-  return {{"part", part.name},      {"order", part.assembly_order},
-          {"filters", filters},     {"regrasp_nodes", nodes.size()},
-          {"regrasp_edges", kinds}, {"bridges", bridges}, {"alternative_bridges", alternatives},
-          {"goals", goals},         {"goal_connected", any}};
+  return {{"part", part.name},
+          {"order", part.assembly_order},
+          {"filters", filters},
+          {"regrasp_nodes", nodes.size()},
+          {"regrasp_edges", kinds},
+          {"bridges", bridges},
+          {"alternative_bridges", alternatives},
+          {"goals", goals},
+          {"goal_connected", any}};
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ struct RegraspSettings {
   // parallel transfer edges after it: online, a scene that blocks one often leaves another.
   int bridge_alternatives = 2;
   long alternative_checks = 200000;  // each alternative's budget (lateral_left's needs > 40000)
-  std::uint64_t seed = 1;  // bridges' samplers
+  std::uint64_t seed = 1;            // bridges' samplers
   double lift = 0.15;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
   // The receiving arm's way in at the exchange: a pre-grasp this far (m) back from the grasp or
   // along the board's edge (as the online planner's approach), the straight motion into the
