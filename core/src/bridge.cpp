@@ -54,6 +54,32 @@ bool segment_valid(const std::function<bool(const Eigen::VectorXd&)>& valid,
   return all_samples_coarse_to_fine(a, b, resolution, valid);
 }
 
+std::vector<Eigen::VectorXd> shortcut_path(const std::vector<Eigen::VectorXd>& path,
+                                           const std::function<bool(const Eigen::VectorXd&)>& valid,
+                                           double resolution, long* budget, bool check_kept) {
+  if (path.empty()) return {};
+  std::vector<Eigen::VectorXd> out{path.front()};
+  std::size_t at = 0;
+  while (at + 1 < path.size()) {
+    std::size_t next = at + 1;
+    for (std::size_t j = path.size() - 1; j > at + 1 && (budget == nullptr || *budget > 0); --j) {
+      long spent = 0;
+      const bool clear = all_samples_coarse_to_fine(path[at], path[j], resolution, valid, &spent);
+      if (budget != nullptr) *budget -= spent;
+      if (clear) {
+        next = j;
+        break;
+      }
+    }
+    if (check_kept && next == at + 1 && !segment_valid(valid, path[at], path[next], resolution)) {
+      return {};
+    }
+    out.push_back(path[next]);
+    at = next;
+  }
+  return out;
+}
+
 std::vector<Eigen::VectorXd> plan_bridge(const Arm& arm,
                                          const std::function<bool(const Eigen::VectorXd&)>& valid,
                                          const Eigen::VectorXd& from, const Eigen::VectorXd& to,
@@ -118,26 +144,9 @@ std::vector<Eigen::VectorXd> plan_bridge_to_any(
   for (std::size_t i = 0; i < path->getStateCount(); ++i) {
     raw.push_back(to_vector(path->getState(i), dof));
   }
-  // Greedy shortcuts: from each kept waypoint, the farthest later one a straight segment reaches.
-  std::vector<Eigen::VectorXd> out{raw.front()};
-  std::size_t at = 0;
-  while (at + 1 < raw.size()) {
-    std::size_t next = at + 1;
-    for (std::size_t j = raw.size() - 1; j > at + 1; --j) {
-      if (segment_valid(valid, raw[at], raw[j], settings.resolution)) {
-        next = j;
-        break;
-      }
-    }
-    // RRT-Connect's own segments were checked by OMPL's motion validator; re-check at exactly
-    // the documented resolution.
-    if (next == at + 1 && !segment_valid(valid, raw[at], raw[next], settings.resolution)) {
-      return {};
-    }
-    out.push_back(raw[next]);
-    at = next;
-  }
-  return out;
+  // RRT-Connect's own segments were checked by OMPL's motion validator: the kept ones are
+  // checked again at exactly the documented resolution.
+  return shortcut_path(raw, valid, settings.resolution, nullptr, true);
 }
 
 }  // namespace hila::core

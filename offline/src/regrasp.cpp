@@ -76,10 +76,25 @@ bool edge_valid_here(ArmPlanning& arm, int a, int b) {
   return true;
 }
 
+// A configuration's validity for a motion of the arm: the slip limit and the workspace as it
+// currently holds (what a bridge and a shortcut check; a filtered roadmap edge keeps the slip
+// limit by construction).
+std::function<bool(const Eigen::VectorXd&)> valid_under(ArmPlanning& arm, const GraspSlip& slip) {
+  return [&arm, holds = SlipTest(slip),
+          base_rotation =
+              Eigen::Matrix3d(arm.workspace.base().linear())](const Eigen::VectorXd& q) {
+    return holds(gravity_in_tcp(arm.workspace.arm(), base_rotation, q)) && arm.workspace.valid(q);
+  };
+}
+
 // Shortest path between two attached configurations over the allowed edges, its edges
-// validated lazily at the board's stage (a blocked edge is dropped and the search repeated).
-Connection roadmap_path(ArmPlanning& arm, std::vector<bool> allowed, const Endpoint& from,
-                        const Endpoint& to, core::GraphSearchWorkspace& search) {
+// validated lazily at the board's stage (a blocked edge is dropped and the search repeated),
+// then shortened by straight shortcuts under `slip` and the workspace: the online planner
+// follows the stored path and shortens it within a small check budget, which a long roadmap
+// path can exhaust; here it is done once, without a budget.
+Connection roadmap_path(ArmPlanning& arm, const GraspSlip& slip, std::vector<bool> allowed,
+                        const Endpoint& from, const Endpoint& to,
+                        core::GraphSearchWorkspace& search) {
   constexpr int kMaxSearches = 100;
   Connection c;
   if (from.attached.empty() || to.attached.empty()) return c;
@@ -113,6 +128,7 @@ Connection roadmap_path(ArmPlanning& arm, std::vector<bool> allowed, const Endpo
   c.path.push_back(from.q);
   for (const int n : path.nodes) c.path.push_back(arm.roadmap.nodes[static_cast<std::size_t>(n)]);
   c.path.push_back(to.q);
+  c.path = core::shortcut_path(c.path, valid_under(arm, slip), check_resolution(arm));
   c.cost = path_length(c.path);
   return c;
 }
@@ -124,11 +140,7 @@ Connection bridge_path(ArmPlanning& arm, const GraspSlip& slip, const Eigen::Vec
                        const Eigen::VectorXd& to, const core::BridgeSettings& bridge,
                        bool project = false) {
   Connection c;
-  const SlipTest holds(slip);
-  const Eigen::Matrix3d base_rotation = arm.workspace.base().linear();
-  auto valid = [&](const Eigen::VectorXd& q) {
-    return holds(gravity_in_tcp(arm.workspace.arm(), base_rotation, q)) && arm.workspace.valid(q);
-  };
+  const auto valid = valid_under(arm, slip);
   core::BridgeSettings checked = bridge;
   checked.resolution = check_resolution(arm);
   if (project) {
@@ -150,7 +162,7 @@ Connection connect(ArmPlanning& arm, const std::vector<bool>& allowed, const Gra
                    core::GraphSearchWorkspace& search, const core::BridgeSettings& bridge) {
   const Endpoint start = endpoint(arm, slip, from, k);
   if (!start.attached.empty()) {
-    Connection c = roadmap_path(arm, allowed, start, endpoint(arm, slip, to, k), search);
+    Connection c = roadmap_path(arm, slip, allowed, start, endpoint(arm, slip, to, k), search);
     if (c.connected) return c;
   }
   return bridge_path(arm, slip, from, to, bridge);
@@ -444,7 +456,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
         for (chosen = 0; chosen < ends.size(); ++chosen) {
           if (pass == 1 && static_cast<int>(chosen) >= settings.transfer_bridges) break;
           transfer = pass == 0
-                         ? roadmap_path(suction, edges, lifted,
+                         ? roadmap_path(suction, no_slip_limit, edges, lifted,
                                         endpoint(suction, no_slip_limit, ends[chosen], k), search)
                          : bridge_path(suction, no_slip_limit, pick.lift, ends[chosen], bridge());
           if (transfer.connected) break;
@@ -519,7 +531,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       end.node = add_node("robot_handover", settings.receiving_arm, "gripper", s.robot_grasp_id,
                           s.robot_handover_id, -1, rr.board, {q});
       ends.push_back(end);
-      transits.push_back(roadmap_path(receiving, receiving.all_edges, home_end,
+      transits.push_back(roadmap_path(receiving, no_slip_limit, receiving.all_edges, home_end,
                                       endpoint(receiving, no_slip_limit, q, k), search));
     }
     const bool any = std::any_of(transits.begin(), transits.end(),
@@ -596,7 +608,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
         }
         if (it->second.attached.empty()) continue;
         if (!to_ends[b]) to_ends[b] = endpoint(receiving, slip, goals_rh[b], k);
-        transfer = roadmap_path(receiving, edges, it->second, *to_ends[b], search);
+        transfer = roadmap_path(receiving, slip, edges, it->second, *to_ends[b], search);
         if (transfer.connected) {
           from_node = node;
           to_branch = b;

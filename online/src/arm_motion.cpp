@@ -436,25 +436,8 @@ void ArmMotionPlanner::shorten(std::vector<Eigen::VectorXd>& path) {
   if (unique.size() == 1) unique.push_back(unique.front());  // a motion has two ends
   path = std::move(unique);
   long budget = settings_.shortcut_checks;
-  std::vector<Eigen::VectorXd> out{path.front()};
-  std::size_t at = 0;
-  while (at + 1 < path.size()) {
-    std::size_t next = at + 1;
-    for (std::size_t j = path.size() - 1; j > at + 1 && budget > 0; --j) {
-      long spent = 0;
-      const bool clear = core::all_samples_coarse_to_fine(
-          path[at], path[j], resolution_, [this](const Eigen::VectorXd& q) { return valid(q); },
-          &spent);
-      budget -= spent;
-      if (clear) {
-        next = j;
-        break;
-      }
-    }
-    out.push_back(path[next]);
-    at = next;
-  }
-  path = std::move(out);
+  path = core::shortcut_path(
+      path, [this](const Eigen::VectorXd& q) { return valid(q); }, resolution_, &budget);
 }
 
 std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd& q,

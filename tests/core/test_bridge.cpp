@@ -372,3 +372,141 @@ TEST(Bridge, CoarseToFineVisitsEveryEdgeSampleOnceMiddleFirst) {
     }
   }
 }
+
+namespace {
+
+// Greedy farthest-reach shortcuts, written out plainly: every sample of edge_samples checked in
+// order (the function under test visits them coarse to fine).
+std::vector<Eigen::VectorXd> greedy_reference(const std::vector<Eigen::VectorXd>& path,
+                                              const Validity& valid, double resolution) {
+  const auto clear = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    const auto samples = core::edge_samples(a, b, resolution);
+    return std::all_of(samples.begin(), samples.end(), valid);
+  };
+  std::vector<Eigen::VectorXd> out{path.front()};
+  std::size_t at = 0;
+  while (at + 1 < path.size()) {
+    std::size_t next = at + 1;
+    for (std::size_t j = at + 2; j < path.size(); ++j) {
+      if (clear(path[at], path[j])) next = j;  // the farthest that holds
+    }
+    out.push_back(path[next]);
+    at = next;
+  }
+  return out;
+}
+
+// Every waypoint and every sample at `resolution` between them holds (the shortcut's contract:
+// a denser check may find a segment that grazes the ball between samples).
+void expect_sampled_valid(const std::vector<Eigen::VectorXd>& path, const Validity& valid,
+                          double resolution) {
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    EXPECT_TRUE(valid(path[i])) << "waypoint " << i;
+    if (i == 0) continue;
+    for (const auto& q : core::edge_samples(path[i - 1], path[i], resolution)) {
+      EXPECT_TRUE(valid(q)) << "segment " << i - 1;
+    }
+  }
+}
+
+// A ball of invalid configurations and a random walk round it in 6 joints.
+struct BallWorld {
+  Eigen::VectorXd centre = Eigen::VectorXd::Zero(6);
+  double radius = 0.6;
+  Validity valid() const {
+    return [c = centre, r = radius](const Eigen::VectorXd& q) { return (q - c).norm() > r; };
+  }
+};
+
+std::vector<Eigen::VectorXd> walk_round(const BallWorld& world, std::mt19937_64& rng, int n) {
+  std::uniform_real_distribution<double> u(-0.35, 0.35);
+  const Validity valid = world.valid();
+  std::vector<Eigen::VectorXd> path;
+  Eigen::VectorXd q = Eigen::VectorXd::Constant(6, 0.9);
+  path.push_back(q);
+  while (static_cast<int>(path.size()) < n) {
+    Eigen::VectorXd step(6);
+    for (int j = 0; j < 6; ++j) step[j] = u(rng);
+    // Drift round the ball: the walk's segments hold, many shortcuts across it do not.
+    step[0] -= 0.08;
+    step[1] += 0.05;
+    const Eigen::VectorXd next = q + step;
+    if (!valid(next) || !core::segment_valid(valid, q, next, 0.05)) continue;
+    path.push_back(next);
+    q = next;
+  }
+  return path;
+}
+
+}  // namespace
+
+TEST(Bridge, ShortcutPathIsTheGreedyFarthestReach) {
+  const BallWorld world;
+  const Validity valid = world.valid();
+  std::mt19937_64 rng(11);
+  int shortened = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const auto path = walk_round(world, rng, 12 + trial % 7);
+    const auto out = core::shortcut_path(path, valid, 0.05);
+    const auto want = greedy_reference(path, valid, 0.05);
+    ASSERT_EQ(out.size(), want.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < out.size(); ++i) EXPECT_EQ(out[i], want[i]) << "trial " << trial;
+    EXPECT_EQ(out.front(), path.front());
+    EXPECT_EQ(out.back(), path.back());
+    // Maximal: skipping any kept waypoint would cross the ball (else greedy had gone further).
+    for (std::size_t k = 0; k + 2 < out.size(); ++k) {
+      EXPECT_FALSE(core::segment_valid(valid, out[k], out[k + 2], 0.05)) << "trial " << trial;
+    }
+    expect_sampled_valid(out, valid, 0.05);
+    shortened += out.size() < path.size() ? 1 : 0;
+  }
+  EXPECT_GT(shortened, 20);  // the test means something only if most paths do shorten
+}
+
+TEST(Bridge, ShortcutPathSpendsAtMostItsBudget) {
+  const BallWorld world;
+  const Validity valid = world.valid();
+  std::mt19937_64 rng(12);
+  const auto path = walk_round(world, rng, 16);
+  long none = 0;
+  EXPECT_EQ(core::shortcut_path(path, valid, 0.05, &none), path);  // nothing to spend: as given
+  long unlimited_spent = 0;
+  const Validity counting = [&](const Eigen::VectorXd& q) {
+    ++unlimited_spent;
+    return valid(q);
+  };
+  const auto full = core::shortcut_path(path, counting, 0.05);
+  for (const long budget : {5L, 40L, 200L}) {
+    long left = budget;
+    long spent = 0;
+    const Validity counted = [&](const Eigen::VectorXd& q) {
+      ++spent;
+      return valid(q);
+    };
+    const auto out = core::shortcut_path(path, counted, 0.05, &left);
+    EXPECT_EQ(budget - left, spent) << "budget " << budget;  // every check is charged
+    EXPECT_LE(spent, unlimited_spent);
+    // Waypoints of the path, in order, from its start to its end.
+    std::size_t at = 0;
+    for (const auto& q : out) {
+      while (at < path.size() && path[at] != q) ++at;
+      EXPECT_LT(at, path.size()) << "budget " << budget << ": a waypoint not of the path";
+    }
+    EXPECT_EQ(out.front(), path.front());
+    EXPECT_EQ(out.back(), path.back());
+    expect_sampled_valid(out, valid, 0.05);
+  }
+  long plenty = 1000000;
+  EXPECT_EQ(core::shortcut_path(path, valid, 0.05, &plenty), full);
+}
+
+TEST(Bridge, ShortcutPathChecksKeptSegmentsOnlyWhenAsked) {
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(6), b = Eigen::VectorXd::Zero(6);
+  a[0] = -1.0;
+  b[0] = 1.0;
+  const BallWorld world;  // centred between a and b
+  const std::vector<Eigen::VectorXd> through{a, b};
+  // Taken as valid by default (a planner's own segments), refused when checked.
+  EXPECT_EQ(core::shortcut_path(through, world.valid(), 0.05), through);
+  EXPECT_TRUE(core::shortcut_path(through, world.valid(), 0.05, nullptr, true).empty());
+}

@@ -47,6 +47,16 @@ std::vector<Eigen::VectorXd> plan_bridge_to_any(
     const Eigen::VectorXd& from, const std::vector<Eigen::VectorXd>& targets,
     const BridgeSettings& settings);
 
+// Greedy straight shortcuts of a path: from each kept waypoint, the farthest later one a straight
+// segment reaches, valid at every sample at `resolution` (visited coarse to fine), while `budget`
+// lasts (validity checks, spent as they are made; nullptr: no limit). A segment between
+// consecutive waypoints is taken as valid, unless `check_kept`: it is then checked too, and
+// nothing is returned when it fails.
+std::vector<Eigen::VectorXd> shortcut_path(const std::vector<Eigen::VectorXd>& path,
+                                           const std::function<bool(const Eigen::VectorXd&)>& valid,
+                                           double resolution, long* budget = nullptr,
+                                           bool check_kept = false);
+
 // The interior samples of the straight joint-space segment a -> b at `resolution`:
 // ceil(|b - a| / resolution) - 1 points, evenly spaced (what roadmaps check and annotate).
 std::vector<Eigen::VectorXd> edge_samples(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
