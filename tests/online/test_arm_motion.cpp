@@ -137,6 +137,23 @@ std::optional<CratedPath> crate_on_a_roadmap_path() {
   return std::nullopt;
 }
 
+// Tests that start from the crated roadmap path: it and the world of its crated scene, made
+// before each of them.
+class ArmMotionCrated : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    crated_ = crate_on_a_roadmap_path();
+    ASSERT_TRUE(crated_.has_value()) << "a roadmap path with interior nodes";
+    world_.emplace(*test::reference_cell(), cabinet(), crated_->blocked, "top");
+  }
+  const CratedPath& crated() const { return *crated_; }
+  const online::World& crated_world() const { return *world_; }
+
+ private:
+  std::optional<CratedPath> crated_;
+  std::optional<online::World> world_;
+};
+
 }  // namespace
 
 TEST(ArmMotion, SolvedMotionsPassTheIndependentValidator) {
@@ -160,12 +177,9 @@ TEST(ArmMotion, SolvedMotionsPassTheIndependentValidator) {
   EXPECT_GE(solved, 6) << "of 8 node pairs";
 }
 
-TEST(ArmMotion, AnObstacleOnTheStoredPathIsRepairedAround) {
-  const auto& cell = *test::reference_cell();
-  const auto crated = crate_on_a_roadmap_path();
-  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
-  const auto& [a, b, before, blocked] = *crated;
-  const online::World world(cell, cabinet(), blocked, "top");
+TEST_F(ArmMotionCrated, AnObstacleOnTheStoredPathIsRepairedAround) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
   core::CollisionData data = world.make_data();
   const auto old =
       online::validate_motion(world, data, timed(before.path, cabinet().part("top").initial));
@@ -184,12 +198,9 @@ TEST(ArmMotion, AnObstacleOnTheStoredPathIsRepairedAround) {
 // search only: with a repair budget the stored path is bridged around the crate where it is
 // blocked and kept elsewhere (its waypoint before the crate is still on the path); without one
 // the motion falls through to a bridge across the whole motion.
-TEST(ArmMotion, AStoredPathBlockedMidwayIsRepairedLocally) {
-  const auto& cell = *test::reference_cell();
-  const auto crated = crate_on_a_roadmap_path();
-  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
-  const auto& [a, b, before, blocked] = *crated;
-  const online::World world(cell, cabinet(), blocked, "top");
+TEST_F(ArmMotionCrated, AStoredPathBlockedMidwayIsRepairedLocally) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
   core::CollisionData data = world.make_data();
   const std::vector<Eigen::VectorXd>& stored = before.path;
   const std::size_t crate_at = stored.size() / 2;  // the waypoint the crate sits on
@@ -244,12 +255,9 @@ TEST(ArmMotion, AStoredPathBlockedMidwayIsRepairedLocally) {
 // Stored paths are tried in order, each followed whole: the one the crate blocks is passed
 // over for the next (the database stores other bridges of a transfer after the first, for
 // scenes that block it), whichever comes first.
-TEST(ArmMotion, AStoredPathTheSceneBlocksGivesWayToTheNextOne) {
-  const auto& cell = *test::reference_cell();
-  const auto crated = crate_on_a_roadmap_path();
-  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
-  const auto& [a, b, before, blocked] = *crated;
-  const online::World world(cell, cabinet(), blocked, "top");
+TEST_F(ArmMotionCrated, AStoredPathTheSceneBlocksGivesWayToTheNextOne) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
   core::CollisionData data = world.make_data();
   const std::vector<Eigen::VectorXd>& stored = before.path;
   // A way round the crate: planned in the crated scene without any stored path.
@@ -290,12 +298,9 @@ TEST(ArmMotion, AStoredPathTheSceneBlocksGivesWayToTheNextOne) {
 // A path the validator rejected (the crate planted on it after it was found): given back as
 // MotionRequest::rejected, it is mended where the crate blocks it, kept elsewhere, and the
 // mended path passes the validator; with no mending budget the motion is planned again instead.
-TEST(ArmMotion, ARejectedPathIsMendedWhereItIsBlocked) {
-  const auto& cell = *test::reference_cell();
-  const auto crated = crate_on_a_roadmap_path();
-  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
-  const auto& [a, b, before, blocked] = *crated;
-  const online::World world(cell, cabinet(), blocked, "top");
+TEST_F(ArmMotionCrated, ARejectedPathIsMendedWhereItIsBlocked) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
   core::CollisionData data = world.make_data();
   const std::vector<Eigen::VectorXd>& rejected = before.path;
   const auto first_report =
@@ -350,12 +355,10 @@ TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
 // The planner keeps the edges it found blocked while the scene is posed the same: a second
 // request finds the same path without invalidating them again, and a request posing the rest
 // of the robot differently starts over (matching a fresh planner).
-TEST(ArmMotion, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame) {
+TEST_F(ArmMotionCrated, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame) {
   const auto& cell = *test::reference_cell();
-  const auto crated = crate_on_a_roadmap_path();
-  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
-  const auto& [a, b, before, blocked] = *crated;
-  const online::World world(cell, cabinet(), blocked, "top");
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
 
   online::ArmMotionPlanner planner(world, left_roadmap(), "left");
   const auto first = planner.plan(request(a, b));
@@ -739,12 +742,9 @@ TEST(ArmMotion, AStepOntoAnUncheckedConfigurationChecksIt) {
 // A bridge that failed within its budget is not run again for the same ends under the same
 // checks (another goal with the same configuration asks the same): the same failure, without
 // its checks. A larger budget runs it again.
-TEST(ArmMotion, AFailedBridgeIsNotRunAgainForTheSameEnds) {
-  const auto& cell = *test::reference_cell();
-  const auto crated = crate_on_a_roadmap_path();
-  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
-  const auto& [a, b, before, blocked] = *crated;
-  const online::World world(cell, cabinet(), blocked, "top");
+TEST_F(ArmMotionCrated, AFailedBridgeIsNotRunAgainForTheSameEnds) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
   online::MotionRequest r = request(a, b);
   online::MotionSettings settings;
   settings.attach_neighbours = 0;  // both ends wedged: straight to the bridge
@@ -780,12 +780,9 @@ TEST(ArmMotion, AFailedBridgeIsNotRunAgainForTheSameEnds) {
 // A wedged motion's repair of a stored path that fails within its budget fails again for the
 // same ends, path, budget and context: not run again, even after the planner served another
 // context in between (the larger bridges' round comes back to the first round's contexts).
-TEST(ArmMotion, AFailedRepairIsNotRunAgainUnderTheSameContext) {
-  const auto& cell = *test::reference_cell();
-  const auto crated = crate_on_a_roadmap_path();
-  ASSERT_TRUE(crated.has_value()) << "a roadmap path with interior nodes";
-  const auto& [a, b, before, blocked] = *crated;
-  const online::World world(cell, cabinet(), blocked, "top");
+TEST_F(ArmMotionCrated, AFailedRepairIsNotRunAgainUnderTheSameContext) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
   const std::vector<Eigen::VectorXd>& stored = before.path;
   online::MotionRequest r = request(a, b);
   r.hints = {&stored};
