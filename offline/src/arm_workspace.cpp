@@ -127,6 +127,16 @@ void ArmWorkspace::release() {
   posed_.resize(0);
 }
 
+void ArmWorkspace::pose_rest(const Eigen::VectorXd& robot_q) {
+  robot_q_ = robot_q;
+  core::set_robot_state(cell_, scene_.cell, data_, robot_q_);
+  const core::Arm& tool_arm = cell_.arms()[static_cast<std::size_t>(scene_.suction_arm)];
+  core::set_tool_held(cell_, scene_, data_,
+                      core::arm_base_in_world(cell_, tool_arm) *
+                          tool_arm.chain.fk(cell_.arm_joints(robot_q_, tool_arm)));
+  posed_.resize(0);
+}
+
 std::string ArmWorkspace::why_invalid(const Eigen::VectorXd& q) {
   if (!arm_.chain.within_limits(q, 1e-12)) return "outside the joint limits";
   pose_arm(q);

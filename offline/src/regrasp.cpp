@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <memory>
 #include <optional>
 #include <tuple>
 
@@ -218,18 +219,17 @@ class ExchangeCheck {
     return !core::in_collision(scene_.cell.model, data_, receiving_bodies_);
   }
 
-  // Whether the receiving arm at `receiving_q` has a way in (core::find_pre_grasp, as the
-  // handover search and the online approach ask), the suction arm holding the board as in
-  // clear(). An exchange pressed against the robot's body may be valid and yet unreachable.
-  bool approachable(const core::Pose& board, const Eigen::VectorXd& suction_q,
-                    const Eigen::VectorXd& receiving_q, double jaw, double distance,
-                    double resolution) {
+  // The receiving arm's way in to `receiving_q` (core::find_pre_grasp, as the handover search
+  // and the online approach ask), the suction arm holding the board as in clear(); none for an
+  // exchange pressed against the robot's body, which may be valid and yet unreachable.
+  std::optional<Eigen::VectorXd> pre_grasp(const core::Pose& board, const Eigen::VectorXd& suction_q,
+                                           const Eigen::VectorXd& receiving_q, double jaw,
+                                           double distance, double resolution) {
     return core::find_pre_grasp(cell_, receiving_, receiving_q, distance, resolution,
                                 [&](const Eigen::VectorXd& q) {
                                   return receiving_.chain.within_limits(q, 1e-9) &&
                                          clear(board, suction_q, q, jaw);
-                                })
-        .has_value();
+                                });
   }
 
  private:
@@ -348,6 +348,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   };
   const GraspSlip no_slip_limit;  // theta_c 90: any tilt
   const int k = settings.attach_neighbours;
+  const int k_way_in = std::max(k, settings.way_in_neighbours);
   const core::Pose cup_in_tcp = suction.workspace.scene().cup_in_tcp;
 
   auto add_node = [&](const std::string& kind, const std::string& arm,
@@ -499,10 +500,27 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   };
   const core::Arm& receiving_arm = receiving.workspace.arm();
   const double jaw_max = cell.spec().gripper.jaw_max;
-  const Endpoint home_end = endpoint(receiving, no_slip_limit, receiving_arm.spec.home, k);
   struct LeftEnd {
     int node = -1;
     bool transit = false;  // home -> node connected and the exchange clear
+  };
+  // An arm's workspace with the board standing still (a static part, which the arm must not
+  // touch) and the rest of the robot posed: the receiving arm's way in at an exchange (the
+  // suction arm there, holding the board). Made once per (use, which pose of the board).
+  enum class Standing { kWayIn };
+  std::map<std::pair<Standing, std::int64_t>, std::unique_ptr<ArmPlanning>> standing;
+  auto standing_for = [&](Standing use, std::int64_t tag, const core::Pose& board,
+                          const Eigen::VectorXd& robot_q) -> ArmPlanning& {
+    auto& slot = standing[{use, tag}];
+    if (slot) return *slot;
+    std::vector<core::PlacedPart> parts = finished;
+    parts.push_back({part.name + "_standing", &part.mesh, board});
+    slot = std::make_unique<ArmPlanning>(ArmPlanning{
+        receiving_roadmap, receiving.graph,
+        ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, nullptr, parts, stacked),
+        receiving.all_edges, settings.held_resolution});
+    slot->workspace.pose_rest(robot_q);
+    return *slot;
   };
   // Per (robot handover, grasp): one node per receiving-arm branch at the exchange.
   std::map<std::pair<std::int64_t, std::int64_t>, std::vector<LeftEnd>> rr_left;
@@ -518,29 +536,43 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     const double jaw = std::min(jaw_max, grasp.jaw_width + kJawMargin);
     // The suction arm may hold the board in another IK branch than the handover search checked.
     const auto& suction_q = result.nodes[static_cast<std::size_t>(suction_node)].solutions.front();
+    // The transit ends with the way in (home -> pre-grasp -> grasp), checked as the arm makes
+    // it: the suction arm at the exchange, holding the board there. Checked with the suction
+    // arm at home and no board, every stored transit ran into the board near its end, and the
+    // online planner searched the roadmap for every receiving approach instead.
+    Eigen::VectorXd at_exchange = cell.home_configuration();
+    cell.set_arm(at_exchange, suction_arm, suction_q);
+    ArmPlanning& way_in = standing_for(Standing::kWayIn, s.robot_handover_id, rr.board, at_exchange);
+    const Endpoint way_in_home = endpoint(way_in, no_slip_limit, receiving_arm.spec.home, k);
     // Transits through the roadmap to every branch; bridges (costly when they fail) only when
     // none connects, to the first few branches.
     std::vector<Connection> transits;
+    std::vector<Eigen::VectorXd> pre_grasps;
     for (const auto& q : valid_branches(receiving, rr.board * grasp.tcp, s.joints_rr)) {
-      if (!exchange.clear(rr.board, suction_q, q, jaw) ||
-          !exchange.approachable(rr.board, suction_q, q, jaw, settings.approach,
-                                 settings.approach_resolution)) {
-        continue;
-      }
+      if (!exchange.clear(rr.board, suction_q, q, jaw)) continue;
+      const std::optional<Eigen::VectorXd> pre_q =
+          exchange.pre_grasp(rr.board, suction_q, q, jaw, settings.approach,
+                             settings.approach_resolution);
+      if (!pre_q) continue;  // valid, but pressed where no open gripper gets in
       LeftEnd end;
       end.node = add_node("robot_handover", settings.receiving_arm, "gripper", s.robot_grasp_id,
                           s.robot_handover_id, -1, rr.board, {q});
       ends.push_back(end);
-      transits.push_back(roadmap_path(receiving, no_slip_limit, receiving.all_edges, home_end,
-                                      endpoint(receiving, no_slip_limit, q, k), search));
+      pre_grasps.push_back(*pre_q);
+      transits.push_back(roadmap_path(way_in, no_slip_limit, way_in.all_edges, way_in_home,
+                                      endpoint(way_in, no_slip_limit, *pre_q, k_way_in), search));
     }
     const bool any = std::any_of(transits.begin(), transits.end(),
                                  [](const Connection& c) { return c.connected; });
     for (std::size_t i = 0; i < ends.size(); ++i) {
       if (!any && static_cast<int>(i) < settings.transfer_bridges) {
-        transits[i] = bridge_path(
-            receiving, no_slip_limit, receiving_arm.spec.home,
-            result.nodes[static_cast<std::size_t>(ends[i].node)].solutions.front(), bridge());
+        transits[i] = bridge_path(way_in, no_slip_limit, receiving_arm.spec.home, pre_grasps[i],
+                                  bridge());
+      }
+      if (transits[i].connected) {  // the straight approach, checked by pre_grasp()
+        transits[i].path.push_back(
+            result.nodes[static_cast<std::size_t>(ends[i].node)].solutions.front());
+        transits[i].cost = path_length(transits[i].path);
       }
       add_edge("transit", settings.receiving_arm, home_receiving, ends[i].node, -1, transits[i]);
       Connection exchange_edge;

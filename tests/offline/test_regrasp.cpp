@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <memory>
+#include <string>
 #include <tuple>
 
 #include "hila/core/collision.hpp"
@@ -59,6 +62,14 @@ struct Reference {
   }
 };
 
+const core::TriangleMesh& part_mesh(const core::ProductSpec& product, const std::string& name) {
+  for (const auto& p : product.parts) {
+    if (p.name == name) return p.mesh;
+  }
+  ADD_FAILURE() << "no part " << name;
+  return product.parts.front().mesh;
+}
+
 double path_length(const std::vector<Eigen::VectorXd>& path) {
   double l = 0.0;
   for (std::size_t i = 1; i < path.size(); ++i) l += (path[i] - path[i - 1]).norm();
@@ -88,6 +99,56 @@ class Assembly {
  private:
   core::CollisionModel model_;
   int board_ = -1;
+  std::unique_ptr<core::CollisionData> data_;
+};
+
+// The cell with one board standing still (static): where the suction arm holds it at an
+// exchange, or the human at a goal. Whether the moving arm, the other arm posed too, touches
+// anything. Built from the cell and the board's mesh, not from the stage scene the build checks
+// in.
+class BoardStanding {
+ public:
+  BoardStanding(const core::Cell& cell, const core::TriangleMesh& mesh, const core::Pose& board,
+                const core::Arm& moving)
+      : cell_(cell), scene_(core::build_cell_scene(cell)) {
+    scene_.model.add_mesh_body("board_standing", mesh, true, board);
+    for (std::size_t i = 0; i < cell.arms().size(); ++i) {
+      if (&cell.arms()[i] == &moving) moving_bodies_ = scene_.arm_bodies[i];
+    }
+    data_ = std::make_unique<core::CollisionData>(scene_.model);
+  }
+  // The first contact of the moving arm at `q`, the other at `other_q` ("" if none).
+  std::string contact(const core::Arm& moving, const Eigen::VectorXd& q, const core::Arm& other,
+                      const Eigen::VectorXd& other_q) {
+    Eigen::VectorXd robot_q = cell_.home_configuration();
+    cell_.set_arm(robot_q, other, other_q);
+    cell_.set_arm(robot_q, moving, q);
+    core::set_cell_state(cell_, scene_, *data_, robot_q, cell_.human_neutral());
+    core::CollisionPair pair;
+    if (!core::in_collision(scene_.model, *data_, moving_bodies_, &pair)) return "";
+    return core::describe_pair(scene_.model, pair);
+  }
+  // The first contact along `path` from waypoint `first` on, every `resolution` rad.
+  std::string contact_along(const core::Arm& moving, const std::vector<Eigen::VectorXd>& path,
+                            std::size_t first, double resolution, const core::Arm& other,
+                            const Eigen::VectorXd& other_q) {
+    for (std::size_t i = first + 1; i < path.size(); ++i) {
+      const auto& a = path[i - 1];
+      const auto& b = path[i];
+      const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
+      for (int k = 0; k <= steps; ++k) {
+        std::string c = contact(moving, a + (b - a) * (static_cast<double>(k) / steps), other,
+                                other_q);
+        if (!c.empty()) return c;
+      }
+    }
+    return "";
+  }
+
+ private:
+  const core::Cell& cell_;
+  core::CellScene scene_;
+  std::vector<int> moving_bodies_;
   std::unique_ptr<core::CollisionData> data_;
 };
 
@@ -160,6 +221,12 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
     // cost; the receiving arm's transfers keep the grasp's slip limit and the arm clear of the
     // cell at 4x the roadmap's resolution.
     bool transfer_connected = false;
+    // The suction arm's node at each exchange node of the receiving arm (the handover edges).
+    std::map<std::int64_t, std::int64_t> suction_node_at;
+    for (const auto& e : database.regrasp_edges(part.id)) {
+      if (e.kind == "handover") suction_node_at[e.to_node] = e.from_node;
+    }
+    int ways_in = 0;
     // Parallel transfer edges are other bridges of the first (RegraspSettings::
     // bridge_alternatives): only where the first is a bridge, in its filter, and another path.
     std::map<std::tuple<std::string, std::int64_t, std::int64_t>, db::RegraspEdgeRecord> first;
@@ -190,6 +257,27 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
       EXPECT_TRUE(e.path.front().isApprox(from.solutions.front(), 1e-12)) << "edge " << e.id;
       EXPECT_TRUE(e.path.back().isApprox(to.solutions.front(), 1e-12)) << "edge " << e.id;
       EXPECT_NEAR(e.cost, path_length(e.path), 1e-9) << "edge " << e.id;
+      // Since 0.7.0 the receiving arm's transit to the exchange ends with its way in: home ->
+      // pre-grasp -> grasp, the last segment a straight approach of at most 5 cm, and the whole
+      // path clear of the board standing there in the suction arm's hand, at the empty arm's
+      // resolution (the online planner follows it as it is).
+      const auto tcp_step = [&](const core::Arm& arm, std::size_t i) {
+        return (ref.tcp(arm, e.path[i]).translation() - ref.tcp(arm, e.path[i + 1]).translation())
+            .norm();
+      };
+      const double empty_resolution = database.roadmap("left")->resolution;
+      if (e.kind == "transit" && e.arm == "left" && to.kind == "robot_handover") {
+        ++ways_in;
+        const auto& suction_q =
+            node_by_id.at(suction_node_at.at(e.to_node))->solutions.front();
+        const double approach = tcp_step(left, e.path.size() - 2);
+        EXPECT_GT(approach, 0.0) << "edge " << e.id << " has no approach";
+        EXPECT_LE(approach, 0.05 + 1e-9) << "edge " << e.id;
+        BoardStanding exchange(*ref.cell, part_mesh(product, part.name),
+                               rr_by_id.at(to.robot_handover_id).board, left);
+        EXPECT_EQ(exchange.contact_along(left, e.path, 0, empty_resolution, right, suction_q), "")
+            << "transit edge " << e.id << " into the exchange";
+      }
       // Since 0.3.0 the chains are planned at the board's stage: a held board never passes
       // through the boards assembled before it, checked every 0.01 rad as online.
       if (e.kind == "transfer") {
@@ -231,6 +319,7 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
       // Between two checked samples (0.05 rad of joint motion) the slip angle moves little.
       EXPECT_LE(worst, g.theta_c_deg + 1.5) << "edge " << e.id;
     }
+    EXPECT_GT(ways_in, 0) << "no connected transit into an exchange";
     (transfer_connected ? connected_boards : unconnected_boards).push_back(part.name);
 
     // Filters: bits only on edges whose both ends keep the grasp's slip limit (FK).

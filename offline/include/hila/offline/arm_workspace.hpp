@@ -43,6 +43,10 @@ class ArmWorkspace {
   void place_board(const core::Pose& world);
   void release();
   bool holding() const { return holding_; }
+  // The rest of the robot (the other arm, the jaws) at robot_q, the tool in the suction arm's
+  // hand wherever that arm is; this arm's own joints stay each check's. The receiving arm's way
+  // in to the exchange is checked with the suction arm there, not at home.
+  void pose_rest(const Eigen::VectorXd& robot_q);
 
   // The held board clear of everything but what it touches (the arm as posed by q).
   bool board_clear(const Eigen::VectorXd& q);

@@ -21,6 +21,9 @@ struct RegraspSettings {
   int goals = 10;
   int served_goals = 3;
   int attach_neighbours = 10;  // roadmap nodes tried when connecting a configuration
+  // The same for the receiving arm's pre-grasp at the exchange: beside the board it holds still,
+  // most straight joins to the nearest nodes cross it.
+  int way_in_neighbours = 150;
   // Where a filtered roadmap is cut (or an end does not attach), a bridge is planned.
   core::BridgeSettings bridge;
   // The receiving arm may take the board in any IK branch at the exchange and hand it over in
