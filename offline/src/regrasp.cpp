@@ -504,17 +504,16 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     int node = -1;
     bool transit = false;  // home -> node connected and the exchange clear
   };
-  // An arm's workspace with the board standing still (a static part, which the arm must not
-  // touch) and the rest of the robot posed: the receiving arm's way in at an exchange (the
-  // suction arm there, holding the board). Made once per (use, which pose of the board).
-  enum class Standing { kWayIn };
-  std::map<std::pair<Standing, std::int64_t>, std::unique_ptr<ArmPlanning>> standing;
-  auto standing_for = [&](Standing use, std::int64_t tag, const core::Pose& board,
-                          const Eigen::VectorXd& robot_q) -> ArmPlanning& {
-    auto& slot = standing[{use, tag}];
+  // Per robot-robot pose: the receiving arm's workspace with the board standing there (a static
+  // part, which the gripper must not touch on its way in) and the rest of the robot as at the
+  // exchange (the suction arm holding the board).
+  std::map<std::int64_t, std::unique_ptr<ArmPlanning>> ways_in;
+  auto way_in_for = [&](std::int64_t robot_handover, const core::Pose& board,
+                        const Eigen::VectorXd& robot_q) -> ArmPlanning& {
+    auto& slot = ways_in[robot_handover];
     if (slot) return *slot;
     std::vector<core::PlacedPart> parts = finished;
-    parts.push_back({part.name + "_standing", &part.mesh, board});
+    parts.push_back({part.name + "_at_exchange", &part.mesh, board});
     slot = std::make_unique<ArmPlanning>(ArmPlanning{
         receiving_roadmap, receiving.graph,
         ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, nullptr, parts, stacked),
@@ -542,7 +541,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     // online planner searched the roadmap for every receiving approach instead.
     Eigen::VectorXd at_exchange = cell.home_configuration();
     cell.set_arm(at_exchange, suction_arm, suction_q);
-    ArmPlanning& way_in = standing_for(Standing::kWayIn, s.robot_handover_id, rr.board, at_exchange);
+    ArmPlanning& way_in = way_in_for(s.robot_handover_id, rr.board, at_exchange);
     const Endpoint way_in_home = endpoint(way_in, no_slip_limit, receiving_arm.spec.home, k);
     // Transits through the roadmap to every branch; bridges (costly when they fail) only when
     // none connects, to the first few branches.
