@@ -222,14 +222,14 @@ class ExchangeCheck {
   // The receiving arm's way in to `receiving_q` (core::find_pre_grasp, as the handover search
   // and the online approach ask), the suction arm holding the board as in clear(); none for an
   // exchange pressed against the robot's body, which may be valid and yet unreachable.
-  std::optional<Eigen::VectorXd> pre_grasp(const core::Pose& board, const Eigen::VectorXd& suction_q,
+  std::optional<Eigen::VectorXd> pre_grasp(const core::Pose& board,
+                                           const Eigen::VectorXd& suction_q,
                                            const Eigen::VectorXd& receiving_q, double jaw,
                                            double distance, double resolution) {
-    return core::find_pre_grasp(cell_, receiving_, receiving_q, distance, resolution,
-                                [&](const Eigen::VectorXd& q) {
-                                  return receiving_.chain.within_limits(q, 1e-9) &&
-                                         clear(board, suction_q, q, jaw);
-                                });
+    return core::find_pre_grasp(
+        cell_, receiving_, receiving_q, distance, resolution, [&](const Eigen::VectorXd& q) {
+          return receiving_.chain.within_limits(q, 1e-9) && clear(board, suction_q, q, jaw);
+        });
   }
 
  private:
@@ -549,9 +549,8 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     std::vector<Eigen::VectorXd> pre_grasps;
     for (const auto& q : valid_branches(receiving, rr.board * grasp.tcp, s.joints_rr)) {
       if (!exchange.clear(rr.board, suction_q, q, jaw)) continue;
-      const std::optional<Eigen::VectorXd> pre_q =
-          exchange.pre_grasp(rr.board, suction_q, q, jaw, settings.approach,
-                             settings.approach_resolution);
+      const std::optional<Eigen::VectorXd> pre_q = exchange.pre_grasp(
+          rr.board, suction_q, q, jaw, settings.approach, settings.approach_resolution);
       if (!pre_q) continue;  // valid, but pressed where no open gripper gets in
       LeftEnd end;
       end.node = add_node("robot_handover", settings.receiving_arm, "gripper", s.robot_grasp_id,
@@ -565,8 +564,8 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
                                  [](const Connection& c) { return c.connected; });
     for (std::size_t i = 0; i < ends.size(); ++i) {
       if (!any && static_cast<int>(i) < settings.transfer_bridges) {
-        transits[i] = bridge_path(way_in, no_slip_limit, receiving_arm.spec.home, pre_grasps[i],
-                                  bridge());
+        transits[i] =
+            bridge_path(way_in, no_slip_limit, receiving_arm.spec.home, pre_grasps[i], bridge());
       }
       if (transits[i].connected) {  // the straight approach, checked by pre_grasp()
         transits[i].path.push_back(

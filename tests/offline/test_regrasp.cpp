@@ -137,8 +137,8 @@ class BoardStanding {
       const auto& b = path[i];
       const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
       for (int k = 0; k <= steps; ++k) {
-        std::string c = contact(moving, a + (b - a) * (static_cast<double>(k) / steps), other,
-                                other_q);
+        std::string c =
+            contact(moving, a + (b - a) * (static_cast<double>(k) / steps), other, other_q);
         if (!c.empty()) return c;
       }
     }
@@ -268,8 +268,7 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
       const double empty_resolution = database.roadmap("left")->resolution;
       if (e.kind == "transit" && e.arm == "left" && to.kind == "robot_handover") {
         ++ways_in;
-        const auto& suction_q =
-            node_by_id.at(suction_node_at.at(e.to_node))->solutions.front();
+        const auto& suction_q = node_by_id.at(suction_node_at.at(e.to_node))->solutions.front();
         const double approach = tcp_step(left, e.path.size() - 2);
         EXPECT_GT(approach, 0.0) << "edge " << e.id << " has no approach";
         EXPECT_LE(approach, 0.05 + 1e-9) << "edge " << e.id;
