@@ -27,7 +27,7 @@ constexpr double kJawMargin = 0.005;
 // One arm's roadmap with its search structure and workspace.
 struct ArmPlanning {
   const Roadmap& roadmap;
-  core::RoadmapGraph graph;
+  const core::RoadmapGraph& graph;  // of the roadmap, shared by every workspace of the arm
   ArmWorkspace workspace;
   std::vector<bool> all_edges;
   double held_resolution = 0.01;  // rad, motions with the board in hand (the online planner's)
@@ -318,15 +318,17 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   // transfer blocked in the nominal sequence and fall back to bridges.
   const std::vector<core::PlacedPart> finished = core::parts_before(product, index);
   const std::vector<core::PlacedPart> stacked = core::parts_after(product, index);
+  const core::RoadmapGraph suction_graph(suction_roadmap.nodes, suction_roadmap.edges);
+  const core::RoadmapGraph receiving_graph(receiving_roadmap.nodes, receiving_roadmap.edges);
   ArmPlanning suction{
-      suction_roadmap, core::RoadmapGraph(suction_roadmap.nodes, suction_roadmap.edges),
+      suction_roadmap, suction_graph,
       ArmWorkspace(cell, settings.suction_arm, settings.suction_arm, &part.mesh, finished, stacked),
       std::vector<bool>(suction_roadmap.edges.size(), true), settings.held_resolution};
-  ArmPlanning receiving{
-      receiving_roadmap, core::RoadmapGraph(receiving_roadmap.nodes, receiving_roadmap.edges),
-      ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, &part.mesh, finished,
-                   stacked),
-      std::vector<bool>(receiving_roadmap.edges.size(), true), settings.held_resolution};
+  ArmPlanning receiving{receiving_roadmap, receiving_graph,
+                        ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, &part.mesh,
+                                     finished, stacked),
+                        std::vector<bool>(receiving_roadmap.edges.size(), true),
+                        settings.held_resolution};
   core::GraphSearchWorkspace search;
   ExchangeCheck exchange(cell, part.mesh, finished, stacked, settings.suction_arm,
                          settings.receiving_arm);
@@ -506,19 +508,26 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   };
   // Per robot-robot pose: the receiving arm's workspace with the board standing there (a static
   // part, which the gripper must not touch on its way in) and the rest of the robot as at the
-  // exchange (the suction arm holding the board).
-  std::map<std::int64_t, std::unique_ptr<ArmPlanning>> ways_in;
+  // exchange (the suction arm holding the board), with home attached in it once.
+  struct WayIn {
+    ArmPlanning planning;
+    Endpoint home;
+  };
+  std::map<std::int64_t, std::unique_ptr<WayIn>> ways_in;
   auto way_in_for = [&](std::int64_t robot_handover, const core::Pose& board,
-                        const Eigen::VectorXd& robot_q) -> ArmPlanning& {
+                        const Eigen::VectorXd& robot_q) -> WayIn& {
     auto& slot = ways_in[robot_handover];
     if (slot) return *slot;
     std::vector<core::PlacedPart> parts = finished;
     parts.push_back({part.name + "_at_exchange", &part.mesh, board});
-    slot = std::make_unique<ArmPlanning>(ArmPlanning{
-        receiving_roadmap, receiving.graph,
-        ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, nullptr, parts, stacked),
-        receiving.all_edges, settings.held_resolution});
-    slot->workspace.pose_rest(robot_q);
+    slot = std::make_unique<WayIn>(
+        WayIn{ArmPlanning{receiving_roadmap, receiving_graph,
+                          ArmWorkspace(cell, settings.receiving_arm, settings.suction_arm, nullptr,
+                                       parts, stacked),
+                          receiving.all_edges, settings.held_resolution},
+              {}});
+    slot->planning.workspace.pose_rest(robot_q);
+    slot->home = endpoint(slot->planning, no_slip_limit, receiving_arm.spec.home, k);
     return *slot;
   };
   // Per (robot handover, grasp): one node per receiving-arm branch at the exchange.
@@ -541,8 +550,9 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     // online planner searched the roadmap for every receiving approach instead.
     Eigen::VectorXd at_exchange = cell.home_configuration();
     cell.set_arm(at_exchange, suction_arm, suction_q);
-    ArmPlanning& way_in = way_in_for(s.robot_handover_id, rr.board, at_exchange);
-    const Endpoint way_in_home = endpoint(way_in, no_slip_limit, receiving_arm.spec.home, k);
+    WayIn& entry = way_in_for(s.robot_handover_id, rr.board, at_exchange);
+    ArmPlanning& way_in = entry.planning;
+    const Endpoint& way_in_home = entry.home;
     // Transits through the roadmap to every branch; bridges (costly when they fail) only when
     // none connects, to the first few branches.
     std::vector<Connection> transits;

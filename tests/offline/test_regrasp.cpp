@@ -128,11 +128,11 @@ class BoardStanding {
     if (!core::in_collision(scene_.model, *data_, moving_bodies_, &pair)) return "";
     return core::describe_pair(scene_.model, pair);
   }
-  // The first contact along `path` from waypoint `first` on, every `resolution` rad.
+  // The first contact along `path`, every `resolution` rad.
   std::string contact_along(const core::Arm& moving, const std::vector<Eigen::VectorXd>& path,
-                            std::size_t first, double resolution, const core::Arm& other,
+                            double resolution, const core::Arm& other,
                             const Eigen::VectorXd& other_q) {
-    for (std::size_t i = first + 1; i < path.size(); ++i) {
+    for (std::size_t i = 1; i < path.size(); ++i) {
       const auto& a = path[i - 1];
       const auto& b = path[i];
       const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
@@ -261,20 +261,19 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
       // pre-grasp -> grasp, the last segment a straight approach of at most 5 cm, and the whole
       // path clear of the board standing there in the suction arm's hand, at the empty arm's
       // resolution (the online planner follows it as it is).
-      const auto tcp_step = [&](const core::Arm& arm, std::size_t i) {
-        return (ref.tcp(arm, e.path[i]).translation() - ref.tcp(arm, e.path[i + 1]).translation())
-            .norm();
-      };
-      const double empty_resolution = database.roadmap("left")->resolution;
       if (e.kind == "transit" && e.arm == "left" && to.kind == "robot_handover") {
         ++ways_in;
         const auto& suction_q = node_by_id.at(suction_node_at.at(e.to_node))->solutions.front();
-        const double approach = tcp_step(left, e.path.size() - 2);
+        const std::size_t n = e.path.size();
+        const double approach = (ref.tcp(left, e.path[n - 2]).translation() -
+                                 ref.tcp(left, e.path[n - 1]).translation())
+                                    .norm();
+        const double empty_resolution = database.roadmap("left")->resolution;
         EXPECT_GT(approach, 0.0) << "edge " << e.id << " has no approach";
         EXPECT_LE(approach, 0.05 + 1e-9) << "edge " << e.id;
         BoardStanding exchange(*ref.cell, part_mesh(product, part.name),
                                rr_by_id.at(to.robot_handover_id).board, left);
-        EXPECT_EQ(exchange.contact_along(left, e.path, 0, empty_resolution, right, suction_q), "")
+        EXPECT_EQ(exchange.contact_along(left, e.path, empty_resolution, right, suction_q), "")
             << "transit edge " << e.id << " into the exchange";
       }
       // Since 0.3.0 the chains are planned at the board's stage: a held board never passes
