@@ -110,7 +110,8 @@ std::vector<Eigen::VectorXd> plan_bridge_to_any(
     high = high.cwiseMax(*t);
   }
   const auto space =
-      detail::joint_space(arm, settings.joint_range, settings.seed, &low, &high, settings.project);
+      detail::joint_space(arm, settings.joint_range, settings.seed, &low, &high, settings.project,
+                          {settings.focus, settings.focus_fraction, settings.focus_sigma});
   auto si = std::make_shared<ob::SpaceInformation>(space);
   long checks = 0;
   si->setStateValidityChecker([&](const ob::State* s) {

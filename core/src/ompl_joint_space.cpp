@@ -1,6 +1,7 @@
 #include "ompl_joint_space.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "hila/core/joint_box.hpp"
 
@@ -8,8 +9,17 @@ namespace ob = ompl::base;
 
 namespace hila::core::detail {
 
-SeededSampler::SeededSampler(const ob::StateSpace* space, std::uint64_t seed, Projection project)
-    : ob::StateSampler(space), rng_(seed), project_(std::move(project)) {}
+SeededSampler::SeededSampler(const ob::StateSpace* space, std::uint64_t seed, Projection project,
+                             SamplerFocus focus)
+    : ob::StateSampler(space), rng_(seed), project_(std::move(project)), focus_(std::move(focus)) {}
+
+// Box-Muller from the seeded generator (std::normal_distribution's output is not specified
+// across standard libraries).
+double SeededSampler::gaussian() {
+  const double u1 = 1.0 - uniform();  // (0, 1]
+  const double u2 = uniform();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.14159265358979323846 * u2);
+}
 
 void SeededSampler::sampleUniform(ob::State* state) {
   if (!project_) {
@@ -39,6 +49,16 @@ void SeededSampler::sampleUniform(ob::State* state) {
 void SeededSampler::draw(ob::State* state) {
   const auto& bounds = space_->as<ob::RealVectorStateSpace>()->getBounds();
   auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+  if (!focus_.around.empty() && uniform() < focus_.fraction) {
+    const auto k = std::min(focus_.around.size() - 1,
+                            static_cast<std::size_t>(uniform() * focus_.around.size()));
+    const Eigen::VectorXd& c = focus_.around[k];
+    for (std::size_t i = 0; i < bounds.low.size(); ++i) {
+      v->values[i] = std::clamp(c[static_cast<Eigen::Index>(i)] + focus_.sigma * gaussian(),
+                                bounds.low[i], bounds.high[i]);
+    }
+    return;
+  }
   for (std::size_t i = 0; i < bounds.low.size(); ++i) {
     v->values[i] = bounds.low[i] + uniform() * (bounds.high[i] - bounds.low[i]);
   }
@@ -58,11 +78,9 @@ void SeededSampler::sampleGaussian(ob::State* state, const ob::State* mean, doub
   sampleUniformNear(state, mean, 2.0 * stddev);
 }
 
-std::shared_ptr<ob::RealVectorStateSpace> joint_space(const Arm& arm, double joint_range,
-                                                      std::uint64_t seed,
-                                                      const Eigen::VectorXd* include_a,
-                                                      const Eigen::VectorXd* include_b,
-                                                      SeededSampler::Projection project) {
+std::shared_ptr<ob::RealVectorStateSpace> joint_space(
+    const Arm& arm, double joint_range, std::uint64_t seed, const Eigen::VectorXd* include_a,
+    const Eigen::VectorXd* include_b, SeededSampler::Projection project, SamplerFocus focus) {
   const int dof = arm.chain.dof();
   auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(dof));
   ob::RealVectorBounds bounds(static_cast<unsigned>(dof));
@@ -79,9 +97,10 @@ std::shared_ptr<ob::RealVectorStateSpace> joint_space(const Arm& arm, double joi
     bounds.setHigh(static_cast<unsigned>(i), high);
   }
   space->setBounds(bounds);
-  space->setStateSamplerAllocator([seed, project = std::move(project)](const ob::StateSpace* s) {
-    return std::make_shared<SeededSampler>(s, seed, project);
-  });
+  space->setStateSamplerAllocator(
+      [seed, project = std::move(project), focus = std::move(focus)](const ob::StateSpace* s) {
+        return std::make_shared<SeededSampler>(s, seed, project, focus);
+      });
   return space;
 }
 

@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <random>
+#include <vector>
 
 #include "hila/core/cell.hpp"
 
@@ -18,13 +19,21 @@ namespace hila::core::detail {
 
 // Uniform joint samples from a seeded generator (OMPL's own samplers draw from a process-wide
 // seed, which would make plans depend on what ran before).
+// Where part of the samples are drawn: around given configurations (a Gaussian per joint),
+// for a tree rooted where few straight steps toward uniform samples are free.
+struct SamplerFocus {
+  std::vector<Eigen::VectorXd> around;
+  double fraction = 0.0;  // of the samples
+  double sigma = 0.5;     // rad, per joint
+};
+
 class SeededSampler : public ompl::base::StateSampler {
  public:
   // `project` (optional) moves each uniform sample onto a constraint, or rejects it (false):
   // the sample is then drawn again, a few times at most (the last one is kept as drawn).
   using Projection = std::function<bool(Eigen::VectorXd&)>;
   SeededSampler(const ompl::base::StateSpace* space, std::uint64_t seed,
-                Projection project = nullptr);
+                Projection project = nullptr, SamplerFocus focus = {});
   void sampleUniform(ompl::base::State* state) override;
   void sampleUniformNear(ompl::base::State* state, const ompl::base::State* near,
                          double distance) override;
@@ -34,8 +43,10 @@ class SeededSampler : public ompl::base::StateSampler {
  private:
   double uniform() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
   void draw(ompl::base::State* state);
+  double gaussian();
   std::mt19937_64 rng_;
   Projection project_;
+  SamplerFocus focus_;
   Eigen::VectorXd scratch_;
 };
 
@@ -44,6 +55,7 @@ class SeededSampler : public ompl::base::StateSampler {
 // samples go through `project` when given (SeededSampler).
 std::shared_ptr<ompl::base::RealVectorStateSpace> joint_space(
     const Arm& arm, double joint_range, std::uint64_t seed, const Eigen::VectorXd* include_a,
-    const Eigen::VectorXd* include_b, SeededSampler::Projection project = nullptr);
+    const Eigen::VectorXd* include_b, SeededSampler::Projection project = nullptr,
+    SamplerFocus focus = {});
 
 }  // namespace hila::core::detail

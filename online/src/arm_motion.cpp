@@ -156,6 +156,7 @@ core::BridgeSettings ArmMotionPlanner::bridge_settings(
   bridge.resolution = resolution_;
   bridge.seed = settings_.seed;
   bridge.deadline = deadline;
+  bridge.focus_sigma = settings_.focus_sigma;
   if (settings_.project_slip && held_.held && held_.theta_c_deg < 90.0) {
     const core::SlipProjection slip(arm_, base_, held_.axis_tcp, held_.lever_tcp,
                                     held_.theta_c_deg);
@@ -363,7 +364,9 @@ std::vector<Eigen::VectorXd> ArmMotionPlanner::follow(
         index.push_back(k);
       }
     }
-    const core::BridgeSettings bridge = bridge_settings(repair_checks, deadline);
+    core::BridgeSettings bridge = bridge_settings(repair_checks, deadline);
+    bridge.focus = {at(i)};
+    bridge.focus_fraction = settings_.repair_focus;
     const auto around = core::plan_bridge_to_any(arm_, valid_here, at(i), targets, bridge);
     if (around.empty()) return {};
     path.insert(path.end(), around.begin() + 1, around.end());
@@ -739,7 +742,14 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     if (!late()) remember_failure(repair);
   }
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
-  const core::BridgeSettings bridge = bridge_settings(settings_.bridge_checks, request.deadline);
+  core::BridgeSettings bridge =
+      bridge_settings(r.wedged ? std::min(settings_.bridge_checks, settings_.wedged_bridge_checks)
+                               : settings_.bridge_checks,
+                      request.deadline);
+  if (r.wedged) {
+    bridge.focus = {entries.empty() ? request.start : request.goal};
+    bridge.focus_fraction = settings_.wedged_focus;
+  }
   // The bridge is deterministic: the same ends under the same checks and budget fail again.
   const FailedBridge asked{request.start, request.goal, bridge.max_checks, request.start_in_contact,
                            nullptr,       context_};

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hila/core/bridge.hpp"
+#include "hila/core/joint_box.hpp"
 #include "util/joint_wall.hpp"
 #include "util/test_util.hpp"
 
@@ -218,6 +219,62 @@ TEST(Bridge, ToAnyEndsAtOneOfTheValidTargets) {
   };
   EXPECT_TRUE(core::plan_bridge_to_any(arm, counting, s.from, {inside}, {}).empty());
   EXPECT_LE(calls, 2);
+}
+
+// An end wedged as the scene wedges a held board: free right around it, but every straight step
+// of the bridge's range toward the joint box's middle blocked (a shell around the end, open
+// only in a cone facing the box's edge). Toward uniform samples its tree cannot leave its root,
+// and the other tree must find the cone's mouth by chance; with part of the samples drawn
+// around the end, its tree grows out through the cone. Same seeds and budget for both.
+TEST(Bridge, FocusAroundAWedgedEndGetsOutOfIt) {
+  const core::Arm& arm = left_arm();
+  const core::JointBox box = core::joint_box(arm, core::BridgeSettings{}.joint_range);
+  const Eigen::VectorXd middle = (box.lower + box.upper) / 2.0;
+  Eigen::VectorXd goal = middle;
+  goal[0] = box.upper[0] - 0.5;
+  Eigen::VectorXd start = middle;
+  start[0] -= 1.5;
+  const Eigen::VectorXd outward = Eigen::VectorXd::Unit(goal.size(), 0);
+  long calls = 0;
+  const Validity valid = [&](const Eigen::VectorXd& q) {
+    ++calls;
+    const Eigen::VectorXd d = q - goal;
+    const double r = d.norm();
+    return !(r > 0.12 && r < 0.8 && d.dot(outward) < 0.3 * r);
+  };
+  ASSERT_TRUE(valid(start) && valid(goal));
+  ASSERT_TRUE(within_limits(arm, start) && within_limits(arm, goal));
+  int uniform_found = 0;
+  int focused_found = 0;
+  long uniform_calls = 0;
+  long focused_calls = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    core::BridgeSettings settings;
+    settings.seed = seed;
+    settings.max_checks = 3000;
+    calls = 0;
+    const auto uniform = core::plan_bridge(arm, valid, start, goal, settings);
+    uniform_calls += calls;
+    uniform_found += uniform.empty() ? 0 : 1;
+    settings.focus = {goal};
+    settings.focus_fraction = 0.6;
+    calls = 0;
+    const auto focused = core::plan_bridge(arm, valid, start, goal, settings);
+    focused_calls += calls;
+    if (focused.empty()) continue;
+    ++focused_found;
+    // Drawn from the seeded generator too: the same seed, the same path.
+    EXPECT_EQ(core::plan_bridge(arm, valid, start, goal, settings), focused);
+    EXPECT_EQ(focused.front(), start);
+    EXPECT_EQ(focused.back(), goal);
+    for (const auto& q : focused) EXPECT_TRUE(within_limits(arm, q)) << q.transpose();
+    expect_path_valid(focused, valid, settings.resolution);
+  }
+  // Measured: 0 of 10 uniform, 10 of 10 focused, with under a quarter of the checks.
+  EXPECT_GE(focused_found, 8);
+  EXPECT_GT(focused_found, uniform_found + 3);
+  EXPECT_LT(focused_calls, uniform_calls);
 }
 
 TEST(Bridge, SegmentValidMatchesDenseCheck) {

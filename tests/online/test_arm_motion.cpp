@@ -750,6 +750,7 @@ TEST_F(ArmMotionCrated, AFailedBridgeIsNotRunAgainForTheSameEnds) {
   settings.attach_neighbours = 0;  // both ends wedged: straight to the bridge
   settings.wedged_repair_checks = 0;
   settings.bridge_checks = 30;  // too few to get around the crate
+  settings.wedged_focus = 0.0;  // uniform samples: drawn around the wedged end, 30 get round
   online::ArmMotionPlanner planner(world, left_roadmap(), "left", settings);
   planner.prepare(r);
   ASSERT_FALSE(planner.segment_valid(a, b)) << "the crate must block the straight motion";
@@ -777,6 +778,38 @@ TEST_F(ArmMotionCrated, AFailedBridgeIsNotRunAgainForTheSameEnds) {
   EXPECT_GE(planner.checks() - before_larger, first_checks);
 }
 
+// Both ends wedged (attached to no node): the whole-motion bridge draws most of its samples
+// around the end it leaves from (MotionSettings::wedged_focus) and gets at most
+// wedged_bridge_checks in the first round, whatever bridge_checks allows; the larger bridges'
+// round lifts the cap (set_wedged_bridge_checks). The path it finds passes the independent
+// validator. (That the focus gets a wedged end out where uniform samples do not is
+// test_bridge's FocusAroundAWedgedEndGetsOutOfIt: this crate wedges nothing directionally.)
+TEST_F(ArmMotionCrated, AWedgedEndsBridgeIsFocusedAndCappedInTheFirstRound) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
+  online::MotionSettings settings;
+  settings.attach_neighbours = 0;  // both ends wedged: straight to the bridge
+  settings.wedged_repair_checks = 0;
+  settings.bridge_checks = 10000;
+  settings.wedged_bridge_checks = 400;  // measured: 1244 needed here
+  ASSERT_GT(settings.wedged_focus, 0.0);
+  online::ArmMotionPlanner planner(world, left_roadmap(), "left", settings);
+  const long at_capped = planner.checks();
+  const auto capped = planner.plan(request(a, b));
+  ASSERT_FALSE(capped.solved()) << "400 checks got round the crate";
+  EXPECT_TRUE(capped.wedged);
+  EXPECT_LT(planner.checks() - at_capped, 1000) << "the bridge ran with bridge_checks";
+
+  planner.set_wedged_bridge_checks(settings.bridge_checks);
+  const auto lifted = planner.plan(request(a, b));
+  ASSERT_TRUE(lifted.solved()) << lifted.reason;
+  EXPECT_EQ(lifted.via, "bridge");
+  EXPECT_TRUE(lifted.path.front().isApprox(a, 0.0));
+  EXPECT_TRUE(lifted.path.back().isApprox(b, 0.0));
+  const auto report = validate_in(world, lifted.path);
+  EXPECT_TRUE(report.valid()) << describe(report);
+}
+
 // A wedged motion's repair of a stored path that fails within its budget fails again for the
 // same ends, path, budget and context: not run again, even after the planner served another
 // context in between (the larger bridges' round comes back to the first round's contexts).
@@ -790,6 +823,8 @@ TEST_F(ArmMotionCrated, AFailedRepairIsNotRunAgainUnderTheSameContext) {
   settings.attach_neighbours = 0;      // both ends wedged: the repair, then the bridge
   settings.wedged_repair_checks = 40;  // too few to get around the crate
   settings.bridge_checks = 30;
+  settings.wedged_focus = 0.0;  // uniform samples: what the budgets above are too few for
+  settings.repair_focus = 0.0;
   online::ArmMotionPlanner planner(world, left_roadmap(), "left", settings);
   planner.prepare(r);
   ASSERT_FALSE(planner.valid(stored[stored.size() / 2])) << "the crate must block the stored path";

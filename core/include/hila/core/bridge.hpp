@@ -27,6 +27,13 @@ struct BridgeSettings {
   // SlipProjection), or rejects it: in a thin constrained set nearly every uniform sample is
   // invalid, and RRT-Connect by rejection alone spends its budget there. Optional.
   std::function<bool(Eigen::VectorXd&)> project;
+  // Configurations a share of the samples is drawn around (`focus_fraction`, a Gaussian of
+  // `focus_sigma` rad per joint). For an end wedged in by the scene: straight steps from it
+  // toward uniform samples mostly fail, though the space right around it is largely free, so
+  // its tree stays at its root while the other one spends the budget.
+  std::vector<Eigen::VectorXd> focus;
+  double focus_fraction = 0.0;
+  double focus_sigma = 0.5;
 };
 
 // A path from `from` to `to` where every state satisfies `valid`, for where a filtered roadmap

@@ -132,6 +132,16 @@ struct MotionSettings {
   // go home from beside the human's hands on back_lower and shelf_middle (the whole goal was then
   // abandoned after every other motion was planned); 10000 bridges them.
   long bridge_checks = 10000;
+  // A bridge for an end wedged in by the scene (no straight join reaches a roadmap node): a
+  // `wedged_focus` share of its samples drawn around that end (a Gaussian of `focus_sigma` rad
+  // per joint, core::BridgeSettings::focus), within `wedged_bridge_checks` (and bridge_checks)
+  // until the larger bridges' round. Uniform samples alone left the wedged end's tree at its
+  // root: 20 of 35 wedged bridges in bench_online got through, needing a median of 1 400 checks
+  // and up to 6 800; drawn around the end, 19 of 31, needing a median of 400 and at most 4 300.
+  // The hopeless ones then cost 3 000 checks each instead of 10 000 (docs/online.md, session 23).
+  long wedged_bridge_checks = 3000;
+  double wedged_focus = 0.6;
+  double focus_sigma = 0.5;  // rad
   // A stored path the scene blocks, repaired around each blocked stretch (at most
   // `max_repairs`) by a bridge to one of the next `repair_targets` valid waypoints, when the
   // roadmap fails and before a bridge across the whole motion: with `repair_checks` per
@@ -149,6 +159,9 @@ struct MotionSettings {
   long escalated_repair_checks = 20000;
   int max_repairs = 2;
   int repair_targets = 12;
+  // A repair's samples drawn around the waypoint it leaves from, as for a wedged end: the stored
+  // path is blocked right after it, so it is usually up against what blocks it.
+  double repair_focus = 0.6;
   // A path the validator rejected, mended stretch by stretch at its resolution
   // (MotionRequest::rejected): each blocked stretch's bridge budget, and how many stretches.
   long fine_repair_checks = 10000;
@@ -195,6 +208,8 @@ class ArmMotionPlanner {
 
   // A bridge's check budget from the next request on (MotionSettings::bridge_checks).
   void set_bridge_checks(long checks) { settings_.bridge_checks = checks; }
+  // A wedged end's bridge budget from the next request on (MotionSettings::wedged_bridge_checks).
+  void set_wedged_bridge_checks(long checks) { settings_.wedged_bridge_checks = checks; }
   // A stored path's repair budget from the next request on (MotionSettings::repair_checks).
   void set_repair_checks(long checks) { settings_.repair_checks = checks; }
 
