@@ -1,6 +1,7 @@
 #include "ompl_joint_space.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "hila/core/joint_box.hpp"
@@ -11,7 +12,12 @@ namespace hila::core::detail {
 
 SeededSampler::SeededSampler(const ob::StateSpace* space, std::uint64_t seed, Projection project,
                              SamplerFocus focus)
-    : ob::StateSampler(space), rng_(seed), project_(std::move(project)), focus_(std::move(focus)) {}
+    : ob::StateSampler(space), rng_(seed), project_(std::move(project)), focus_(std::move(focus)) {
+  for (const auto& c : focus_.around) {
+    assert(c.size() == static_cast<Eigen::Index>(space->getDimension()));
+    (void)c;
+  }
+}
 
 // Box-Muller from the seeded generator (std::normal_distribution's output is not specified
 // across standard libraries).

@@ -17,16 +17,17 @@
 
 namespace hila::core::detail {
 
-// Uniform joint samples from a seeded generator (OMPL's own samplers draw from a process-wide
-// seed, which would make plans depend on what ran before).
 // Where part of the samples are drawn: around given configurations (a Gaussian per joint),
 // for a tree rooted where few straight steps toward uniform samples are free.
 struct SamplerFocus {
-  std::vector<Eigen::VectorXd> around;
-  double fraction = 0.0;  // of the samples
-  double sigma = 0.5;     // rad, per joint
+  std::vector<Eigen::VectorXd> around;  // each of the space's dimension
+  double fraction = 0.0;                // of the samples
+  double sigma = 0.5;                   // rad, per joint
 };
 
+// Uniform joint samples from a seeded generator (OMPL's own samplers draw from a process-wide
+// seed, which would make plans depend on what ran before); a `focus` share of them around given
+// configurations instead.
 class SeededSampler : public ompl::base::StateSampler {
  public:
   // `project` (optional) moves each uniform sample onto a constraint, or rejects it (false):

@@ -216,9 +216,8 @@ class Run {
   }
 
   // Bridges (a wedged end's too) of `checks` and stored-path repairs of `repair_checks` from now
-  // on. The stages that
-  // failed are forgotten so that they are planned again; those that were planned stand (a larger
-  // budget finds the same or more).
+  // on. The stages that failed are forgotten so that they are planned again; those that were
+  // planned stand (a larger budget finds the same or more).
   void escalate(long checks, long repair_checks) {
     suction_planner_.set_bridge_checks(checks);
     receiving_planner_.set_bridge_checks(checks);
