@@ -723,23 +723,31 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   const long repair_budget = r.wedged
                                  ? std::max(settings_.repair_checks, settings_.wedged_repair_checks)
                                  : settings_.repair_checks;
+  // A wedged motion's stored paths are each tried cheaply before any is tried at full budget.
+  std::vector<long> repair_budgets{repair_budget};
+  if (r.wedged && settings_.wedged_first_repair_checks > 0 &&
+      settings_.wedged_first_repair_checks < repair_budget) {
+    repair_budgets.insert(repair_budgets.begin(), settings_.wedged_first_repair_checks);
+  }
   // A repair is as deterministic as a bridge: one that failed within its budget is not run again
-  // (the larger bridges' round repeats a wedged motion's repairs at the same budget).
-  for (const auto* hint : request.hints) {
-    if (!request.follow_hints || repair_budget <= 0 || late()) break;
-    const FailedBridge repair{request.start, request.goal, repair_budget, request.start_in_contact,
-                              hint,          context_};
-    if (std::find(failed_bridges_.begin(), failed_bridges_.end(), repair) !=
-        failed_bridges_.end()) {
-      continue;
+  // (the larger bridges' round repeats a wedged motion's repairs at the same budgets).
+  for (const long budget : repair_budgets) {
+    for (const auto* hint : request.hints) {
+      if (!request.follow_hints || budget <= 0 || late()) break;
+      const FailedBridge repair{request.start, request.goal, budget, request.start_in_contact,
+                                hint,          context_};
+      if (std::find(failed_bridges_.begin(), failed_bridges_.end(), repair) !=
+          failed_bridges_.end()) {
+        continue;
+      }
+      r.path = follow(*hint, request.start, request.goal, budget, valid_here, request.deadline,
+                      settings_.max_repairs);
+      if (!r.path.empty()) {
+        r.via = "stored+repair";
+        return finish(MotionStatus::kSolved, "");
+      }
+      if (!late()) remember_failure(repair);
     }
-    r.path = follow(*hint, request.start, request.goal, repair_budget, valid_here, request.deadline,
-                    settings_.max_repairs);
-    if (!r.path.empty()) {
-      r.via = "stored+repair";
-      return finish(MotionStatus::kSolved, "");
-    }
-    if (!late()) remember_failure(repair);
   }
   // The roadmap is cut here: a bridge under the same checks, within the deadline.
   core::BridgeSettings bridge =

@@ -856,3 +856,60 @@ TEST_F(ArmMotionCrated, AFailedRepairIsNotRunAgainUnderTheSameContext) {
   EXPECT_EQ(again.reason, first.reason);
   EXPECT_EQ(fresh.checks(), first_checks);
 }
+
+// A wedged motion with two stored paths: the first blocked by the crate (its repair needs
+// hundreds of checks), the second a way round the crate with one waypoint planted in it (a
+// repair of a few checks). With a cheap first pass (wedged_first_repair_checks) each stored
+// path is tried cheaply before either at full budget: the second is taken, for fewer checks;
+// with the full budget only, the first is repaired at length. Both pass the validator.
+TEST_F(ArmMotionCrated, AWedgedMotionTriesEveryStoredPathCheaplyFirst) {
+  const auto& [a, b, before, blocked] = crated();
+  const online::World& world = crated_world();
+  const std::vector<Eigen::VectorXd>& crated_path = before.path;
+  online::MotionSettings settings;
+  settings.attach_neighbours = 0;  // both ends wedged: the repairs, then the bridge
+  settings.wedged_repair_checks = 20000;
+  settings.wedged_first_repair_checks = 0;
+
+  // A way round the crate (a bridge's), with the crated path's blocked middle planted in it.
+  online::ArmMotionPlanner finder(world, left_roadmap(), "left", settings);
+  const auto round = finder.plan(request(a, b));
+  ASSERT_TRUE(round.solved()) << round.reason;
+  ASSERT_GE(round.path.size(), 3u);
+  const Eigen::VectorXd& planted = crated_path[crated_path.size() / 2];
+  finder.prepare(request(a, b));
+  ASSERT_FALSE(finder.valid(planted)) << "the crate must block the crated path's middle";
+  std::vector<Eigen::VectorXd> around = round.path;
+  around.insert(around.begin() + 2, planted);
+
+  online::MotionRequest r = request(a, b);
+  r.hints = {&crated_path, &around};
+  online::ArmMotionPlanner full_only(world, left_roadmap(), "left", settings);
+  const auto at_full = full_only.plan(r);
+  settings.wedged_first_repair_checks = 100;
+  online::ArmMotionPlanner cheap_first(world, left_roadmap(), "left", settings);
+  const auto at_cheap = cheap_first.plan(r);
+
+  for (const auto* result : {&at_full, &at_cheap}) {
+    ASSERT_TRUE(result->solved()) << result->reason;
+    EXPECT_EQ(result->via, "stored+repair");
+    EXPECT_TRUE(result->wedged);
+    EXPECT_TRUE(result->path.front().isApprox(a, 0.0));
+    EXPECT_TRUE(result->path.back().isApprox(b, 0.0));
+    const auto report = validate_in(world, result->path);
+    EXPECT_TRUE(report.valid()) << describe(report);
+  }
+  const auto passes_through = [](const std::vector<Eigen::VectorXd>& path,
+                                 const Eigen::VectorXd& q) {
+    return std::any_of(path.begin(), path.end(),
+                       [&](const Eigen::VectorXd& p) { return p.isApprox(q, 0.0); });
+  };
+  // The full budget repairs the crated path (its first interior waypoint kept); the cheap pass
+  // takes the way round (its waypoint before the planted one kept).
+  EXPECT_TRUE(passes_through(at_full.path, crated_path[1]));
+  EXPECT_FALSE(passes_through(at_full.path, around[1]));
+  EXPECT_TRUE(passes_through(at_cheap.path, around[1]));
+  EXPECT_FALSE(passes_through(at_cheap.path, crated_path[1]));
+  EXPECT_LT(cheap_first.checks(), full_only.checks())
+      << cheap_first.checks() << " against " << full_only.checks();
+}

@@ -154,8 +154,13 @@ struct MotionSettings {
   // A wedged repair gets the larger round's budget from the start (20000, was 10000):
   // lateral_left's v3, v7 and v8 needed it, and got it only after every goal had failed once
   // (median of 3 runs 273/318/364 -> 67/85/134 ms, the same 140 plans).
+  // Wedged repairs first go over every stored path at `wedged_first_repair_checks` each, then
+  // at the full budget: of three stored transfers the first may need 15 000 checks round a box
+  // where another gets round it in 3 000 (lateral_left v3, v7, v16: 55-85 -> 23-29 ms, p95
+  // 45 -> 30 ms; docs/online.md, Session 24). 0: the full budget only.
   long repair_checks = 0;
   long wedged_repair_checks = 20000;
+  long wedged_first_repair_checks = 3000;
   long escalated_repair_checks = 20000;
   int max_repairs = 2;
   int repair_targets = 12;
