@@ -724,8 +724,9 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
                                  ? std::max(settings_.repair_checks, settings_.wedged_repair_checks)
                                  : settings_.repair_checks;
   // A wedged motion's stored paths are each tried cheaply before any is tried at full budget.
+  // (With one stored path the cheap try would be the full one's first checks, spent twice.)
   std::vector<long> repair_budgets{repair_budget};
-  if (r.wedged && settings_.wedged_first_repair_checks > 0 &&
+  if (r.wedged && request.hints.size() > 1 && settings_.wedged_first_repair_checks > 0 &&
       settings_.wedged_first_repair_checks < repair_budget) {
     repair_budgets.insert(repair_budgets.begin(), settings_.wedged_first_repair_checks);
   }
