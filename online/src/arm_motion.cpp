@@ -468,7 +468,10 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd&
   };
   std::vector<core::GraphEndpoint> out;
   for (std::size_t j = 0; j < take; ++j) {
-    if (static_cast<int>(out.size()) >= settings_.attachments) break;
+    if (static_cast<int>(out.size()) >=
+        (check_joins ? settings_.checked_attachments : settings_.attachments)) {
+      break;
+    }
     sort_up_to(j);
     const int n = near[j].second;
     if (node_valid(n) && (!check_joins || segment_valid(q, nodes[static_cast<std::size_t>(n)]))) {

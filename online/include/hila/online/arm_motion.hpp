@@ -117,6 +117,11 @@ struct MotionSettings {
   // planned, median 1.33 s; with 150, 20/20 and 0.73 s).
   int attach_neighbours = 150;
   int attachments = 6;  // valid attachments kept per end
+  // The same where the joins are checked (an end whose unchecked joins failed, a stored path's
+  // end): each kept node costs a whole segment's checks, and past the second they rarely
+  // shorten the path. 2 instead of 6: per problem x0.80-0.91 (bench seeds 1 and 2), x0.999
+  // (seed 3), robot motion over the 140 plans 4026 -> 4013 s (docs/online.md, Session 24).
+  int checked_attachments = 2;
   int max_searches = 200;
   int staging_searches = 20;  // per staging try (MotionRequest::max_searches)
   // Segment checks while holding a board (rad): finer than the roadmap's 0.05, since a long
@@ -247,7 +252,8 @@ class ArmMotionPlanner {
   std::vector<Eigen::VectorXd> stored_tail(const Hints& hints, const Eigen::VectorXd& goal);
   void shorten(std::vector<Eigen::VectorXd>& path);
   // The nearest valid roadmap nodes (MotionSettings::attachments of the attach_neighbours
-  // nearest), with `check_joins` only those the straight segment from q reaches.
+  // nearest), with `check_joins` only those the straight segment from q reaches (and
+  // MotionSettings::checked_attachments of them).
   std::vector<core::GraphEndpoint> attach(const Eigen::VectorXd& q, bool check_joins);
   // The roadmap entered (checked joins) where a stored path's longest valid beginning from q
   // (`is_start`), or end into q, takes the arm: `via` becomes that stretch. Empty when none.
