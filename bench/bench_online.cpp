@@ -184,6 +184,7 @@ struct Result {
   std::map<std::string, int> outcomes;  // every attempt's outcome in full, with its count
   std::vector<std::string> invalidity;  // solved but rejected by the re-check
   int checked_samples = 0;
+  int motions_planned = 0;  // BoardPlan::motions_planned
   bool invalid() const { return solved && !invalidity.empty(); }
 };
 
@@ -245,6 +246,7 @@ Result run(online::BoardPlanner& planner, const online::PlannerModel& model,
   r.seconds = plan.planning_seconds;
   r.times = plan.times;
   r.attempts = static_cast<int>(plan.attempts.size());
+  r.motions_planned = plan.motions_planned;
   for (const auto& a : plan.attempts) ++r.outcomes[a.outcome];
   if (!r.solved) {
     r.why_failed = why_failed(plan);
@@ -350,6 +352,7 @@ nlohmann::json result_json(const Result& r) {
     j["valid"] = !r.invalid();
     j["invalidity"] = r.invalidity;
     j["checked_samples"] = r.checked_samples;
+    j["motions_planned"] = r.motions_planned;
   }
   return j;
 }

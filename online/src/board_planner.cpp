@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <map>
 #include <memory>
 #include <optional>
@@ -126,6 +127,8 @@ struct Stage {
 
 using Hints = std::vector<const std::vector<Eigen::VectorXd>*>;
 
+constexpr const char* kNoHumanPoseIk = "transfer_to_human: no valid IK at the robot-human pose";
+
 // The steps whose paths, reversed, lead the receiving arm home after the release (Run::leave),
 // where its retreat attaches to no roadmap node.
 constexpr std::array<std::string_view, 3> kWayBackSteps = {"transfer_to_human", "receiving_grasp",
@@ -197,6 +200,7 @@ class Run {
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
   // The run's times so far, the validator's own time on either thread included.
   int rejected_motions() const { return rejected_motions_; }
+  int motions_planned() const { return motions_planned_; }
   PlanTimes times() const {
     PlanTimes t = times_;
     t.queued_validation = queue_ ? queue_->seconds() : queued_seconds_;
@@ -278,7 +282,12 @@ class Run {
       stages[0] = &tool();
       if (stages[0]->ok()) stages[1] = &pick(rr.suction_grasp_id);
       if (stages[1] != nullptr && stages[1]->ok()) stages[2] = &transfer(rr);
-      if (stages[2] != nullptr && stages[2]->ok()) stages[3] = &receive(rr, grasp);
+      // The exchange and release are planned per grasp: not for one whose goal the receiving
+      // arm cannot reach (the present stage's own first check, made first).
+      if (stages[2] != nullptr && stages[2]->ok() &&
+          (!settings_.reach_human_pose_first || reaches_human_pose(grasp, goal))) {
+        stages[3] = &receive(rr, grasp);
+      }
       if (stages[3] != nullptr && stages[3]->ok()) stages[4] = &release(rr, grasp);
       if (stages[4] != nullptr && stages[4]->ok()) stages[5] = &present(rr, grasp, goal);
       if (stages[5] != nullptr && stages[5]->ok()) stages[6] = &leave(rr, grasp, goal);
@@ -298,6 +307,7 @@ class Run {
     double clock = 0.0;
     std::size_t previous_begin = 0;
     for (const Stage* stage : stages) {
+      if (stage == nullptr) return kNoHumanPoseIk;  // the stages before it hold
       if (!stage->ok()) return stage->failure;
       if (stage->supersedes_previous) {
         steps.resize(previous_begin);
@@ -674,6 +684,7 @@ class Run {
 
   MotionResult timed_plan(ArmMotionPlanner& planner, const MotionRequest& request) {
     const Stopwatch watch(times_.motions);
+    ++motions_planned_;
     return planner.plan(request);
   }
 
@@ -1156,8 +1167,9 @@ class Run {
         first_valid(st, receiving_planner_, present,
                     solutions(cell_, receiving_, rh_tcp, grasp_q,
                               stored.empty() ? nullptr : &stored.front()->path.back()));
+    assert(rh_q.has_value() == reaches_human_pose(grasp, goal));
     if (!rh_q) {
-      st.failure = "transfer_to_human: no valid IK at the robot-human pose";
+      st.failure = kNoHumanPoseIk;
       return st;
     }
     present.start = grasp_q;
@@ -1170,6 +1182,28 @@ class Run {
       st.failure = e;
     }
     return st;
+  }
+
+  // Whether any IK branch of the receiving arm at the goal's robot-human pose with `grasp` is
+  // valid in the state present() checks it in (the suction arm home, the board in hand): the
+  // same answer without planning the exchange first. Per grasp and goal.
+  bool reaches_human_pose(const db::RobotGraspRecord& grasp,
+                          const db::HandoverCandidateRecord& goal) {
+    const auto key = std::make_pair(grasp.id, goal.id);
+    if (const auto found = human_reach_.find(key); found != human_reach_.end()) {
+      return found->second;
+    }
+    Stage at;
+    at.end = tool().end;  // the suction arm's jaw as it holds the tool; its joints home below
+    cell_.set_arm(at.end.robot_q, suction_, suction_.spec.home);
+    MotionRequest present;
+    present.held = in_gripper(grasp);
+    const bool reached =
+        first_valid(at, receiving_planner_, present,
+                    solutions(cell_, receiving_, goal.board * grasp.tcp, receiving_.spec.home))
+            .has_value();
+    human_reach_.emplace(key, reached);
+    return reached;
   }
 
   // 6. The human takes it (wrist F/T): open, back off, home. Once per present stage.
@@ -1272,6 +1306,7 @@ class Run {
   std::optional<ValidationQueue> queue_;
   bool speculate_ = false;  // step() queues its motion's validation and plans on
   int rejected_motions_ = 0;
+  int motions_planned_ = 0;
   core::Pose board_initial_;
   Eigen::Vector3d opening_tcp_;
   Eigen::Vector3d approach_tcp_;
@@ -1284,6 +1319,7 @@ class Run {
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> receives_;  // by (handover, grasp)
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> releases_;
   std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, Stage> presents_;
+  std::map<std::pair<std::int64_t, std::int64_t>, bool> human_reach_;  // by (grasp, goal)
   std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, Stage> leaves_;
 };
 
@@ -1305,6 +1341,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
       running->stop_validation();
       result.times = running->times();
       result.rejected_motions = running->rejected_motions();
+      result.motions_planned = running->motions_planned();
     }
     result.status = status;
     result.reason = std::move(reason);

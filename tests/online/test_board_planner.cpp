@@ -319,6 +319,31 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
   EXPECT_GE(fallback.attempts.size(), 2u);
   EXPECT_EQ(fallback.attempts.front().rank, nominal.goal_rank);
   EXPECT_NE(fallback.attempts.front().outcome, "planned");
+  // The crate leaves no valid IK branch at the first goal's robot-human pose. Checked before the
+  // exchange is planned (the default), the grasps that cannot serve that goal cost no exchange:
+  // the same attempts and plan as planning the exchange first, with fewer motions planned.
+  {
+    online::BoardPlanSettings exchange_first;
+    exchange_first.reach_human_pose_first = false;
+    const auto late =
+        online::BoardPlanner(*model, exchange_first).plan(blocked, board, in_seconds(120.0));
+    ASSERT_TRUE(late.solved()) << late.reason;
+    EXPECT_EQ(late.candidate_id, fallback.candidate_id);
+    ASSERT_EQ(late.attempts.size(), fallback.attempts.size());
+    int unreachable = 0;
+    for (std::size_t i = 0; i < late.attempts.size(); ++i) {
+      EXPECT_EQ(late.attempts[i].outcome, fallback.attempts[i].outcome) << "attempt " << i;
+      const std::string& outcome = fallback.attempts[i].outcome;
+      if (outcome.find("no valid IK at the robot-human pose") != std::string::npos) ++unreachable;
+    }
+    expect_same_steps(late, fallback);
+    ASSERT_GT(unreachable, 0) << "the crate must leave the first goal unreachable";
+    EXPECT_LT(fallback.motions_planned, late.motions_planned);
+    std::printf(
+        "robot-human pose checked first: %d motions planned, exchange first: %d (%d "
+        "attempts without a valid IK there)\n",
+        fallback.motions_planned, late.motions_planned, unreachable);
+  }
 
   // A validator stricter than the planner (a held board kept 2 deg inside theta_c) rejects
   // transfers the planner has already planned past: with the validation overlapped, each is

@@ -42,6 +42,11 @@ struct BoardPlanSettings {
   // thread rather than queued with its validation (the plan is the same either way). false
   // queues every step's smoothing: the median board went x1.10 slower (bench_online, session 19).
   bool smooth_here_when_behind = true;
+  // Before the exchange is planned for a goal and grasp, whether the receiving arm reaches the
+  // goal's robot-human pose with that grasp at all (the transfer to the human's own first
+  // check): the same plans, without planning exchanges for grasps the goal cannot use. false
+  // plans the exchange first (before session 25).
+  bool reach_human_pose_first = true;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
@@ -112,6 +117,9 @@ struct BoardPlan {
   // Motions the validator rejected as first planned (a fallback then passed, or the stage or
   // goal was given up), over every goal tried.
   int rejected_motions = 0;
+  // Motions planned over every goal tried (fallbacks and re-plans included): the work done, as
+  // no clock on a shared machine measures it.
+  int motions_planned = 0;
   Eigen::VectorXd robot_q_after;  // the robot when the board has been taken
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };
