@@ -307,7 +307,10 @@ class Run {
     double clock = 0.0;
     std::size_t previous_begin = 0;
     for (const Stage* stage : stages) {
-      if (stage == nullptr) return kNoHumanPoseIk;  // the stages before it hold
+      if (stage == nullptr) {  // the stages before it hold: only the reach check stops so
+        assert(settings_.reach_human_pose_first);
+        return kNoHumanPoseIk;
+      }
       if (!stage->ok()) return stage->failure;
       if (stage->supersedes_previous) {
         steps.resize(previous_begin);

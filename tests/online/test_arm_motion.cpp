@@ -111,6 +111,32 @@ online::SceneObstacle crate_at(const Eigen::Vector3d& p, double size) {
   return crate;
 }
 
+// A start `fraction` of the way from far node `a` to `b` whose path through the roadmap in the
+// nominal scene (`nominal_planner`'s, no bridges) enters it at an interior waypoint, and the
+// scene with a crate on the middle of that join (nothing when the pair's path is not so).
+struct CratedJoin {
+  online::MotionRequest request;  // start to b, no bridges
+  Eigen::VectorXd entry;          // the path's second waypoint in the nominal scene
+  online::Scene crated;
+};
+
+std::optional<CratedJoin> crate_on_the_join(online::ArmMotionPlanner& nominal_planner,
+                                            const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                            double fraction) {
+  const auto& cell = *test::reference_cell();
+  const core::Arm& left = cell.arm("left");
+  const Eigen::VectorXd start = a + fraction * (b - a);
+  CratedJoin join{request(start, b), {}, online::nominal_scene(cell, cabinet())};
+  join.request.allow_bridge = false;
+  const auto before = nominal_planner.plan(join.request);
+  if (!before.solved() || before.via != "roadmap" || before.path.size() < 3) return std::nullopt;
+  join.entry = before.path[1];
+  const core::Pose middle =
+      core::arm_base_in_world(cell, left) * left.chain.fk(0.5 * (start + join.entry));
+  join.crated.obstacles.push_back(crate_at(middle.translation(), 0.06));
+  return join;
+}
+
 // A roadmap path with interior nodes in the nominal scene, between far node pairs `a` and `b`,
 // and the scene with a crate at the TCP of its middle waypoint (nothing when no pair plans so).
 struct CratedPath {
@@ -405,26 +431,19 @@ TEST_F(ArmMotionCrated, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame
 // join, taken unchecked for the first search, fails when the path is checked and another holds.
 TEST(ArmMotion, ABlockedJoinIntoTheRoadmapIsReplacedByOneThatHolds) {
   const auto& cell = *test::reference_cell();
-  const core::Arm& left = cell.arm("left");
-  const online::Scene nominal = online::nominal_scene(cell, cabinet());
-  const online::World nominal_world(cell, cabinet(), nominal, "top");
+  const online::World nominal_world(cell, cabinet(), online::nominal_scene(cell, cabinet()), "top");
   online::MotionSettings settings;
   settings.shortcut_checks = 0;  // the path as searched: its second waypoint is the entry node
   online::ArmMotionPlanner nominal_planner(nominal_world, left_roadmap(), "left", settings);
   int tried = 0;
   for (const auto& [a, b] : far_pairs(20)) {
     // A start off the roadmap, a quarter of the way to the far node.
-    const Eigen::VectorXd start = a + 0.25 * (b - a);
-    online::MotionRequest r = request(start, b);
-    r.allow_bridge = false;
-    const auto before = nominal_planner.plan(r);
-    if (!before.solved() || before.via != "roadmap" || before.path.size() < 3) continue;
-    const Eigen::VectorXd entry = before.path[1];
-    const core::Pose middle =
-        core::arm_base_in_world(cell, left) * left.chain.fk(0.5 * (start + entry));
-    online::Scene crated = nominal;
-    crated.obstacles.push_back(crate_at(middle.translation(), 0.06));
-    const online::World world(cell, cabinet(), crated, "top");
+    const auto join = crate_on_the_join(nominal_planner, a, b, 0.25);
+    if (!join) continue;
+    const online::MotionRequest& r = join->request;
+    const Eigen::VectorXd& start = r.start;
+    const Eigen::VectorXd& entry = join->entry;
+    const online::World world(cell, cabinet(), join->crated, "top");
     online::ArmMotionPlanner planner(world, left_roadmap(), "left", settings);
     planner.prepare(r);
     if (!planner.valid(start) || !planner.valid(b) || !planner.valid(entry) ||
@@ -449,9 +468,7 @@ TEST(ArmMotion, ABlockedJoinIntoTheRoadmapIsReplacedByOneThatHolds) {
 // over the pairs; every path passes the validator.
 TEST(ArmMotion, CheckedJoinsKeepOnlyTheFirstThatHold) {
   const auto& cell = *test::reference_cell();
-  const core::Arm& left = cell.arm("left");
-  const online::Scene nominal = online::nominal_scene(cell, cabinet());
-  const online::World nominal_world(cell, cabinet(), nominal, "top");
+  const online::World nominal_world(cell, cabinet(), online::nominal_scene(cell, cabinet()), "top");
   online::MotionSettings settings;
   ASSERT_EQ(settings.checked_attachments, 2);
   online::ArmMotionPlanner nominal_planner(nominal_world, left_roadmap(), "left", settings);
@@ -460,16 +477,11 @@ TEST(ArmMotion, CheckedJoinsKeepOnlyTheFirstThatHold) {
   long checks_six = 0;
   for (const auto& [a, b] : far_pairs(20)) {
     // A start half way between two far nodes: its joins to the roadmap are long.
-    const Eigen::VectorXd start = a + 0.5 * (b - a);
-    online::MotionRequest r = request(start, b);
-    r.allow_bridge = false;
-    const auto before = nominal_planner.plan(r);
-    if (!before.solved() || before.via != "roadmap" || before.path.size() < 3) continue;
-    const core::Pose middle =
-        core::arm_base_in_world(cell, left) * left.chain.fk(0.5 * (start + before.path[1]));
-    online::Scene crated = nominal;
-    crated.obstacles.push_back(crate_at(middle.translation(), 0.06));
-    const online::World world(cell, cabinet(), crated, "top");
+    const auto join = crate_on_the_join(nominal_planner, a, b, 0.5);
+    if (!join) continue;
+    const online::MotionRequest& r = join->request;
+    const Eigen::VectorXd& start = r.start;
+    const online::World world(cell, cabinet(), join->crated, "top");
     online::MotionSettings six = settings;
     six.checked_attachments = 6;
     online::ArmMotionPlanner two_kept(world, left_roadmap(), "left", settings);
