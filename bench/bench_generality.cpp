@@ -71,6 +71,7 @@ constexpr const char* kUsage =
     "                        [--deadline S] [--keep-db] [--reuse-db] [--json FILE]\n"
     "                        [--meta KEY=VALUE]...\n"
     "       bench_generality --pick-region N --db FILE [--scene FILE] [--region M] [--seed N]\n"
+    "                        [--stack-pose DX,DY,YAW_DEG]...\n"
     "                        [--deadline S] [--json FILE] [--meta KEY=VALUE]...\n"
     "  --products    a directory of products (tools/dev/gen_products): DIR/pNN/product.yaml\n"
     "                and DIR/pNN/scene.yaml\n"
@@ -85,6 +86,8 @@ constexpr const char* kUsage =
     "  --db          the cabinet database for --pick-region\n"
     "  --scene       its nominal scene (default: meshes/cabinet/scene.yaml)\n"
     "  --region      m, the stack's offset in x and y is uniform in +-this (default 0.10)\n"
+    "  --stack-pose  DX,DY,YAW_DEG: plan this stack pose (m, m, deg; repeatable) instead of\n"
+    "                drawn ones, touching or not\n"
     "  --json        also write every figure to FILE\n"
     "  --meta        KEY=VALUE recorded in the JSON (commit, machine, ...)\n";
 
@@ -101,6 +104,7 @@ struct Options {
   std::string db;
   std::string scene = HILA_DATA_DIR "/cabinet/scene.yaml";
   double region = 0.10;
+  std::vector<Eigen::Vector3d> stack_poses;  // given (dx m, dy m, yaw deg) instead of drawn
   std::string json;
   std::map<std::string, std::string> meta;
   std::string command;
@@ -168,6 +172,10 @@ Options parse(int argc, char** argv) {
         if (!(opt.region >= 0.0 && opt.region <= 0.5)) {
           usage_error("--region: expected metres in [0, 0.5], got " + value);
         }
+      } else if (arg == "--stack-pose") {
+        const auto v = split_list(value);
+        if (v.size() != 3) usage_error("--stack-pose: expected DX,DY,YAW_DEG, got '" + value + "'");
+        opt.stack_poses.emplace_back(std::stod(v[0]), std::stod(v[1]), std::stod(v[2]));
       } else if (arg == "--json") {
         opt.json = value;
       } else if (arg == "--meta") {
@@ -183,8 +191,9 @@ Options parse(int argc, char** argv) {
       usage_error(arg + ": expected a number, got '" + value + "'");
     }
   }
+  if (!opt.stack_poses.empty()) opt.pick_region = static_cast<int>(opt.stack_poses.size());
   if ((opt.pick_region > 0) == !opt.products.empty()) {
-    usage_error("expected exactly one of --products DIR or --pick-region N");
+    usage_error("expected exactly one of --products DIR or --pick-region N (or --stack-pose)");
   }
   if (opt.pick_region > 0 && opt.db.empty()) usage_error("--pick-region: expected --db FILE");
   if (opt.deadline < 0.0) opt.deadline = opt.pick_region > 0 ? 10.0 : 30.0;
@@ -345,7 +354,10 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
     if (r.goals == 0 && !r.build_failure.empty()) {
       r.cause = "no goal in the database: " + reason_key(r.build_failure);
     } else if (!r.top_outcome.empty()) {
-      r.cause = r.status + ", mostly " + reason_key(r.top_outcome);
+      // The round ("(larger bridges) ") is in the JSON's outcomes; the cause groups by step.
+      std::string top = r.top_outcome;
+      if (top.rfind("(larger bridges) ", 0) == 0) top = top.substr(17);
+      r.cause = r.status + ", mostly " + reason_key(top);
     } else {
       r.cause = r.status + ": " + reason_key(r.reason);
     }
@@ -714,6 +726,8 @@ struct StackPose {
   Eigen::Vector2d offset = Eigen::Vector2d::Zero();
   double yaw_deg = 0.0;
   int redraws = 0;
+  std::vector<std::string> redraw_causes;  // per redrawn pose: the first contact
+  std::string touching;                    // a given pose (--stack-pose) that touches
   std::vector<PartResult> boards;
 };
 
@@ -773,6 +787,7 @@ int run_pick_region(const Options& opt) {
       return std::uniform_real_distribution<double>(a, b)(rng);
     };
     online::Scene scene;
+    const bool given = !opt.stack_poses.empty();
     for (int attempt = 0;; ++attempt) {
       if (attempt == kTries) {
         std::cerr << "bench_generality: no stack pose clear of the cell in " << kTries
@@ -780,9 +795,15 @@ int run_pick_region(const Options& opt) {
         return 3;
       }
       // One draw per statement: the order of draws is part of what the seed means.
-      sp.offset.x() = uniform(-opt.region, opt.region);
-      sp.offset.y() = uniform(-opt.region, opt.region);
-      sp.yaw_deg = uniform(-180.0, 180.0);
+      if (given) {
+        const Eigen::Vector3d& g = opt.stack_poses[static_cast<std::size_t>(k)];
+        sp.offset = g.head<2>();
+        sp.yaw_deg = g.z();
+      } else {
+        sp.offset.x() = uniform(-opt.region, opt.region);
+        sp.offset.y() = uniform(-opt.region, opt.region);
+        sp.yaw_deg = uniform(-180.0, 180.0);
+      }
       core::Pose move = core::Pose::Identity();
       move.linear() = Eigen::AngleAxisd(core::deg_to_rad(sp.yaw_deg), Eigen::Vector3d::UnitZ())
                           .toRotationMatrix();
@@ -794,12 +815,18 @@ int run_pick_region(const Options& opt) {
         if (!nominal.is_finished(part.name)) scene.detected[part.name] = move * nominal.initial_pose(part);
       }
       sp.redraws = attempt;
-      if (stack_touches(*model, scene).empty()) break;
+      const std::string hit = stack_touches(*model, scene);
+      if (hit.empty()) break;
+      if (given) {
+        sp.touching = hit;
+        break;
+      }
+      sp.redraw_causes.push_back(hit);
     }
     std::cerr << "[" << k + 1 << "/" << opt.pick_region << "] stack moved ("
               << fixed(100 * sp.offset.x(), 1) << ", " << fixed(100 * sp.offset.y(), 1)
               << ") cm, yaw " << fixed(sp.yaw_deg, 1) << " deg, " << sp.redraws << " redraws"
-              << std::endl;
+              << (sp.touching.empty() ? "" : ", TOUCHING: " + sp.touching) << std::endl;
     sp.boards = plan_all(planner, *model, plan_settings, scene, opt.deadline, "");
     for (const auto& b : sp.boards) invalid += b.delivered && !b.recheck_valid;
     poses.push_back(std::move(sp));
@@ -811,8 +838,10 @@ int run_pick_region(const Options& opt) {
   std::vector<double> plan_s;
   std::map<std::string, int> causes;
   std::map<std::string, std::pair<int, int>> by_board;
+  std::map<std::string, int> redraw_causes;
   for (const auto& sp : poses) {
     redraws += sp.redraws;
+    for (const auto& c : sp.redraw_causes) ++redraw_causes[reason_key(c)];
     int here = 0;
     for (const auto& b : sp.boards) {
       ++boards;
@@ -849,6 +878,9 @@ int run_pick_region(const Options& opt) {
   }
   std::cout << "\nWhy boards were not planned (board: cause, grouped; numbers as N):\n\n";
   print_causes(causes);
+  std::cout << "\nWhy drawn stack poses were drawn again (the first board, at its stage, that "
+               "touches something: a pose no camera could report):\n\n";
+  print_causes(redraw_causes);
   if (invalid > 0) std::cout << "\n**INVALID PLANS: " << invalid << "**\n";
 
   if (!opt.json.empty()) {
@@ -868,7 +900,8 @@ int run_pick_region(const Options& opt) {
                       {"plan_s_median", number(quantile(plan_s, 0.5))},
                       {"plan_s_p95", number(quantile(plan_s, 0.95))},
                       {"invalid", invalid},
-                      {"causes", causes}};
+                      {"causes", causes},
+                      {"redraw_causes", redraw_causes}};
     out["stack_poses"] = nlohmann::json::array();
     for (const auto& sp : poses) {
       nlohmann::json j = {{"index", sp.index},
@@ -876,6 +909,8 @@ int run_pick_region(const Options& opt) {
                           {"offset_m", {sp.offset.x(), sp.offset.y()}},
                           {"yaw_deg", sp.yaw_deg},
                           {"redraws", sp.redraws},
+                          {"redraw_causes", sp.redraw_causes},
+                          {"touching", sp.touching},
                           {"boards", nlohmann::json::array()}};
       for (const auto& b : sp.boards) j["boards"].push_back(part_json(b));
       out["stack_poses"].push_back(j);
