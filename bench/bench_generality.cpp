@@ -32,6 +32,8 @@
 // redraws are counted. Reported: boards planned / boards, per board, and the reasons.
 //
 // Output: markdown tables on stdout, progress on stderr, with --json every figure.
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -49,7 +51,6 @@
 #include <sstream>
 #include <string>
 #include <thread>
-#include <unistd.h>
 #include <vector>
 
 #include "hila/core/collision.hpp"
@@ -233,7 +234,9 @@ std::string fixed(double x, int digits) {
   return s.str();
 }
 
-nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+nlohmann::json number(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
+}
 
 // A reason without its scene-specific numbers, so that equal causes group: every number but a
 // plain 0 ("any of its 0 suction grasps" says something) becomes N.
@@ -266,10 +269,10 @@ struct PartResult {
   int order = 0;
   bool delivered = false;
   std::string status;
-  std::string reason;          // the planner's
-  std::string top_outcome;     // the most frequent failed attempt outcome ("step: status")
-  std::string build_failure;   // the build's handover_failure (no goal)
-  std::string cause;           // the grouped reason of an undelivered part
+  std::string reason;         // the planner's
+  std::string top_outcome;    // the most frequent failed attempt outcome ("step: status")
+  std::string build_failure;  // the build's handover_failure (no goal)
+  std::string cause;          // the grouped reason of an undelivered part
   std::map<std::string, int> outcomes;
   double plan_s = 0.0;
   int attempts = 0;
@@ -413,8 +416,8 @@ std::vector<PartResult> plan_all(online::BoardPlanner& planner, const online::Pl
   for (const auto& part : model.product().parts) {
     if (scene.is_finished(part.name)) continue;
     PartResult r = plan_part(planner, model, settings, scene, part, deadline_s);
-    std::cerr << "  " << label << part.name << ": " << r.status << " " << fixed(r.plan_s, 2)
-              << " s" << (r.delivered ? "" : "  (" + r.cause + ")")
+    std::cerr << "  " << label << part.name << ": " << r.status << " " << fixed(r.plan_s, 2) << " s"
+              << (r.delivered ? "" : "  (" + r.cause + ")")
               << (r.delivered && !r.recheck_valid ? "  !!! INVALID" : "")
               << (r.start_collision.empty() ? "" : "  [start touches " + r.start_collision + "]")
               << std::endl;
@@ -434,12 +437,10 @@ std::string now_utc() {
 }
 
 nlohmann::json header_json(const Options& opt) {
-  nlohmann::json j = {{"bench_generality", 1},
-                      {"command", opt.command},
-                      {"date_utc", now_utc()},
-                      {"hardware_threads", std::thread::hardware_concurrency()},
-                      {"deadline_s", opt.deadline},
-                      {"seed", opt.seed}};
+  nlohmann::json j = {
+      {"bench_generality", 1},      {"command", opt.command},
+      {"date_utc", now_utc()},      {"hardware_threads", std::thread::hardware_concurrency()},
+      {"deadline_s", opt.deadline}, {"seed", opt.seed}};
   for (const auto& [k, v] : opt.meta) j["meta"][k] = v;
   return j;
 }
@@ -458,9 +459,9 @@ bool write_json(const std::string& path, const nlohmann::json& j) {
 void print_causes(const std::map<std::string, int>& causes) {
   std::vector<std::pair<int, std::string>> sorted;
   for (const auto& [cause, n] : causes) sorted.emplace_back(n, cause);
-  std::sort(sorted.begin(), sorted.end(),
-            [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first
-                                                                          : a.second < b.second; });
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
   if (sorted.empty()) std::cout << "- none\n";
   for (const auto& [n, cause] : sorted) std::cout << "- " << n << " x " << cause << "\n";
 }
@@ -479,14 +480,15 @@ struct ProductResult {
   int parts_total = 0;
   std::vector<PartResult> parts;
   int delivered() const {
-    return static_cast<int>(std::count_if(parts.begin(), parts.end(),
-                                          [](const auto& p) { return p.delivered; }));
+    return static_cast<int>(
+        std::count_if(parts.begin(), parts.end(), [](const auto& p) { return p.delivered; }));
   }
 };
 
 int run_products(const Options& opt) {
   std::vector<fs::path> dirs;
-  if (!fs::is_directory(opt.products)) usage_error("--products: no directory '" + opt.products + "'");
+  if (!fs::is_directory(opt.products))
+    usage_error("--products: no directory '" + opt.products + "'");
   for (const auto& entry : fs::directory_iterator(opt.products)) {
     if (!entry.is_directory()) continue;
     if (!fs::exists(entry.path() / "product.yaml") || !fs::exists(entry.path() / "scene.yaml")) {
@@ -600,17 +602,17 @@ int run_products(const Options& opt) {
   }
   std::cout << "## bench_generality: " << results.size() << " products from " << opt.products
             << ", " << (opt.quick ? "quick" : "default") << " build settings (seed " << opt.seed
-            << ", " << opt.jobs << " jobs), deadline " << fixed(opt.deadline, 0)
-            << " s per part, " << std::thread::hardware_concurrency() << " hardware threads, wall "
+            << ", " << opt.jobs << " jobs), deadline " << fixed(opt.deadline, 0) << " s per part, "
+            << std::thread::hardware_concurrency() << " hardware threads, wall "
             << fixed(wall / 60.0, 1) << " min\n\n"
             << "| products | all parts delivered | parts delivered | share | build s median | "
                "build s max | plan s median | plan s p95 | plan s p95 (all) | invalid | errors |\n"
             << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
-            << "| " << results.size() << " | " << products_all << " | " << delivered << "/"
-            << parts << " | " << fixed(100.0 * delivered / std::max(1, parts), 1) << " % | "
+            << "| " << results.size() << " | " << products_all << " | " << delivered << "/" << parts
+            << " | " << fixed(100.0 * delivered / std::max(1, parts), 1) << " % | "
             << fixed(quantile(build_s, 0.5), 1) << " | "
-            << fixed(build_s.empty() ? std::nan("") : *std::max_element(build_s.begin(),
-                                                                          build_s.end()),
+            << fixed(build_s.empty() ? std::nan("")
+                                     : *std::max_element(build_s.begin(), build_s.end()),
                      1)
             << " | " << fixed(quantile(plan_s, 0.5), 3) << " | " << fixed(quantile(plan_s, 0.95), 3)
             << " | " << fixed(quantile(plan_all_s, 0.95), 3) << " | " << invalid << " | " << errors
@@ -631,8 +633,9 @@ int run_products(const Options& opt) {
     }
     std::cout << "| " << pr.dir << " " << pr.name << " | " << pr.style << " | " << pr.layout
               << " | " << pr.parts_total << " | " << pr.delivered() << " | "
-              << (pr.reused ? "reused" : fixed(pr.build_s, 1)) << " | " << fixed(quantile(t, 0.5), 3)
-              << " | " << fixed(quantile(t, 0.95), 3) << " | " << valid << "/" << t.size()
+              << (pr.reused ? "reused" : fixed(pr.build_s, 1)) << " | "
+              << fixed(quantile(t, 0.5), 3) << " | " << fixed(quantile(t, 0.95), 3) << " | "
+              << valid << "/" << t.size()
               << (pr.error.empty() ? "" : " ERROR: " + reason_key(pr.error, 100)) << " |\n";
   }
 
@@ -673,9 +676,8 @@ int run_products(const Options& opt) {
     nlohmann::json out = header_json(opt);
     out["mode"] = "products";
     out["products_dir"] = opt.products;
-    out["build"] = {{"settings", opt.quick ? "quick" : "default"},
-                    {"seed", opt.seed},
-                    {"jobs", opt.jobs}};
+    out["build"] = {
+        {"settings", opt.quick ? "quick" : "default"}, {"seed", opt.seed}, {"jobs", opt.jobs}};
     out["wall_s"] = wall;
     out["summary"] = {{"products", results.size()},
                       {"products_all_delivered", products_all},
@@ -683,9 +685,9 @@ int run_products(const Options& opt) {
                       {"delivered", delivered},
                       {"share", parts ? static_cast<double>(delivered) / parts : 0.0},
                       {"build_s_median", number(quantile(build_s, 0.5))},
-                      {"build_s_max", number(build_s.empty() ? std::nan("")
-                                                             : *std::max_element(build_s.begin(),
-                                                                                 build_s.end()))},
+                      {"build_s_max",
+                       number(build_s.empty() ? std::nan("")
+                                              : *std::max_element(build_s.begin(), build_s.end()))},
                       {"plan_s_median", number(quantile(plan_s, 0.5))},
                       {"plan_s_p95", number(quantile(plan_s, 0.95))},
                       {"plan_s_p95_all", number(quantile(plan_all_s, 0.95))},
@@ -812,7 +814,8 @@ int run_pick_region(const Options& opt) {
           c + Eigen::Vector3d(sp.offset.x(), sp.offset.y(), 0.0) - move.linear() * c;
       scene = nominal;
       for (const auto& part : product.parts) {
-        if (!nominal.is_finished(part.name)) scene.detected[part.name] = move * nominal.initial_pose(part);
+        if (!nominal.is_finished(part.name))
+          scene.detected[part.name] = move * nominal.initial_pose(part);
       }
       sp.redraws = attempt;
       const std::string hit = stack_touches(*model, scene);
