@@ -458,6 +458,7 @@ bool write_json(const std::string& path, const nlohmann::json& j) {
 // A cause table: count x cause, most frequent first.
 void print_causes(const std::map<std::string, int>& causes) {
   std::vector<std::pair<int, std::string>> sorted;
+  sorted.reserve(causes.size());
   for (const auto& [cause, n] : causes) sorted.emplace_back(n, cause);
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
@@ -487,8 +488,9 @@ struct ProductResult {
 
 int run_products(const Options& opt) {
   std::vector<fs::path> dirs;
-  if (!fs::is_directory(opt.products))
+  if (!fs::is_directory(opt.products)) {
     usage_error("--products: no directory '" + opt.products + "'");
+  }
   for (const auto& entry : fs::directory_iterator(opt.products)) {
     if (!entry.is_directory()) continue;
     if (!fs::exists(entry.path() / "product.yaml") || !fs::exists(entry.path() / "scene.yaml")) {
@@ -814,8 +816,9 @@ int run_pick_region(const Options& opt) {
           c + Eigen::Vector3d(sp.offset.x(), sp.offset.y(), 0.0) - move.linear() * c;
       scene = nominal;
       for (const auto& part : product.parts) {
-        if (!nominal.is_finished(part.name))
+        if (!nominal.is_finished(part.name)) {
           scene.detected[part.name] = move * nominal.initial_pose(part);
+        }
       }
       sp.redraws = attempt;
       const std::string hit = stack_touches(*model, scene);
