@@ -7,7 +7,7 @@
 //       [--meta KEY=VALUE ...]
 //   build/release/bench/bench_generality --pick-region 50 --db /tmp/cabinet.hila
 //       [--scene meshes/cabinet/scene.yaml] [--region 0.10] [--seed 1] [--deadline 10]
-//       [--json FILE]
+//       [--stack-pose DX,DY,YAW_DEG]... [--json FILE]
 //
 // Products (--products DIR: every DIR/pNN/ with a product.yaml and a scene.yaml, in name
 // order): each product's database is built with offline::build_database (default BuildSettings
@@ -31,7 +31,9 @@
 // the finished boards) is not a detection a camera could make: it is drawn again, and the
 // redraws are counted. Reported: boards planned / boards, per board, and the reasons.
 //
-// Output: markdown tables on stdout, progress on stderr, with --json every figure.
+// Output: markdown tables on stdout, progress on stderr, with --json every figure. Recorded
+// runs: bench/results/generality_*.json, rendered into docs/bench.md by tools/dev/render_bench
+// (the raw --json output in bench/results/raw/).
 #include <unistd.h>
 
 #include <Eigen/Geometry>
