@@ -11,8 +11,8 @@
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
-#include "hila/offline/comfort.hpp"
-#include "hila/offline/comfort_map.hpp"
+#include "hila/core/comfort.hpp"
+#include "hila/core/comfort_map.hpp"
 #include "hila/offline/human_grasps.hpp"
 #include "hila/offline/suction_pick.hpp"
 
@@ -458,7 +458,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
   }
   const int n_favoured = static_cast<int>(orientations.size());
-  for (const auto& q : spread_orientations(settings.rr_orientations)) {
+  for (const auto& q : core::spread_orientations(settings.rr_orientations)) {
     orientations.push_back(q.toRotationMatrix());
   }
   const int n_pos = static_cast<int>(settings.rr_positions.size());
@@ -564,7 +564,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   }
 
   // --- 𝕊: members of S sharing a grasp with a robot-robot pose, in Eq. 8 order -------------
-  ComfortSettings ik_settings;
+  core::ComfortSettings ik_settings;
   ik_settings.ik_attempts = 12;
   ik_settings.seed = settings.seed;
   auto solve_human = [&](const core::Pose& board, int arm, int grasp) {
@@ -574,7 +574,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     const Eigen::VectorXd seed = Eigen::VectorXd::Zero(chain.dof())
                                      .cwiseMax(chain.lower_limits())
                                      .cwiseMin(chain.upper_limits());
-    return best_comfort(chain, hand, seed, ik_settings);
+    return core::best_comfort(chain, hand, seed, ik_settings);
   };
   int verified = 0;
   // At the robot-human pose the receiving arm and the board it holds move against the rest.
@@ -634,8 +634,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
       // are coarse, so a bin's Q may come from a neighbouring hand orientation.
       if (verified < settings.human_ik_goals) {
-        const ComfortResult first = solve_human(c.board, h.arm, h.grasp);
-        ComfortResult second;
+        const core::ComfortResult first = solve_human(c.board, h.arm, h.grasp);
+        core::ComfortResult second;
         if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
         const double q =
             h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;

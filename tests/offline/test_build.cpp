@@ -74,9 +74,9 @@ TEST(Build, CabinetDatabaseHoldsEveryBoardWithGraspsOfEachKind) {
   // One comfort map per human arm, equal to one built directly with the same settings and seed.
   ASSERT_EQ(database.comfort_maps().size(), 2u);
   const auto cell = test::reference_cell();
-  offline::ComfortMapSettings comfort = quick_settings().comfort;
+  core::ComfortMapSettings comfort = quick_settings().comfort;
   comfort.seed = offline::part_seed(7, "comfort:right", 3);
-  const auto direct = offline::ComfortMap::build(cell->human_arms()[1].chain, comfort);
+  const auto direct = core::ComfortMap::build(cell->human_arms()[1].chain, comfort);
   EXPECT_EQ(database.comfort_map("right").values, direct.values());
   EXPECT_EQ(database.comfort_map("right").dims, direct.dims());
   EXPECT_EQ(files_in(dir), (std::vector<std::string>{"cabinet.hila"}));  // no temporary left

@@ -6,7 +6,7 @@
 #include "hila/core/kinematic_chain.hpp"
 #include "hila/core/pose.hpp"
 
-namespace hila::offline {
+namespace hila::core {
 
 // Human comfort of paper Eq. 4: Q = sigma_min / sigma_max of the arm's 6 x n Jacobian. The
 // translational rows are divided by a characteristic length L (the arm's reach) so that Q is
@@ -35,4 +35,4 @@ ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& ha
                            const Eigen::VectorXd& seed_joints,
                            const ComfortSettings& settings = {});
 
-}  // namespace hila::offline
+}  // namespace hila::core

@@ -1,11 +1,11 @@
-#include "hila/offline/comfort.hpp"
+#include "hila/core/comfort.hpp"
 
 #include <Eigen/SVD>
 #include <random>
 
 #include "hila/core/generic_ik.hpp"
 
-namespace hila::offline {
+namespace hila::core {
 
 double comfort_index(const core::Jacobian& jacobian, double characteristic_length) {
   core::Jacobian scaled = jacobian;
@@ -44,4 +44,4 @@ ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& ha
   return best;
 }
 
-}  // namespace hila::offline
+}  // namespace hila::core
