@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <iomanip>
 #include <cassert>
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <span>
 #include <string_view>
 #include <tuple>
@@ -71,6 +74,8 @@ const char* to_string(BoardPlanStatus status) {
       return "no goal";
     case BoardPlanStatus::kTimeout:
       return "timeout";
+    case BoardPlanStatus::kHumanOutOfReach:
+      return "human out of reach";
   }
   return "unknown";
 }
@@ -1364,10 +1369,35 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (records == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
-  // The first goals in Eq. 8 order.
-  const std::size_t goal_count =
-      std::min(records->goals.size(), static_cast<std::size_t>(std::max(0, settings_.goals)));
-  const auto goals = std::span(records->goals).first(goal_count);
+  // The first goals in Eq. 8 order that the scene's human can take, with their comfort for them.
+  std::vector<const db::HandoverCandidateRecord*> goals;
+  std::map<std::int64_t, double> worker_quality;  // by goal id
+  double best_out_of_reach = 0.0;
+  for (const auto& goal : records->goals) {
+    if (goals.size() >= static_cast<std::size_t>(std::max(0, settings_.goals))) break;
+    const double q =
+        model_.worker_comfort().goal_quality(goal, records->human_grasps, scene.human_stance);
+    if (q < std::min(settings_.worker_quality_floor, goal.quality)) {
+      ++result.goals_out_of_reach;
+      best_out_of_reach = std::max(best_out_of_reach, q);
+      continue;
+    }
+    goals.push_back(&goal);
+    worker_quality[goal.id] = q;
+  }
+  if (goals.empty() && !records->goals.empty()) {
+    const core::Pose& stance = scene.human_stance;
+    const double facing = core::rad_to_deg(std::atan2(stance.linear()(1, 0), stance.linear()(0, 0)));
+    std::ostringstream reason;
+    reason << std::fixed << std::setprecision(2) << "the human at (" << stance.translation().x()
+           << ", " << stance.translation().y() << ", " << stance.translation().z()
+           << ") m facing " << std::setprecision(0) << facing << " deg cannot take '" << board
+           << "' at any of its " << records->goals.size() << " stored goals (best comfort Q "
+           << std::setprecision(3) << best_out_of_reach << ", needed "
+           << std::min(settings_.worker_quality_floor, records->goals.front().quality)
+           << "): move the human or rebuild the database for this stance";
+    return finish(BoardPlanStatus::kHumanOutOfReach, reason.str());
+  }
   bool any_connected_offline = false;
   // Every goal in order under `settings`; true when one is planned (result filled in).
   Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
@@ -1393,7 +1423,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.robot_grasp_id = s.robot_grasp_id;
     result.suction_grasp_id = rr.suction_grasp_id;
     result.theta_c_deg = run.robot_grasps().at(s.robot_grasp_id).theta_c_deg;
-    result.quality = goal.quality;
+    result.quality = worker_quality.at(goal.id);
     result.robot_handover = rr.board;
     result.human_handover = goal.board;
     result.duration = result.steps.back().time.back();
@@ -1403,7 +1433,8 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     return true;
   };
   auto try_goals = [&](const std::string& round) {
-    for (const auto& goal : goals) {
+    for (const auto* goal_record : goals) {
+      const auto& goal = *goal_record;
       // The shared grasps the offline regrasp graph connected for this goal first: their
       // stored paths and IK branches are what the motions re-validate.
       std::vector<db::SharedGraspRecord> shared = records->shared_grasps.at(goal.id);

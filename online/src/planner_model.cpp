@@ -13,7 +13,8 @@ std::shared_ptr<const PlannerModel> PlannerModel::load(const std::string& databa
   db::OpenOptions options;
   options.expected_cell_hash = db::cell_hash(cell->spec());
   options.expected_product_hash = db::product_hash(product);
-  options.comfort_maps = false;  // offline work: planning never reads them
+  // The comfort maps re-evaluate the stored goals for the human the scene has (WorkerComfort).
+  options.comfort_maps = true;
   db::Database database = db::Database::open(database_path, options);
   if (database.meta().product_name != product.name) {
     throw db::DatabaseError(database_path, "meta.product_name",
@@ -26,7 +27,10 @@ std::shared_ptr<const PlannerModel> PlannerModel::load(const std::string& databa
 
 PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::ProductSpec product,
                            db::Database database)
-    : cell_(std::move(cell)), product_(std::move(product)), database_(std::move(database)) {
+    : cell_(std::move(cell)),
+      product_(std::move(product)),
+      database_(std::move(database)),
+      worker_comfort_(*cell_, database_.comfort_maps(), database_.path()) {
   for (const auto& arm : cell_->arms()) {
     const db::RoadmapRecord* record = database_.roadmap(arm.spec.name);
     if (record == nullptr) {
@@ -43,6 +47,7 @@ PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::Product
     for (const auto& goal : b.goals) b.shared_grasps[goal.id] = database_.shared_grasps(goal.id);
     for (auto& g : database_.robot_grasps(part.id)) b.robot_grasps[g.id] = std::move(g);
     for (auto& g : database_.suction_grasps(part.id)) b.suction_grasps[g.id] = std::move(g);
+    for (auto& g : database_.human_grasps(part.id)) b.human_grasps[g.id] = std::move(g);
     for (auto& h : database_.robot_handovers(part.id)) b.robot_handovers[h.id] = std::move(h);
     for (auto& f : database_.roadmap_filters(part.id)) {
       b.filters[{f.grasp_kind, f.grasp_id}] = std::move(f.edges);

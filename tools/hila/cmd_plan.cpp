@@ -63,7 +63,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                         {"queued_validation", 1e3 * plan.times.queued_validation},
                         {"queued_smoothing", 1e3 * plan.times.queued_smoothing}}},
                       {"attempts", attempts},
-                      {"rejected_motions", plan.rejected_motions}};
+                      {"rejected_motions", plan.rejected_motions},
+                      {"goals_out_of_reach", plan.goals_out_of_reach}};
   if (plan.solved()) {
     j["goal_rank"] = plan.goal_rank;
     j["candidate"] = plan.candidate_id;

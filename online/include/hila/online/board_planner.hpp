@@ -47,6 +47,11 @@ struct BoardPlanSettings {
   // check): the same plans, without planning exchanges for grasps the goal cannot use. false
   // plans the exchange first (before session 25).
   bool reach_human_pose_first = true;
+  // The human who is there: a stored goal is used only when the scene's human takes it with a
+  // comfort Q (paper Eq. 4, by the database's comfort maps) of at least this, or of at least the
+  // goal's stored Q where that is lower, so that every stored goal stands at the stance it was
+  // built for. The build's comfort threshold (paper §VI-B).
+  double worker_quality_floor = 0.06;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
@@ -72,7 +77,9 @@ struct GoalAttempt {
   std::string outcome;  // "planned" or the reason
 };
 
-enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout };
+// kHumanOutOfReach: the scene's human can take the board at none of its stored goals (where they
+// stand, or how they face, puts every goal out of comfortable reach).
+enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout, kHumanOutOfReach };
 const char* to_string(BoardPlanStatus status);
 
 // Where a board's planning time went (s, wall clock, summed over every goal attempt; the rest is
@@ -101,7 +108,10 @@ struct BoardPlan {
   std::int64_t robot_grasp_id = 0;
   std::int64_t suction_grasp_id = 0;
   double theta_c_deg = 90.0;
-  double quality = 0.0;                                // the human's comfort at the goal
+  double quality = 0.0;  // the comfort Q of the scene's human at the goal (paper Eq. 4)
+  // Stored goals passed over because the scene's human could not take them there
+  // (BoardPlanSettings::worker_quality_floor).
+  int goals_out_of_reach = 0;
   core::Pose robot_handover = core::Pose::Identity();  // board poses (world)
   core::Pose human_handover = core::Pose::Identity();
   std::vector<PlanStep> steps;

@@ -1,0 +1,171 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <random>
+
+#include "hila/core/comfort_map.hpp"
+#include "hila/offline/build.hpp"
+#include "hila/offline/human_comfort.hpp"
+#include "hila/online/board_planner.hpp"
+#include "hila/online/planner_model.hpp"
+#include "hila/online/scene.hpp"
+#include "hila/online/worker_comfort.hpp"
+#include "util/quick_build.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+// A small but complete cabinet database (no body set: the stored Q is the cell human's), built
+// and loaded once for the file.
+class WorkerComfortTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const std::string dir = test::temp_dir("worker_comfort");
+    const std::string out = dir + "/cabinet.hila";
+    // Quick, with maps dense enough that every board has goals.
+    offline::BuildSettings settings = test::quick_build_settings(7, 2);
+    settings.comfort.samples = 400000;
+    settings.handover.candidates = 200;
+    settings.handover.max_candidates = 400;
+    offline::build_database(test::product_path(), test::cell_path(), out, settings);
+    model_ = online::PlannerModel::load(out, test::cell_path(), test::product_path());
+  }
+  static void TearDownTestSuite() { model_.reset(); }
+
+  static std::shared_ptr<const online::PlannerModel> model_;
+};
+std::shared_ptr<const online::PlannerModel> WorkerComfortTest::model_;
+
+core::Pose moved(const core::Pose& stance, const Eigen::Vector3d& by, double yaw) {
+  core::Pose p = stance;
+  p.translation() += by;
+  p.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * p.linear();
+  return p;
+}
+
+}  // namespace
+
+// At the stance the goals were built for, every stored goal's comfort is found again exactly:
+// the online lookup is the build's.
+TEST_F(WorkerComfortTest, AtTheCellsStanceEveryGoalHasItsStoredQuality) {
+  const auto& cell = model_->cell();
+  int goals = 0;
+  for (const auto& part : model_->product().parts) {
+    const online::BoardRecords* b = model_->board_records(part.name);
+    ASSERT_NE(b, nullptr);
+    for (const auto& goal : b->goals) {
+      const double q =
+          model_->worker_comfort().goal_quality(goal, b->human_grasps, cell.spec().human_stance);
+      EXPECT_NEAR(q, goal.quality, 1e-12) << part.name << " goal " << goal.id;
+      ++goals;
+    }
+  }
+  EXPECT_GT(goals, 7);
+}
+
+// A human standing elsewhere sees the world moved the other way: Q of a hand pose H for the
+// human at stance S equals the build's Q (offline::HumanComfort, the cell's stance S0) of the
+// hand pose S0 S^-1 H. Checked over random stances and hand poses near the human.
+TEST_F(WorkerComfortTest, AMovedHumanIsTheBuildsHumanInAMovedWorld) {
+  const auto& cell = model_->cell();
+  std::vector<core::ComfortMap> maps;
+  for (const auto& arm : cell.human_arms()) {
+    const auto& r = model_->database().comfort_map(arm.spec.name);
+    maps.push_back(core::ComfortMap::from_grid(r.origin, r.spacing, r.dims, r.orientations,
+                                               r.values, r.coverage));
+  }
+  const offline::HumanComfort build_comfort(cell, maps);
+  const core::Pose s0 = cell.spec().human_stance;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int reachable = 0;
+  for (int i = 0; i < 400; ++i) {
+    const core::Pose stance = moved(s0, Eigen::Vector3d(0.3 * u(rng), 0.3 * u(rng), 0.0), u(rng));
+    // A hand pose in front of the moved human at chest height.
+    core::Pose hand = test::random_pose(rng, 0.25);
+    hand.translation() += stance * Eigen::Vector3d(0.35, 0.0, 1.2);
+    const int a = i % 2;
+    const std::string& arm = cell.human_arms()[static_cast<std::size_t>(a)].spec.name;
+    const double online_q =
+        model_->worker_comfort().hand_quality(arm, hand, core::Pose::Identity(), stance);
+    const double build_q = build_comfort.quality(a, s0 * stance.inverse() * hand);
+    EXPECT_NEAR(online_q, build_q, 1e-9) << "sample " << i;
+    reachable += build_q > 0.0 ? 1 : 0;
+  }
+  EXPECT_GT(reachable, 50);  // the comparison is not all zeros
+}
+
+// Where the human cannot take the board at any stored goal, the planner says so before any
+// motion is planned, and names where the human stands.
+TEST_F(WorkerComfortTest, AHumanOutOfReachGetsItsOwnStatus) {
+  online::Scene scene = online::nominal_scene(model_->cell(), model_->product());
+  const core::Pose s0 = scene.human_stance;
+  online::BoardPlanner planner(*model_);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (const Eigen::Vector3d& by :
+       {Eigen::Vector3d(5.0, 0.0, 0.0), Eigen::Vector3d(0.0, 0.0, 2.0)}) {
+    scene.human_stance = moved(s0, by, 0.0);
+    const online::BoardPlan plan = planner.plan(scene, "base", deadline);
+    EXPECT_EQ(plan.status, online::BoardPlanStatus::kHumanOutOfReach) << plan.reason;
+    EXPECT_NE(plan.reason.find("cannot take 'base' at any of its"), std::string::npos)
+        << plan.reason;
+    EXPECT_EQ(plan.motions_planned, 0);
+    EXPECT_EQ(plan.goals_out_of_reach,
+              static_cast<int>(model_->board_records("base")->goals.size()));
+    EXPECT_STREQ(online::to_string(plan.status), "human out of reach");
+  }
+  // The same scene with the human where the goals were built for: the goals are used.
+  scene.human_stance = s0;
+  const online::BoardPlan plan = planner.plan(scene, "base", deadline);
+  EXPECT_NE(plan.status, online::BoardPlanStatus::kHumanOutOfReach) << plan.reason;
+  EXPECT_EQ(plan.goals_out_of_reach, 0);
+}
+
+// A human turned away or stepped aside: whatever is planned is handed over where that human
+// takes it comfortably, and every goal passed over is one they could not take.
+TEST_F(WorkerComfortTest, EveryPlanIsComfortableForTheHumanWhoIsThere) {
+  online::Scene scene = online::nominal_scene(model_->cell(), model_->product());
+  const core::Pose s0 = scene.human_stance;
+  const online::BoardRecords* b = model_->board_records("base");
+  ASSERT_NE(b, nullptr);
+  online::BoardPlanner planner(*model_);
+  const double floor = online::BoardPlanSettings{}.worker_quality_floor;
+  int passed_over = 0;
+  for (const double yaw_deg : {0.0, 45.0, 90.0, 180.0}) {
+    for (const double dy : {0.0, 0.25}) {
+      scene.human_stance = moved(s0, Eigen::Vector3d(0.0, dy, 0.0), core::deg_to_rad(yaw_deg));
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      const online::BoardPlan plan = planner.plan(scene, "base", deadline);
+      SCOPED_TRACE("yaw " + std::to_string(yaw_deg) + " dy " + std::to_string(dy));
+      // The goals passed over are exactly those below the floor, among the first tried.
+      int expected_out = 0;
+      std::size_t kept = 0;
+      for (const auto& goal : b->goals) {
+        if (kept >= static_cast<std::size_t>(online::BoardPlanSettings{}.goals)) break;
+        const double q =
+            model_->worker_comfort().goal_quality(goal, b->human_grasps, scene.human_stance);
+        if (q < std::min(floor, goal.quality)) {
+          ++expected_out;
+        } else {
+          ++kept;
+        }
+      }
+      EXPECT_EQ(plan.goals_out_of_reach, expected_out);
+      passed_over += plan.goals_out_of_reach;
+      if (plan.solved()) {
+        const auto& goal = *std::find_if(b->goals.begin(), b->goals.end(),
+                                         [&](const auto& g) { return g.id == plan.candidate_id; });
+        EXPECT_GE(plan.quality, std::min(floor, goal.quality));
+        EXPECT_NEAR(
+            plan.quality,
+            model_->worker_comfort().goal_quality(goal, b->human_grasps, scene.human_stance),
+            1e-12);
+      } else if (kept == 0) {
+        EXPECT_EQ(plan.status, online::BoardPlanStatus::kHumanOutOfReach);
+      }
+    }
+  }
+  EXPECT_GT(passed_over, 0);  // some of these stances do put goals out of reach
+}
