@@ -2,14 +2,14 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <iomanip>
-#include <cassert>
 #include <map>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <span>
+#include <sstream>
 #include <string_view>
 #include <tuple>
 
@@ -1370,13 +1370,28 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
   // The first goals in Eq. 8 order that the scene's human can take, with their comfort for them.
+  // At the stance the goals were built for, their stored Q is the scene human's (the same
+  // lookup); elsewhere the comfort maps are looked up again.
+  const bool built_stance = scene.human_stance.isApprox(model_.cell().spec().human_stance, 1e-12);
+  const WorkerComfort* comfort = nullptr;
+  if (!built_stance) {
+    std::string error;
+    comfort = model_.worker_comfort(&error);
+    if (comfort == nullptr) {
+      return finish(BoardPlanStatus::kNoGoal,
+                    "the human stands elsewhere than the database's goals were built for, and "
+                    "its comfort maps could not be read: " +
+                        error);
+    }
+  }
   std::vector<const db::HandoverCandidateRecord*> goals;
   std::map<std::int64_t, double> worker_quality;  // by goal id
   double best_out_of_reach = 0.0;
   for (const auto& goal : records->goals) {
     if (goals.size() >= static_cast<std::size_t>(std::max(0, settings_.goals))) break;
-    const double q =
-        model_.worker_comfort().goal_quality(goal, records->human_grasps, scene.human_stance);
+    const double q = built_stance
+                         ? goal.quality
+                         : comfort->goal_quality(goal, records->human_grasps, scene.human_stance);
     if (q < std::min(settings_.worker_quality_floor, goal.quality)) {
       ++result.goals_out_of_reach;
       best_out_of_reach = std::max(best_out_of_reach, q);
@@ -1387,13 +1402,14 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   }
   if (goals.empty() && !records->goals.empty()) {
     const core::Pose& stance = scene.human_stance;
-    const double facing = core::rad_to_deg(std::atan2(stance.linear()(1, 0), stance.linear()(0, 0)));
+    const double facing =
+        core::rad_to_deg(std::atan2(stance.linear()(1, 0), stance.linear()(0, 0)));
     std::ostringstream reason;
     reason << std::fixed << std::setprecision(2) << "the human at (" << stance.translation().x()
-           << ", " << stance.translation().y() << ", " << stance.translation().z()
-           << ") m facing " << std::setprecision(0) << facing << " deg cannot take '" << board
-           << "' at any of its " << records->goals.size() << " stored goals (best comfort Q "
-           << std::setprecision(3) << best_out_of_reach << ", needed "
+           << ", " << stance.translation().y() << ", " << stance.translation().z() << ") m facing "
+           << std::setprecision(0) << facing << " deg cannot take '" << board << "' at any of its "
+           << records->goals.size() << " stored goals (best comfort Q " << std::setprecision(3)
+           << best_out_of_reach << ", needed "
            << std::min(settings_.worker_quality_floor, records->goals.front().quality)
            << "): move the human or rebuild the database for this stance";
     return finish(BoardPlanStatus::kHumanOutOfReach, reason.str());

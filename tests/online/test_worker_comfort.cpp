@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <random>
 
@@ -57,7 +58,7 @@ TEST_F(WorkerComfortTest, AtTheCellsStanceEveryGoalHasItsStoredQuality) {
     ASSERT_NE(b, nullptr);
     for (const auto& goal : b->goals) {
       const double q =
-          model_->worker_comfort().goal_quality(goal, b->human_grasps, cell.spec().human_stance);
+          model_->worker_comfort()->goal_quality(goal, b->human_grasps, cell.spec().human_stance);
       EXPECT_NEAR(q, goal.quality, 1e-12) << part.name << " goal " << goal.id;
       ++goals;
     }
@@ -71,8 +72,10 @@ TEST_F(WorkerComfortTest, AtTheCellsStanceEveryGoalHasItsStoredQuality) {
 TEST_F(WorkerComfortTest, AMovedHumanIsTheBuildsHumanInAMovedWorld) {
   const auto& cell = model_->cell();
   std::vector<core::ComfortMap> maps;
+  const auto records = model_->database().read_comfort_maps();
   for (const auto& arm : cell.human_arms()) {
-    const auto& r = model_->database().comfort_map(arm.spec.name);
+    const auto& r = *std::find_if(records.begin(), records.end(),
+                                  [&](const auto& m) { return m.arm == arm.spec.name; });
     maps.push_back(core::ComfortMap::from_grid(r.origin, r.spacing, r.dims, r.orientations,
                                                r.values, r.coverage));
   }
@@ -89,7 +92,7 @@ TEST_F(WorkerComfortTest, AMovedHumanIsTheBuildsHumanInAMovedWorld) {
     const int a = i % 2;
     const std::string& arm = cell.human_arms()[static_cast<std::size_t>(a)].spec.name;
     const double online_q =
-        model_->worker_comfort().hand_quality(arm, hand, core::Pose::Identity(), stance);
+        model_->worker_comfort()->hand_quality(arm, hand, core::Pose::Identity(), stance);
     const double build_q = build_comfort.quality(a, s0 * stance.inverse() * hand);
     EXPECT_NEAR(online_q, build_q, 1e-9) << "sample " << i;
     reachable += build_q > 0.0 ? 1 : 0;
@@ -145,7 +148,7 @@ TEST_F(WorkerComfortTest, EveryPlanIsComfortableForTheHumanWhoIsThere) {
       for (const auto& goal : b->goals) {
         if (kept >= static_cast<std::size_t>(online::BoardPlanSettings{}.goals)) break;
         const double q =
-            model_->worker_comfort().goal_quality(goal, b->human_grasps, scene.human_stance);
+            model_->worker_comfort()->goal_quality(goal, b->human_grasps, scene.human_stance);
         if (q < std::min(floor, goal.quality)) {
           ++expected_out;
         } else {
@@ -160,7 +163,7 @@ TEST_F(WorkerComfortTest, EveryPlanIsComfortableForTheHumanWhoIsThere) {
         EXPECT_GE(plan.quality, std::min(floor, goal.quality));
         EXPECT_NEAR(
             plan.quality,
-            model_->worker_comfort().goal_quality(goal, b->human_grasps, scene.human_stance),
+            model_->worker_comfort()->goal_quality(goal, b->human_grasps, scene.human_stance),
             1e-12);
       } else if (kept == 0) {
         EXPECT_EQ(plan.status, online::BoardPlanStatus::kHumanOutOfReach);
