@@ -1384,22 +1384,28 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                         error);
     }
   }
-  std::vector<const db::HandoverCandidateRecord*> goals;
+  // The goals in Eq. 8 order that the scene's human can take: first those they take
+  // comfortably, then those they only reach; the first BoardPlanSettings::goals of them.
+  std::vector<const db::HandoverCandidateRecord*> goals, reached_only;
   std::map<std::int64_t, double> worker_quality;  // by goal id
   double best_out_of_reach = 0.0;
   for (const auto& goal : records->goals) {
-    if (goals.size() >= static_cast<std::size_t>(std::max(0, settings_.goals))) break;
     const double q = built_stance
                          ? goal.quality
                          : comfort->goal_quality(goal, records->human_grasps, scene.human_stance);
-    if (q < std::min(settings_.worker_quality_floor, goal.quality)) {
+    worker_quality[goal.id] = q;
+    if (q >= std::min(settings_.worker_comfort_floor, goal.quality)) {
+      goals.push_back(&goal);
+    } else if (q >= std::min(settings_.worker_reach_floor, goal.quality)) {
+      reached_only.push_back(&goal);
+      ++result.goals_uncomfortable;
+    } else {
       ++result.goals_out_of_reach;
       best_out_of_reach = std::max(best_out_of_reach, q);
-      continue;
     }
-    goals.push_back(&goal);
-    worker_quality[goal.id] = q;
   }
+  goals.insert(goals.end(), reached_only.begin(), reached_only.end());
+  goals.resize(std::min(goals.size(), static_cast<std::size_t>(std::max(0, settings_.goals))));
   if (goals.empty() && !records->goals.empty()) {
     const core::Pose& stance = scene.human_stance;
     const double facing =
@@ -1409,8 +1415,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
            << ", " << stance.translation().y() << ", " << stance.translation().z() << ") m facing "
            << std::setprecision(0) << facing << " deg cannot take '" << board << "' at any of its "
            << records->goals.size() << " stored goals (best comfort Q " << std::setprecision(3)
-           << best_out_of_reach << ", needed "
-           << std::min(settings_.worker_quality_floor, records->goals.front().quality)
+           << best_out_of_reach << ", needed " << settings_.worker_reach_floor
            << "): move the human or rebuild the database for this stance";
     return finish(BoardPlanStatus::kHumanOutOfReach, reason.str());
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <random>
 
 #include "hila/core/comfort_map.hpp"
@@ -126,49 +127,64 @@ TEST_F(WorkerComfortTest, AHumanOutOfReachGetsItsOwnStatus) {
   EXPECT_EQ(plan.goals_out_of_reach, 0);
 }
 
-// A human turned away or stepped aside: whatever is planned is handed over where that human
-// takes it comfortably, and every goal passed over is one they could not take.
-TEST_F(WorkerComfortTest, EveryPlanIsComfortableForTheHumanWhoIsThere) {
+// A human turned away or stepped aside: the goals they cannot take are never tried, those they
+// take comfortably come before those they only reach, and whatever is planned is handed over
+// where that human takes it.
+TEST_F(WorkerComfortTest, EveryPlanIsTakenByTheHumanWhoIsThere) {
   online::Scene scene = online::nominal_scene(model_->cell(), model_->product());
   const core::Pose s0 = scene.human_stance;
   const online::BoardRecords* b = model_->board_records("base");
   ASSERT_NE(b, nullptr);
   online::BoardPlanner planner(*model_);
-  const double floor = online::BoardPlanSettings{}.worker_quality_floor;
-  int passed_over = 0;
-  for (const double yaw_deg : {0.0, 45.0, 90.0, 180.0}) {
-    for (const double dy : {0.0, 0.25}) {
+  const online::BoardPlanSettings settings;
+  int out_of_reach = 0, uncomfortable = 0, solved = 0;
+  for (const double yaw_deg : {0.0, 20.0, 45.0, 90.0, 180.0}) {
+    for (const double dy : {0.0, 0.1, 0.25}) {
       scene.human_stance = moved(s0, Eigen::Vector3d(0.0, dy, 0.0), core::deg_to_rad(yaw_deg));
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
       const online::BoardPlan plan = planner.plan(scene, "base", deadline);
       SCOPED_TRACE("yaw " + std::to_string(yaw_deg) + " dy " + std::to_string(dy));
-      // The goals passed over are exactly those below the floor, among the first tried.
-      int expected_out = 0;
-      std::size_t kept = 0;
+      // The goals' tiers by brute force over every stored goal.
+      std::map<std::int64_t, int> tier;  // 0 comfortable, 1 reached only, 2 out of reach
+      int expected_out = 0, expected_uncomfortable = 0;
       for (const auto& goal : b->goals) {
-        if (kept >= static_cast<std::size_t>(online::BoardPlanSettings{}.goals)) break;
         const double q =
             model_->worker_comfort()->goal_quality(goal, b->human_grasps, scene.human_stance);
-        if (q < std::min(floor, goal.quality)) {
-          ++expected_out;
-        } else {
-          ++kept;
-        }
+        tier[goal.id] = q >= std::min(settings.worker_comfort_floor, goal.quality) ? 0
+                        : q >= std::min(settings.worker_reach_floor, goal.quality) ? 1
+                                                                                   : 2;
+        expected_out += tier[goal.id] == 2 ? 1 : 0;
+        expected_uncomfortable += tier[goal.id] == 1 ? 1 : 0;
       }
       EXPECT_EQ(plan.goals_out_of_reach, expected_out);
-      passed_over += plan.goals_out_of_reach;
+      EXPECT_EQ(plan.goals_uncomfortable, expected_uncomfortable);
+      out_of_reach += plan.goals_out_of_reach;
+      uncomfortable += plan.goals_uncomfortable;
+      // Attempts never touch an out-of-reach goal, and never go back from a reached-only goal to
+      // a comfortable one.
+      int last_tier = 0;
+      for (const auto& attempt : plan.attempts) {
+        const int t = tier.at(attempt.candidate_id);
+        EXPECT_LT(t, 2);
+        EXPECT_GE(t, last_tier);
+        last_tier = t;
+      }
       if (plan.solved()) {
+        ++solved;
+        EXPECT_NE(tier.at(plan.candidate_id), 2);
         const auto& goal = *std::find_if(b->goals.begin(), b->goals.end(),
                                          [&](const auto& g) { return g.id == plan.candidate_id; });
-        EXPECT_GE(plan.quality, std::min(floor, goal.quality));
         EXPECT_NEAR(
             plan.quality,
             model_->worker_comfort()->goal_quality(goal, b->human_grasps, scene.human_stance),
             1e-12);
-      } else if (kept == 0) {
+      } else if (expected_out == static_cast<int>(b->goals.size())) {
         EXPECT_EQ(plan.status, online::BoardPlanStatus::kHumanOutOfReach);
       }
     }
   }
-  EXPECT_GT(passed_over, 0);  // some of these stances do put goals out of reach
+  // These stances do exercise every tier.
+  EXPECT_GT(out_of_reach, 0);
+  EXPECT_GT(uncomfortable, 0);
+  EXPECT_GT(solved, 0);
 }

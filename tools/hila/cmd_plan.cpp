@@ -64,7 +64,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                         {"queued_smoothing", 1e3 * plan.times.queued_smoothing}}},
                       {"attempts", attempts},
                       {"rejected_motions", plan.rejected_motions},
-                      {"goals_out_of_reach", plan.goals_out_of_reach}};
+                      {"goals_out_of_reach", plan.goals_out_of_reach},
+                      {"goals_uncomfortable", plan.goals_uncomfortable}};
   if (plan.solved()) {
     j["goal_rank"] = plan.goal_rank;
     j["candidate"] = plan.candidate_id;
