@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <sstream>
 #include <string_view>
@@ -1384,9 +1385,35 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                         error);
     }
   }
+  // Whether the scene's human reaches a goal's grasp, by the human arms' inverse kinematics
+  // (the build's own postures where the human stands as built and the build confirmed the goal),
+  // each goal once; a goal they do not reach is never tried.
+  std::map<std::int64_t, WorkerComfort::GoalReach> reach_of;
+  std::set<std::int64_t> out_of_reach;
+  auto reach = [&](const db::HandoverCandidateRecord& goal) -> const WorkerComfort::GoalReach& {
+    const auto it = reach_of.find(goal.id);
+    if (it != reach_of.end()) return it->second;
+    WorkerComfort::GoalReach r;
+    if (built_stance && goal.human_joints.size() > 0 &&
+        (goal.second_arm.empty() || goal.second_joints.size() > 0)) {
+      r.reachable = true;
+      r.quality = goal.quality;
+      r.joints = goal.human_joints;
+      r.second_joints = goal.second_joints;
+    } else if (const WorkerComfort* c = built_stance ? model_.worker_comfort() : comfort) {
+      r = c->goal_reach(goal, records->human_grasps, scene.human_stance);
+    } else {  // as built, and the maps unreadable: the build's word
+      r.reachable = true;
+      r.quality = goal.quality;
+    }
+    if (!r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
+    return reach_of.emplace(goal.id, std::move(r)).first->second;
+  };
   // The goals in Eq. 8 order that the scene's human can take: first those they take
-  // comfortably, then those they only reach; the first BoardPlanSettings::goals of them.
-  std::vector<const db::HandoverCandidateRecord*> goals, reached_only;
+  // comfortably (by the comfort maps), then those they reach only uncomfortably, as far as the
+  // goal count needs them; the first BoardPlanSettings::goals.
+  const auto goal_limit = static_cast<std::size_t>(std::max(0, settings_.goals));
+  std::vector<const db::HandoverCandidateRecord*> goals, below_comfort;
   std::map<std::int64_t, double> worker_quality;  // by goal id
   double best_out_of_reach = 0.0;
   for (const auto& goal : records->goals) {
@@ -1396,17 +1423,24 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     worker_quality[goal.id] = q;
     if (q >= std::min(settings_.worker_comfort_floor, goal.quality)) {
       goals.push_back(&goal);
-    } else if (q >= std::min(settings_.worker_reach_floor, goal.quality)) {
-      reached_only.push_back(&goal);
-      ++result.goals_uncomfortable;
     } else {
-      ++result.goals_out_of_reach;
-      best_out_of_reach = std::max(best_out_of_reach, q);
+      below_comfort.push_back(&goal);
     }
   }
-  goals.insert(goals.end(), reached_only.begin(), reached_only.end());
-  goals.resize(std::min(goals.size(), static_cast<std::size_t>(std::max(0, settings_.goals))));
-  if (goals.empty() && !records->goals.empty()) {
+  for (const auto* goal : below_comfort) {
+    if (goals.size() >= goal_limit) break;
+    const auto& r = reach(*goal);
+    if (r.reachable) {
+      goals.push_back(goal);
+      worker_quality[goal->id] = r.quality;
+      ++result.goals_uncomfortable;
+    } else {
+      best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal->id]);
+    }
+  }
+  goals.resize(std::min(goals.size(), goal_limit));
+  // Where the scene's human can take none of the goals: says where they stand and how they face.
+  auto human_out_of_reach = [&]() {
     const core::Pose& stance = scene.human_stance;
     const double facing =
         core::rad_to_deg(std::atan2(stance.linear()(1, 0), stance.linear()(0, 0)));
@@ -1415,10 +1449,12 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
            << ", " << stance.translation().y() << ", " << stance.translation().z() << ") m facing "
            << std::setprecision(0) << facing << " deg cannot take '" << board << "' at any of its "
            << records->goals.size() << " stored goals (best comfort Q " << std::setprecision(3)
-           << best_out_of_reach << ", needed " << settings_.worker_reach_floor
-           << "): move the human or rebuild the database for this stance";
+           << best_out_of_reach
+           << " by the maps; the arms reach none of the grasps tried): move the human or rebuild "
+              "the database for this stance";
     return finish(BoardPlanStatus::kHumanOutOfReach, reason.str());
-  }
+  };
+  if (goals.empty() && !records->goals.empty()) return human_out_of_reach();
   bool any_connected_offline = false;
   // Every goal in order under `settings`; true when one is planned (result filled in).
   Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
@@ -1445,6 +1481,11 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.suction_grasp_id = rr.suction_grasp_id;
     result.theta_c_deg = run.robot_grasps().at(s.robot_grasp_id).theta_c_deg;
     result.quality = worker_quality.at(goal.id);
+    const auto& posture = reach_of.at(goal.id);
+    result.human_arm = goal.human_arm;
+    result.human_joints = posture.joints;
+    result.second_human_arm = goal.second_arm;
+    result.second_human_joints = posture.second_joints;
     result.robot_handover = rr.board;
     result.human_handover = goal.board;
     result.duration = result.steps.back().time.back();
@@ -1456,6 +1497,12 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   auto try_goals = [&](const std::string& round) {
     for (const auto* goal_record : goals) {
       const auto& goal = *goal_record;
+      // A goal the maps call comfortable may still be out of reach (a map bin holds the best of
+      // the samples near it): confirmed before it is planned.
+      if (!reach(goal).reachable) {
+        best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal.id]);
+        continue;
+      }
       // The shared grasps the offline regrasp graph connected for this goal first: their
       // stored paths and IK branches are what the motions re-validate.
       std::vector<db::SharedGraspRecord> shared = records->shared_grasps.at(goal.id);
@@ -1494,6 +1541,11 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
       result.larger_bridges = true;
       return finish(BoardPlanStatus::kSolved, "");
     }
+  }
+  if (!goals.empty() && std::all_of(goals.begin(), goals.end(), [&](const auto* goal) {
+        return out_of_reach.count(goal->id) > 0;
+      })) {
+    return human_out_of_reach();
   }
   if (std::chrono::steady_clock::now() >= deadline) {
     return finish(

@@ -48,15 +48,12 @@ struct BoardPlanSettings {
   // plans the exchange first (before session 25).
   bool reach_human_pose_first = true;
   // The human who is there. The stored goals are evaluated again for the scene's human (comfort
-  // Q of paper Eq. 4, by the database's comfort maps). Those with Q of at least
-  // worker_comfort_floor (the build's comfort threshold, paper §VI-B) are tried first, in Eq. 8
-  // order; then those with Q of at least worker_reach_floor, which the human reaches but not
-  // comfortably (a human a few centimetres off the stance the goals were built for); the rest
-  // are never used. A goal whose stored Q is lower than a floor is held to its stored Q, so that
-  // at the built stance every stored goal is comfortable and the order is the database's.
+  // Q of paper Eq. 4, by the database's comfort maps). Those with Q of at least this (or of at
+  // least their stored Q where that is lower, so that at the built stance every stored goal
+  // qualifies and the order is the database's) are tried first, in Eq. 8 order; then those the
+  // human's arm reaches by inverse kinematics, uncomfortably; the rest are never tried. The
+  // build's comfort threshold (paper §VI-B).
   double worker_comfort_floor = 0.06;
-  // Half the comfort threshold: below it the arm is near the edge of its reach or singular.
-  double worker_reach_floor = 0.03;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
@@ -114,11 +111,15 @@ struct BoardPlan {
   std::int64_t suction_grasp_id = 0;
   double theta_c_deg = 90.0;
   double quality = 0.0;  // the comfort Q of the scene's human at the goal (paper Eq. 4)
-  // Stored goals the scene's human could not take (never tried), and those they reach but not
-  // comfortably (tried after the comfortable ones): BoardPlanSettings::worker_reach_floor,
-  // worker_comfort_floor.
+  // Stored goals the scene's human reaches only uncomfortably (tried after the comfortable ones)
+  // or not at all (never tried), among those checked (BoardPlanSettings::worker_comfort_floor).
   int goals_out_of_reach = 0;
   int goals_uncomfortable = 0;
+  // The human's receiving posture at the goal: each hand's arm and its joints (rad), from the
+  // human arm's inverse kinematics for the scene's stance (the build's own where it stands as
+  // built). Empty second arm for a one-hand goal.
+  std::string human_arm, second_human_arm;
+  Eigen::VectorXd human_joints, second_human_joints;
   core::Pose robot_handover = core::Pose::Identity();  // board poses (world)
   core::Pose human_handover = core::Pose::Identity();
   std::vector<PlanStep> steps;

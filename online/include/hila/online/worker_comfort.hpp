@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/comfort.hpp"
 #include "hila/core/comfort_map.hpp"
 #include "hila/core/pose.hpp"
 #include "hila/db/records.hpp"
@@ -39,12 +40,27 @@ class WorkerComfort {
                       const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
                       const core::Pose& stance) const;
 
+  // Whether the human at `stance` reaches the goal's grasp with every hand it needs, by inverse
+  // kinematics of the human arm from seeded restarts (core::best_comfort, as the build confirms
+  // its first goals), and the weaker hand's Q at the best posture found. The maps are sampled
+  // (a bin no sample reached reads 0), so a low map Q does not mean out of reach; this does.
+  struct GoalReach {
+    bool reachable = false;
+    double quality = 0.0;                   // the weaker hand's Q at the postures found
+    Eigen::VectorXd joints, second_joints;  // goal.human_arm's, goal.second_arm's (rad)
+  };
+  GoalReach goal_reach(const db::HandoverCandidateRecord& goal,
+                       const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
+                       const core::Pose& stance, const core::ComfortSettings& ik = {}) const;
+
  private:
   struct Arm {
     std::string name;
     core::ComfortMap map;
     core::Pose base_in_stance;  // the arm's base (torso) in the human's floor frame, neutral
+    const core::KinematicChain* chain = nullptr;  // the cell's, which outlives this
   };
+  const Arm* arm(const std::string& name) const;
   std::vector<Arm> arms_;
 };
 
