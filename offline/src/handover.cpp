@@ -6,13 +6,13 @@
 #include <random>
 
 #include "hila/core/collision.hpp"
+#include "hila/core/comfort.hpp"
+#include "hila/core/comfort_map.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
-#include "hila/core/comfort.hpp"
-#include "hila/core/comfort_map.hpp"
 #include "hila/offline/human_grasps.hpp"
 #include "hila/offline/suction_pick.hpp"
 
@@ -371,6 +371,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     return "";
   };
+  // Payload: the suction arm carries the part on the tool, the receiving arm in its jaws.
+  for (const auto& check :
+       {core::check_payload(settings.suction_arm, cell.arm(settings.suction_arm).spec.payload,
+                            part.mass, core::CarryMode::kSuction, cell.spec().suction.mass),
+        core::check_payload(settings.receiving_arm, cell.arm(settings.receiving_arm).spec.payload,
+                            part.mass, core::CarryMode::kGripper, cell.spec().suction.mass)}) {
+    if (!check.within_allowed()) return finish("over the payload: " + check.describe());
+  }
   sample_candidates(settings.candidates);
   if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates) {
     return finish(no_candidate_reason());

@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "hila/core/bridge.hpp"
+#include "hila/core/payload.hpp"
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
@@ -77,6 +78,8 @@ const char* to_string(BoardPlanStatus status) {
       return "timeout";
     case BoardPlanStatus::kHumanOutOfReach:
       return "human out of reach";
+    case BoardPlanStatus::kOverPayload:
+      return "over payload";
   }
   return "unknown";
 }
@@ -204,6 +207,8 @@ class Run {
 
   const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps() const { return robot_grasps_; }
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
+  const core::Arm& suction_arm() const { return suction_; }
+  const core::Arm& receiving_arm() const { return receiving_; }
   // The run's times so far, the validator's own time on either thread included.
   int rejected_motions() const { return rejected_motions_; }
   int motions_planned() const { return motions_planned_; }
@@ -1370,7 +1375,19 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (records == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
-  // The first goals in Eq. 8 order that the scene's human can take, with their comfort for them.
+  Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
+  running = &run;
+  // Payload: the suction arm carries the board on the tool, the receiving arm in its jaws.
+  for (const auto& check :
+       {core::check_payload(run.suction_arm().spec.name, run.suction_arm().spec.payload, part->mass,
+                            core::CarryMode::kSuction, model_.cell().spec().suction.mass),
+        core::check_payload(run.receiving_arm().spec.name, run.receiving_arm().spec.payload,
+                            part->mass, core::CarryMode::kGripper,
+                            model_.cell().spec().suction.mass)}) {
+    if (!check.within_allowed()) {
+      return finish(BoardPlanStatus::kOverPayload, "over the payload: " + check.describe());
+    }
+  }
   // At the stance the goals were built for, their stored Q is the scene human's (the same
   // lookup); elsewhere the comfort maps are looked up again.
   const bool built_stance = scene.human_stance.isApprox(model_.cell().spec().human_stance, 1e-12);
@@ -1456,9 +1473,6 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   };
   if (goals.empty() && !records->goals.empty()) return human_out_of_reach();
   bool any_connected_offline = false;
-  // Every goal in order under `settings`; true when one is planned (result filled in).
-  Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
-  running = &run;
   // One chain of a goal under the round's budgets; true when it is planned (result filled in).
   auto try_shared = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
                         const db::SharedGraspRecord& s) {
@@ -1494,6 +1508,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.robot_q_after = end.robot_q;
     return true;
   };
+  // Every goal in order under the round's budgets; true when one is planned (result filled in).
   auto try_goals = [&](const std::string& round) {
     for (const auto* goal_record : goals) {
       const auto& goal = *goal_record;

@@ -38,7 +38,7 @@ WorkerComfort::GoalReach WorkerComfort::goal_reach(
     const db::HandoverCandidateRecord& goal,
     const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps, const core::Pose& stance,
     const core::ComfortSettings& ik) const {
-  auto hand = [&](const std::string& name, std::int64_t grasp_id) {
+  auto hand = [&](const std::string& name, std::int64_t grasp_id, const Eigen::VectorXd& built) {
     const Arm* a = arm(name);
     const auto it = human_grasps.find(grasp_id);
     if (a == nullptr || it == human_grasps.end()) return core::ComfortResult{};
@@ -49,19 +49,22 @@ WorkerComfort::GoalReach WorkerComfort::goal_reach(
     if ((in_base.translation() - a->chain->first_joint_position()).norm() > reach) {
       return core::ComfortResult{};
     }
-    const Eigen::VectorXd seed = Eigen::VectorXd::Zero(a->chain->dof())
-                                     .cwiseMax(a->chain->lower_limits())
-                                     .cwiseMin(a->chain->upper_limits());
+    const Eigen::VectorXd seed = built.size() == a->chain->dof()
+                                     ? built
+                                     : Eigen::VectorXd::Zero(a->chain->dof())
+                                           .cwiseMax(a->chain->lower_limits())
+                                           .cwiseMin(a->chain->upper_limits());
     return core::best_comfort(*a->chain, in_base, seed, ik);
   };
   GoalReach r;
   if (goal.human_arm.empty()) return r;
-  const core::ComfortResult first = hand(goal.human_arm, goal.human_grasp_id);
+  const core::ComfortResult first = hand(goal.human_arm, goal.human_grasp_id, goal.human_joints);
   if (!first.reachable) return r;
   r.quality = first.quality;
   r.joints = first.joints;
   if (!goal.second_arm.empty()) {
-    const core::ComfortResult second = hand(goal.second_arm, goal.second_grasp_id);
+    const core::ComfortResult second =
+        hand(goal.second_arm, goal.second_grasp_id, goal.second_joints);
     if (!second.reachable) return GoalReach{};
     r.quality = std::min(r.quality, second.quality);
     r.second_joints = second.joints;

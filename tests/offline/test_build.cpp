@@ -137,6 +137,34 @@ TEST(Build, AHumanStanceInsideTheTableIsRejectedBeforeAnyWork) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
 }
 
+// With the UR3's datasheet payload (3.0 kg, the reference cell's allowance of 3.5 kg taken out),
+// the 1.8 kg laterals on the suction tool are over it: the build gives them no goals and says
+// why; the lighter boards are unaffected.
+TEST(Build, APartOverThePayloadGetsNoGoalAndTheReason) {
+  const std::string dir = test::temp_dir("build_payload");
+  std::string cell = test::read_file(test::cell_path());
+  const std::string from = "        allowed_kg: 3.5\n";
+  ASSERT_NE(cell.find(from), std::string::npos);
+  cell.replace(cell.find(from), from.size(), "");
+  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
+    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
+  }
+  const std::string path = test::write_file(dir, "cell.yaml", cell);
+  const offline::BuildSummary summary =
+      offline::build_database(test::product_path(), path, dir + "/x.hila", quick_settings());
+  for (const auto& part : summary.parts) {
+    SCOPED_TRACE(part.name);
+    if (part.mass > 1.45) {
+      EXPECT_EQ(part.goals, 0);
+      EXPECT_EQ(part.handover_failure,
+                "over the payload: part 1.80 kg + tooling 1.30 kg + suction tool 0.25 kg = 3.35 kg "
+                "> 3.00 kg allowed at arm 'right'");
+    } else {
+      EXPECT_EQ(part.handover_failure.find("payload"), std::string::npos);
+    }
+  }
+}
+
 TEST(Build, SameSeedSameDigestForAnyNumberOfJobs) {
   const std::string dir = test::temp_dir("build_digest");
   const std::string a = build(dir, "a.hila", quick_settings(7, 1));

@@ -19,6 +19,10 @@ double characteristic_length(const core::KinematicChain& arm);
 
 struct ComfortSettings {
   int ik_attempts = 24;  // seeded restarts over the arm's self-motion (7 joints, 6 constraints)
+  // Restarts made after the first solution is found; negative: all ik_attempts (the most
+  // comfortable posture). A reach check with a good seed needs few.
+  int attempts_after_found = -1;
+  double tolerance = 1e-10;  // m and rad: the hand pose error a solution may leave
   std::uint64_t seed = 1;
 };
 

@@ -81,7 +81,9 @@ struct GoalAttempt {
 
 // kHumanOutOfReach: the scene's human can take the board at none of its stored goals (where they
 // stand, or how they face, puts every goal out of comfortable reach).
-enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout, kHumanOutOfReach };
+// kOverPayload: an arm would carry more than its payload (the part, its tooling and, on the
+// suction cup, the tool: core::check_payload).
+enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout, kHumanOutOfReach, kOverPayload };
 const char* to_string(BoardPlanStatus status);
 
 // Where a board's planning time went (s, wall clock, summed over every goal attempt; the rest is

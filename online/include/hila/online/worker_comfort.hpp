@@ -41,8 +41,10 @@ class WorkerComfort {
                       const core::Pose& stance) const;
 
   // Whether the human at `stance` reaches the goal's grasp with every hand it needs, by inverse
-  // kinematics of the human arm from seeded restarts (core::best_comfort, as the build confirms
-  // its first goals), and the weaker hand's Q at the best posture found. The maps are sampled
+  // kinematics of the human arm (core::best_comfort, as the build confirms its first goals): from
+  // the build's posture where the goal has one (a human a few centimetres off the built stance
+  // is a few iterations away), then up to 8 seeded restarts, stopping at the first solution. The
+  // weaker hand's Q at the postures found. The maps are sampled
   // (a bin no sample reached reads 0), so a low map Q does not mean out of reach; this does.
   struct GoalReach {
     bool reachable = false;
