@@ -44,8 +44,8 @@ class WorkerComfort {
   // kinematics of the human arm (core::best_comfort, as the build confirms its first goals): from
   // the build's posture where the goal has one (a human a few centimetres off the built stance
   // is a few iterations away), then up to 8 seeded restarts, stopping at the first solution. The
-  // weaker hand's Q at the postures found. The maps are sampled
-  // (a bin no sample reached reads 0), so a low map Q does not mean out of reach; this does.
+  // weaker hand's Q at the postures found. The maps are sampled (a bin no sample reached reads
+  // 0), so a low map Q does not mean out of reach; this does.
   struct GoalReach {
     bool reachable = false;
     double quality = 0.0;                   // the weaker hand's Q at the postures found
@@ -53,7 +53,17 @@ class WorkerComfort {
   };
   GoalReach goal_reach(const db::HandoverCandidateRecord& goal,
                        const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
-                       const core::Pose& stance, const core::ComfortSettings& ik = {}) const;
+                       const core::Pose& stance,
+                       const core::ComfortSettings& ik = reach_settings()) const;
+  // For a reach check: 8 attempts, stopping at the first solution, to 1e-7 m and rad (far below
+  // what a human hand notices).
+  static core::ComfortSettings reach_settings() {
+    core::ComfortSettings s;
+    s.ik_attempts = 8;
+    s.attempts_after_found = 0;
+    s.tolerance = 1e-7;
+    return s;
+  }
 
  private:
   struct Arm {
