@@ -64,7 +64,8 @@ struct CollisionModelImpl {
   }
 
   // The same for a body just appended (the highest index), touching only its row and column: a
-  // world adds some sixty bodies one by one, and a full refresh each time was half its build.
+  // world adds its dozens of bodies one by one, and a full refresh for each would dominate its
+  // build.
   void append_pairs() {
     ++version;
     const std::size_t n = bodies.size();
@@ -162,9 +163,9 @@ void require_new_name(const CollisionModelImpl& m, const std::string& name) {
   }
 }
 
-// Appends a body with its shapes in place, so that the pairs know it has shapes (a mesh body
-// added last once went untested by the subset query: its shape came after the refresh). The
-// caller has checked the name (require_new_name) before making the shapes.
+// Appends a body with its shapes in place, so that the pairs know it has shapes (shapes added
+// after the pairs' refresh would leave a mesh body added last untested by the subset query).
+// The caller has checked the name (require_new_name) before making the shapes.
 int append_body(CollisionModelImpl& m, const std::string& name, std::vector<FclGeometry> geometries,
                 std::vector<Pose> offsets, bool is_static, const Pose& pose) {
   BodyModel body;
@@ -277,8 +278,7 @@ inline void merge(WorldBox& into, const WorldBox& box) {
 
 // Touching boxes overlap, as in FCL.
 // All six comparisons, then one branch: a query tests hundreds of box pairs that mostly miss
-// on some axis, and a branch per axis was mispredicted on many of them
-// (BM_ArmPoserCheckFree 2.3 -> 2.05 us).
+// on some axis, and a branch per axis is mispredicted on many of them.
 inline bool overlap(const WorldBox& a, const WorldBox& b) {
   const auto le = [](double x, double y) { return static_cast<unsigned>(x <= y); };
   return (le(a.lo[0], b.hi[0]) & le(b.lo[0], a.hi[0]) & le(a.lo[1], b.hi[1]) &

@@ -21,8 +21,8 @@ namespace {
 
 // Thrown by the validity checker once a query is out of checks or time. OMPL's LazyPRM only
 // tests its termination condition between roadmap growth steps; its loop of search, lazy
-// check and removal runs to the end however long that takes (it overran a 10 s deadline by
-// minutes), and it checks validity on every turn of that loop, so that is where it is stopped.
+// check and removal runs to the end however long that takes (far past any deadline), and it
+// checks validity on every turn of that loop, so that is where it is stopped.
 struct QueryBudgetSpent {};
 
 }  // namespace

@@ -455,7 +455,8 @@ std::vector<core::GraphEndpoint> ArmMotionPlanner::attach(const Eigen::VectorXd&
   const auto take =
       std::min<std::size_t>(near.size(), static_cast<std::size_t>(settings_.attach_neighbours));
   // Nearest first, sorted in growing chunks as far as the walk below goes: it usually stops
-  // after the first few (a full sort of the 150 nearest of thousands cost more than the checks).
+  // after the first few (a full sort of the attach_neighbours nearest of thousands costs more
+  // than the checks).
   std::size_t sorted = 0;
   const auto sort_up_to = [&](std::size_t j) {
     if (j < sorted) return;

@@ -602,8 +602,8 @@ class Run {
       MotionRequest fine = request;
       fine.fine_checks = true;
       // A bridge, found at a large cost, is mended where it is blocked rather than searched for
-      // again (lateral_left's wedged transfers: 150 000 checks, then as many again); a roadmap
-      // path is searched again, which is cheap and finds shorter ways than mending.
+      // again at that cost; a roadmap path is searched again, which is cheap and finds shorter
+      // ways than mending.
       if (motion.via.find("bridge") != std::string::npos) fine.rejected = &motion.path;
       MotionResult again = timed_plan(planner, fine);
       if (again.solved()) {
@@ -986,7 +986,7 @@ class Run {
     // receiving arm waiting at its pre-grasp while the suction arm is still at the lift and
     // brings the board to it, and only then with bridges to the board in place: those are
     // planned at the empty arm's resolution beside the held board, and the validator often
-    // rejects them (the nominal shelf_middle spent 17 000 checks so).
+    // rejects them, each rejection a bridge's checks spent for nothing.
     const auto direct = [&](bool bridges) {
       for (std::size_t b = 0; b < branches.size(); ++b) {
         if (bridges && static_cast<int>(b) >= settings_.exchange_bridges) break;
@@ -1527,7 +1527,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
       any_connected_offline = any_connected_offline || connected != shared.begin();
       // Where the receiving arm did not reach the exchange with a grasp, that grasp at the same
       // board pose (another suction grasp holding it there) is tried after the goal's other
-      // chains: what blocked it is still there (top v1 in bench_online replayed 110 ms so).
+      // chains: what blocked it is still there, so it would most likely fail again.
       std::vector<const db::SharedGraspRecord*> later;
       for (const auto& s : shared) {
         if (std::chrono::steady_clock::now() >= deadline) return false;

@@ -1,8 +1,12 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
+#include <memory>
+#include <optional>
 
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/build.hpp"
@@ -12,19 +16,6 @@
 using namespace hila;
 
 namespace {
-
-// The cabinet database the test plans from: the default build with a smaller roadmap, or a
-// prebuilt one named by HILA_TEST_DATABASE (e.g. tools/demo's out/cabinet.hila).
-std::string database(const std::string& dir) {
-  if (const char* given = std::getenv("HILA_TEST_DATABASE")) return given;
-  // The default build with a smaller roadmap (the full one takes minutes).
-  offline::BuildSettings s;
-  s.jobs = 2;
-  s.roadmap.nodes = 1200;
-  const std::string out = dir + "/cabinet.hila";
-  offline::build_database(test::product_path(), test::cell_path(), out, s);
-  return out;
-}
 
 std::chrono::steady_clock::time_point in_seconds(double s) {
   return std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(s * 1e6));
@@ -118,6 +109,33 @@ int expect_failed_receives_tried_last(const online::PlannerModel& model, const s
   return came_back;
 }
 
+// The same steps, point for point: the same names, smoothing, times and joints.
+void expect_same_steps(const online::BoardPlan& a, const online::BoardPlan& b) {
+  ASSERT_EQ(a.steps.size(), b.steps.size());
+  for (std::size_t i = 0; i < b.steps.size(); ++i) {
+    EXPECT_EQ(a.steps[i].name, b.steps[i].name);
+    EXPECT_EQ(a.steps[i].smoothed, b.steps[i].smoothed) << b.steps[i].name;
+    EXPECT_EQ(a.steps[i].time, b.steps[i].time) << b.steps[i].name;
+    ASSERT_EQ(a.steps[i].q.size(), b.steps[i].q.size()) << b.steps[i].name;
+    for (std::size_t k = 0; k < b.steps[i].q.size(); ++k) {
+      ASSERT_EQ(a.steps[i].q[k], b.steps[i].q[k]) << b.steps[i].name << " " << k;
+    }
+  }
+}
+
+// How the receiving arm went home after the release ("(none)" without such a step).
+std::string home_via(const online::BoardPlan& plan) {
+  for (const auto& step : plan.steps) {
+    if (step.name == "receiving_arm_home") return step.via;
+  }
+  return "(none)";
+}
+
+bool bridged(const online::BoardPlan& plan) {
+  return std::any_of(plan.steps.begin(), plan.steps.end(),
+                     [](const auto& step) { return step.via.find("bridge") == 0; });
+}
+
 void print_plan(const online::BoardPlan& plan) {
   std::string attempts;
   for (const auto& a : plan.attempts)
@@ -145,79 +163,181 @@ online::SceneObstacle box_at(const std::string& name, const Eigen::Vector3d& cen
 
 }  // namespace
 
-// The cabinet in assembly order, each scene following from the last and a board that cannot be
-// planned assembled by hand (as hila plan --all). Every board must plan, in order, on this
-// smaller roadmap too (base with the tool pick first); a board that did not would say why.
-// Then, on lateral_right's scene, the repairs the issue asks for:
-//  - a crate put on the stored path (at the gripper in the middle of the transfer to the human,
-//    so the old motion certainly hits it) is planned around: a different, validated plan;
-//  - a crate at the first goal's robot-human pose makes the planner fall back to a later goal.
-TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) {
-  const std::string dir = test::temp_dir("board_planner");
-  const auto model =
-      online::PlannerModel::load(database(dir), test::cell_path(), test::product_path());
-  online::BoardPlanner planner(*model);
-  online::Scene scene =
-      online::load_scene(test::data_path("cabinet/scene.yaml"), model->cell(), model->product());
+// The cabinet database, its model and the nominal run, made once per test process and shared
+// read-only by every case (a case copies a scene before it adds an obstacle): the database build
+// is most of the work. The nominal run is the cabinet in assembly order, each scene following
+// from the last and a board that cannot be planned assembled by hand (as hila plan --all), with
+// the default settings. Every plan has a 120 s deadline: a bound, not a goal. ctest runs each
+// case in a process of its own: HILA_TEST_DATABASE shares one database among them.
+class BoardPlanner : public ::testing::Test {
+ protected:
+  // Each board's scene (the boards before it assembled) and its plan there.
+  struct Nominal {
+    std::map<std::string, online::Scene> scene_of;
+    std::map<std::string, online::BoardPlan> plan_of;
+  };
+  // A board whose receiving arm went home along its way in, planned again without that hint.
+  struct WayBack {
+    std::string board;
+    online::BoardPlan without;
+  };
+  // lateral_right's scene with a crate where its first goal hands the board over, and its plan.
+  struct Blocked {
+    online::Scene scene;
+    online::BoardPlan plan;
+  };
+
+  static void SetUpTestSuite() {
+    const std::string path = database();
+    model_ = online::PlannerModel::load(path, test::cell_path(), test::product_path());
+    nominal_ = std::make_unique<Nominal>();
+    online::BoardPlanner planner(*model_);
+    online::Scene scene = online::load_scene(test::data_path("cabinet/scene.yaml"), model_->cell(),
+                                             model_->product());
+    for (const auto& part : model_->product().parts) {
+      const auto plan = planner.plan(scene, part.name, in_seconds(120.0));
+      print_plan(plan);
+      nominal_->scene_of[part.name] = scene;
+      nominal_->plan_of[part.name] = plan;
+      scene = after(*model_, scene, part.name);
+    }
+  }
+
+  static void TearDownTestSuite() {
+    way_back_.reset();
+    way_back_planned_ = false;
+    blocked_.reset();
+    nominal_.reset();
+    model_.reset();
+    if (!dir_.empty()) std::filesystem::remove_all(dir_);
+    dir_.clear();
+  }
+
+  void SetUp() override {
+    ASSERT_TRUE(model_ && nominal_) << "the cabinet database could not be built or loaded";
+  }
+
+  static const online::PlannerModel& model() { return *model_; }
+  static const std::map<std::string, online::BoardPlan>& plans() { return nominal_->plan_of; }
+  static const online::Scene& scene_of(const std::string& board) {
+    return nominal_->scene_of.at(board);
+  }
+  static const online::BoardPlan& plan_of(const std::string& board) {
+    return nominal_->plan_of.at(board);
+  }
+
+  // The first board (in name order) whose nominal plan sends the receiving arm home along its
+  // way in; nullptr when none does. Planned once per process, for whichever case asks first.
+  static const WayBack* way_back_board() {
+    if (!way_back_planned_) {
+      way_back_planned_ = true;
+      const auto it = std::find_if(plans().begin(), plans().end(), [](const auto& kv) {
+        return home_via(kv.second).find("stored") == 0;
+      });
+      if (it != plans().end()) {
+        online::BoardPlanSettings no_way_back;
+        no_way_back.way_back_spacing = 0.0;
+        auto without = online::BoardPlanner(*model_, no_way_back)
+                           .plan(scene_of(it->first), it->first, in_seconds(120.0));
+        print_plan(without);
+        way_back_ = WayBack{it->first, std::move(without)};
+      }
+    }
+    return way_back_ ? &*way_back_ : nullptr;
+  }
+
+  // A crate where lateral_right's first goal hands the board over, planned with the default
+  // settings. Planned once per process, for whichever case asks first.
+  static const Blocked& crate_at_first_goal() {
+    if (!blocked_) {
+      const std::string board = "lateral_right";
+      online::Scene scene = scene_of(board);
+      scene.obstacles.push_back(box_at("crate", plan_of(board).human_handover.translation(), 0.06));
+      auto plan = online::BoardPlanner(*model_).plan(scene, board, in_seconds(120.0));
+      print_plan(plan);
+      blocked_ = Blocked{std::move(scene), std::move(plan)};
+    }
+    return *blocked_;
+  }
+
+ private:
+  // The cabinet database the cases plan from: a prebuilt one named by HILA_TEST_DATABASE (e.g.
+  // tools/demo's out/cabinet.hila), else the default build with a smaller roadmap (the full one
+  // takes minutes), in a directory of this process's own (ctest may run cases side by side).
+  static std::string database() {
+    if (const char* given = std::getenv("HILA_TEST_DATABASE")) return given;
+    offline::BuildSettings s;
+    s.jobs = 2;
+    s.roadmap.nodes = 1200;
+    dir_ = test::temp_dir("board_planner_" + std::to_string(::getpid()));
+    const std::string out = dir_ + "/cabinet.hila";
+    offline::build_database(test::product_path(), test::cell_path(), out, s);
+    return out;
+  }
+
+  static inline std::string dir_;
+  static inline std::shared_ptr<const online::PlannerModel> model_;
+  static inline std::unique_ptr<Nominal> nominal_;
+  static inline bool way_back_planned_ = false;
+  static inline std::optional<WayBack> way_back_;
+  static inline std::optional<Blocked> blocked_;
+};
+
+// Every board plans, in order, on this smaller roadmap too (base with the tool pick first), and
+// every plan is well formed; a board that did not plan would say why and emit nothing. Where a
+// receive failed at a board pose, the goal's other chains came first.
+TEST_F(BoardPlanner, EveryBoardPlansInAssemblyOrderAndValidates) {
   std::vector<std::string> solved;
-  std::map<std::string, online::Scene> scene_of;
-  std::map<std::string, online::BoardPlan> plan_of;
-  for (const auto& part : model->product().parts) {
+  for (const auto& part : model().product().parts) {
     SCOPED_TRACE(part.name);
-    const auto plan = planner.plan(scene, part.name, in_seconds(120.0));  // a bound, not a goal
-    print_plan(plan);
-    scene_of[part.name] = scene;
-    plan_of[part.name] = plan;
-    expect_failed_receives_tried_last(*model, part.name, plan);
+    const online::BoardPlan& plan = plan_of(part.name);
+    expect_failed_receives_tried_last(model(), part.name, plan);
     if (plan.solved()) {
       solved.push_back(part.name);
-      expect_plan_well_formed(*model, scene, plan);
+      expect_plan_well_formed(model(), scene_of(part.name), plan);
     } else {
       EXPECT_FALSE(plan.reason.empty());
       EXPECT_FALSE(plan.attempts.empty());
       for (const auto& a : plan.attempts) EXPECT_NE(a.outcome, "planned");
       EXPECT_TRUE(plan.steps.empty()) << "nothing of a failed plan is emitted";
     }
-    scene = after(*model, scene, part.name);
   }
-  EXPECT_EQ(solved.size(), model->product().parts.size());
+  EXPECT_EQ(solved.size(), model().product().parts.size());
   ASSERT_GE(solved.size(), 4u);
-  // The smoother is part of the pipeline: multi-waypoint motions are smoothed (and validated,
-  // above) rather than all falling back to the found paths.
+  EXPECT_EQ(solved[0], "base");
+  EXPECT_EQ(solved[1], "lateral_right");
+  EXPECT_EQ(solved[2], "back_lower");
+  EXPECT_EQ(solved[3], "shelf_middle");
+}
+
+// The smoother is part of the pipeline: multi-waypoint motions are smoothed (and validated)
+// rather than all falling back to the found paths.
+TEST_F(BoardPlanner, MultiWaypointMotionsAreSmoothed) {
   int smoothed = 0;
-  for (const auto& [name, plan] : plan_of) {
+  for (const auto& [name, plan] : plans()) {
     for (const auto& step : plan.steps) smoothed += step.smoothed ? 1 : 0;
   }
   EXPECT_GT(smoothed, 0);
-  // With the overlap on, steps are smoothed on either thread (queued, or on the planner's while
-  // the queue is behind): the plans are exactly those smoothed and validated in order.
-  // Which thread smoothed a step depends on timing; with every smoothing queued
-  // (smooth_here_when_behind false) none is done on the planner's thread, whatever the timing.
+}
+
+// With the overlap on, steps are smoothed on either thread (queued, or on the planner's while
+// the queue is behind): the plans are exactly those smoothed and validated in order. Which
+// thread smoothed a step depends on timing; with every smoothing queued
+// (smooth_here_when_behind false) none is done on the planner's thread, whatever the timing.
+TEST_F(BoardPlanner, WhereAStepIsSmoothedAndValidatedDoesNotChangeThePlan) {
   online::BoardPlanSettings in_order_settings;
   in_order_settings.overlap_validation = false;
-  online::BoardPlanner in_order_planner(*model, in_order_settings);
+  online::BoardPlanner in_order_planner(model(), in_order_settings);
   online::BoardPlanSettings all_queued_settings;
   all_queued_settings.smooth_here_when_behind = false;
-  online::BoardPlanner all_queued_planner(*model, all_queued_settings);
-  const auto expect_same_steps = [](const online::BoardPlan& a, const online::BoardPlan& b) {
-    ASSERT_EQ(a.steps.size(), b.steps.size());
-    for (std::size_t i = 0; i < b.steps.size(); ++i) {
-      EXPECT_EQ(a.steps[i].name, b.steps[i].name);
-      EXPECT_EQ(a.steps[i].smoothed, b.steps[i].smoothed) << b.steps[i].name;
-      EXPECT_EQ(a.steps[i].time, b.steps[i].time) << b.steps[i].name;
-      ASSERT_EQ(a.steps[i].q.size(), b.steps[i].q.size()) << b.steps[i].name;
-      for (std::size_t k = 0; k < b.steps[i].q.size(); ++k) {
-        ASSERT_EQ(a.steps[i].q[k], b.steps[i].q[k]) << b.steps[i].name << " " << k;
-      }
-    }
-  };
+  online::BoardPlanner all_queued_planner(model(), all_queued_settings);
   double queued_smoothing = 0.0;
-  for (const auto& [name, plan] : plan_of) {
+  for (const auto& [name, plan] : plans()) {
     SCOPED_TRACE(name);
-    const auto in_order = in_order_planner.plan(scene_of.at(name), name, in_seconds(120.0));
+    const auto in_order = in_order_planner.plan(scene_of(name), name, in_seconds(120.0));
     EXPECT_EQ(in_order.times.queued_smoothing, 0.0);
     expect_same_steps(in_order, plan);
-    const auto all_queued = all_queued_planner.plan(scene_of.at(name), name, in_seconds(120.0));
+    const auto all_queued = all_queued_planner.plan(scene_of(name), name, in_seconds(120.0));
     // (a step the validator rejects is planned again in order, smoothed where it is planned)
     if (all_queued.rejected_motions == 0) {
       EXPECT_EQ(all_queued.times.smoothing, 0.0) << "smoothed on the planner's thread";
@@ -226,42 +346,28 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
     expect_same_steps(in_order, all_queued);
   }
   EXPECT_GT(queued_smoothing, 0.0) << "the queued steps were smoothed";
-  // The receiving arm's way home after the release follows its way in, reversed, on some
-  // board; the same board without that hint goes home some other way (the hint was the cause).
-  const auto home_via = [](const online::BoardPlan& plan) {
-    for (const auto& step : plan.steps) {
-      if (step.name == "receiving_arm_home") return step.via;
-    }
-    return std::string("(none)");
-  };
-  const auto way_back = std::find_if(plan_of.begin(), plan_of.end(), [&](const auto& kv) {
-    return home_via(kv.second).find("stored") == 0;
-  });
-  ASSERT_NE(way_back, plan_of.end()) << "no board went home along its way in";
-  online::BoardPlanSettings no_way_back;
-  no_way_back.way_back_spacing = 0.0;
-  online::BoardPlanner without(*model, no_way_back);
-  const auto other = without.plan(scene_of.at(way_back->first), way_back->first, in_seconds(120.0));
-  print_plan(other);
-  ASSERT_TRUE(other.solved()) << way_back->first << ": " << other.reason;
-  expect_plan_well_formed(*model, scene_of.at(way_back->first), other);
-  EXPECT_EQ(home_via(other).find("stored"), std::string::npos) << way_back->first;
-  EXPECT_EQ(solved[0], "base");
-  EXPECT_EQ(solved[1], "lateral_right");
-  EXPECT_EQ(solved[2], "back_lower");
-  EXPECT_EQ(solved[3], "shelf_middle");
+}
 
-  // A board whose plan without the way back needs a bridge (the one above, or one whose nominal
-  // plan does), planned again with no bridge budget at first, no way back and only its nearest
-  // goal: every chain of that goal fails in the first round (on this database each needs a
-  // bridge), and the second round, with bridges as large as the baselines' budget, plans it (the
-  // escalation). A plan with a bridge can only come from that round.
-  auto bridged = [](const online::BoardPlan& plan) {
-    return std::any_of(plan.steps.begin(), plan.steps.end(),
-                       [](const auto& step) { return step.via.find("bridge") == 0; });
-  };
-  std::string needs_bridge = bridged(other) ? way_back->first : "";
-  for (const auto& [name, plan] : plan_of) {
+// The receiving arm's way home after the release follows its way in, reversed, on some board;
+// the same board without that hint goes home some other way (the hint was the cause).
+TEST_F(BoardPlanner, TheReceivingArmGoesHomeAlongItsWayIn) {
+  const WayBack* way_back = way_back_board();
+  ASSERT_NE(way_back, nullptr) << "no board went home along its way in";
+  const online::BoardPlan& other = way_back->without;
+  ASSERT_TRUE(other.solved()) << way_back->board << ": " << other.reason;
+  expect_plan_well_formed(model(), scene_of(way_back->board), other);
+  EXPECT_EQ(home_via(other).find("stored"), std::string::npos) << way_back->board;
+}
+
+// A board whose plan without the way back needs a bridge (the board above, or one whose nominal
+// plan does), planned again with no bridge budget at first, no way back and only its nearest
+// goal: every chain of that goal fails in the first round (on this database each needs a
+// bridge), and the second round, with bridges as large as the baselines' budget, plans it (the
+// escalation). A plan with a bridge can only come from that round.
+TEST_F(BoardPlanner, EveryChainFailingEscalatesToLargerBridges) {
+  const WayBack* way_back = way_back_board();
+  std::string needs_bridge = way_back && bridged(way_back->without) ? way_back->board : "";
+  for (const auto& [name, plan] : plans()) {
     if (needs_bridge.empty() && bridged(plan)) needs_bridge = name;
   }
   ASSERT_FALSE(needs_bridge.empty()) << "some board of the cabinet needs a bridge";
@@ -269,34 +375,36 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
   no_bridges.motion.bridge_checks = 0;
   no_bridges.goals = 1;
   no_bridges.way_back_spacing = 0.0;
-  online::BoardPlanner escalating(*model, no_bridges);
-  const auto escalated =
-      escalating.plan(scene_of.at(needs_bridge), needs_bridge, in_seconds(120.0));
+  online::BoardPlanner escalating(model(), no_bridges);
+  const auto escalated = escalating.plan(scene_of(needs_bridge), needs_bridge, in_seconds(120.0));
   print_plan(escalated);
   ASSERT_TRUE(escalated.solved()) << needs_bridge << ": " << escalated.reason;
-  expect_plan_well_formed(*model, scene_of.at(needs_bridge), escalated);
+  expect_plan_well_formed(model(), scene_of(needs_bridge), escalated);
   EXPECT_TRUE(escalated.larger_bridges || !bridged(escalated)) << needs_bridge;
   EXPECT_TRUE(escalated.larger_bridges) << needs_bridge;
   EXPECT_EQ(escalated.goal_rank, 0);
   EXPECT_NE(escalated.attempts.front().outcome.find("no path"), std::string::npos)
       << escalated.attempts.front().outcome;
+}
 
-  // A crate on the path.
+// A crate on lateral_right's stored path (at the gripper in the middle of the transfer to the
+// human, so the nominal motion certainly hits it) is planned around: a different, validated plan.
+TEST_F(BoardPlanner, ACrateOnTheStoredPathIsPlannedAround) {
   const std::string board = "lateral_right";
-  const online::BoardPlan& nominal = plan_of.at(board);
+  const online::BoardPlan& nominal = plan_of(board);
   const auto transfer = std::find_if(nominal.steps.begin(), nominal.steps.end(),
                                      [](const auto& s) { return s.name == "transfer_to_human"; });
   ASSERT_NE(transfer, nominal.steps.end());
-  const core::Arm& arm = model->cell().arm(transfer->arm);
+  const core::Arm& arm = model().cell().arm(transfer->arm);
   const Eigen::VectorXd& middle = transfer->q[transfer->q.size() / 2];
   const Eigen::Vector3d gripper =
-      (core::arm_base_in_world(model->cell(), arm) * arm.chain.fk(middle)).translation();
-  online::Scene crated = scene_of.at(board);
+      (core::arm_base_in_world(model().cell(), arm) * arm.chain.fk(middle)).translation();
+  online::Scene crated = scene_of(board);
   crated.obstacles.push_back(box_at("crate", gripper, 0.08));
-  const auto repaired = planner.plan(crated, board, in_seconds(120.0));
+  const auto repaired = online::BoardPlanner(model()).plan(crated, board, in_seconds(120.0));
   print_plan(repaired);
   ASSERT_TRUE(repaired.solved()) << repaired.reason;
-  expect_plan_well_formed(*model, crated, repaired);
+  expect_plan_well_formed(model(), crated, repaired);
   bool differs = repaired.candidate_id != nominal.candidate_id ||
                  repaired.steps.size() != nominal.steps.size();
   for (std::size_t i = 0; !differs && i < repaired.steps.size(); ++i) {
@@ -306,51 +414,60 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
                   nominal.steps[i].q[nominal.steps[i].q.size() / 2]);
   }
   EXPECT_TRUE(differs) << "the crate stands where the nominal plan's gripper passes";
+}
 
-  // A crate where the first goal hands the board over.
-  online::Scene blocked = scene_of.at(board);
-  blocked.obstacles.push_back(box_at("crate", nominal.human_handover.translation(), 0.06));
-  const auto fallback = planner.plan(blocked, board, in_seconds(120.0));
-  print_plan(fallback);
+// A crate where lateral_right's first goal hands the board over makes the planner fall back to a
+// later goal.
+TEST_F(BoardPlanner, ACrateAtTheFirstGoalFallsBackToALaterGoal) {
+  const online::BoardPlan& nominal = plan_of("lateral_right");
+  const Blocked& blocked = crate_at_first_goal();
+  const online::BoardPlan& fallback = blocked.plan;
   ASSERT_TRUE(fallback.solved()) << fallback.reason;
-  expect_plan_well_formed(*model, blocked, fallback);
+  expect_plan_well_formed(model(), blocked.scene, fallback);
   EXPECT_GT(fallback.goal_rank, nominal.goal_rank);
   EXPECT_NE(fallback.candidate_id, nominal.candidate_id);
   EXPECT_GE(fallback.attempts.size(), 2u);
   EXPECT_EQ(fallback.attempts.front().rank, nominal.goal_rank);
   EXPECT_NE(fallback.attempts.front().outcome, "planned");
-  // The crate leaves no valid IK branch at the first goal's robot-human pose. Checked before the
-  // exchange is planned (the default), the grasps that cannot serve that goal cost no exchange:
-  // the same attempts and plan as planning the exchange first, with fewer motions planned.
-  {
-    online::BoardPlanSettings exchange_first;
-    exchange_first.reach_human_pose_first = false;
-    const auto late =
-        online::BoardPlanner(*model, exchange_first).plan(blocked, board, in_seconds(120.0));
-    ASSERT_TRUE(late.solved()) << late.reason;
-    EXPECT_EQ(late.candidate_id, fallback.candidate_id);
-    ASSERT_EQ(late.attempts.size(), fallback.attempts.size());
-    int unreachable = 0;
-    for (std::size_t i = 0; i < late.attempts.size(); ++i) {
-      EXPECT_EQ(late.attempts[i].outcome, fallback.attempts[i].outcome) << "attempt " << i;
-      const std::string& outcome = fallback.attempts[i].outcome;
-      if (outcome.find("no valid IK at the robot-human pose") != std::string::npos) ++unreachable;
-    }
-    expect_same_steps(late, fallback);
-    ASSERT_GT(unreachable, 0) << "the crate must leave the first goal unreachable";
-    EXPECT_LT(fallback.motions_planned, late.motions_planned);
-    std::printf(
-        "robot-human pose checked first: %d motions planned, exchange first: %d (%d "
-        "attempts without a valid IK there)\n",
-        fallback.motions_planned, late.motions_planned, unreachable);
-  }
+}
 
-  // A validator stricter than the planner (a held board kept 2 deg inside theta_c) rejects
-  // transfers the planner has already planned past: with the validation overlapped, each is
-  // caught when the goal settles, its fallbacks run and its stage is planned again in order.
-  // The outcome is the one validating every motion before the next gives: the same goal, the
-  // same attempts, every emitted step passing the stricter validator. (On this database lateral
-  // right's first goal is rejected so, 15 times in order, and its second plans.)
+// The crate at the first goal leaves no valid IK branch at its robot-human pose. Checked before
+// the exchange is planned (the default), the grasps that cannot serve that goal cost no
+// exchange: the same attempts and plan as planning the exchange first, with fewer motions
+// planned.
+TEST_F(BoardPlanner, ReachOfTheHumanPoseIsCheckedBeforeTheExchange) {
+  const Blocked& blocked = crate_at_first_goal();
+  const online::BoardPlan& fallback = blocked.plan;
+  ASSERT_TRUE(fallback.solved()) << fallback.reason;
+  online::BoardPlanSettings exchange_first;
+  exchange_first.reach_human_pose_first = false;
+  const auto late = online::BoardPlanner(model(), exchange_first)
+                        .plan(blocked.scene, "lateral_right", in_seconds(120.0));
+  ASSERT_TRUE(late.solved()) << late.reason;
+  EXPECT_EQ(late.candidate_id, fallback.candidate_id);
+  ASSERT_EQ(late.attempts.size(), fallback.attempts.size());
+  int unreachable = 0;
+  for (std::size_t i = 0; i < late.attempts.size(); ++i) {
+    EXPECT_EQ(late.attempts[i].outcome, fallback.attempts[i].outcome) << "attempt " << i;
+    const std::string& outcome = fallback.attempts[i].outcome;
+    if (outcome.find("no valid IK at the robot-human pose") != std::string::npos) ++unreachable;
+  }
+  expect_same_steps(late, fallback);
+  ASSERT_GT(unreachable, 0) << "the crate must leave the first goal unreachable";
+  EXPECT_LT(fallback.motions_planned, late.motions_planned);
+  std::printf(
+      "robot-human pose checked first: %d motions planned, exchange first: %d (%d "
+      "attempts without a valid IK there)\n",
+      fallback.motions_planned, late.motions_planned, unreachable);
+}
+
+// A validator stricter than the planner (a held board kept 2 deg inside theta_c) rejects
+// transfers the planner has already planned past: with the validation overlapped, each is
+// caught when the goal settles, its fallbacks run and its stage is planned again in order.
+// The outcome is the one validating every motion before the next gives: the same goal, the
+// same attempts, every emitted step passing the stricter validator. (On this database lateral
+// right's first goal is rejected so, 15 times in order, and its second plans.)
+TEST_F(BoardPlanner, ARejectionFoundLateGivesThePlanOfValidatingInOrder) {
   online::BoardPlanSettings strict;
   strict.validator.slip_tolerance_deg = -2.0;
   online::BoardPlanSettings strict_in_order = strict;
@@ -358,10 +475,10 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
   int rejected = 0;
   for (const std::string name : {"lateral_right", "top"}) {
     SCOPED_TRACE(name);
-    const online::Scene& s = scene_of.at(name);
-    const auto overlapped = online::BoardPlanner(*model, strict).plan(s, name, in_seconds(120.0));
+    const online::Scene& s = scene_of(name);
+    const auto overlapped = online::BoardPlanner(model(), strict).plan(s, name, in_seconds(120.0));
     const auto in_order =
-        online::BoardPlanner(*model, strict_in_order).plan(s, name, in_seconds(120.0));
+        online::BoardPlanner(model(), strict_in_order).plan(s, name, in_seconds(120.0));
     print_plan(overlapped);
     rejected += overlapped.rejected_motions;
     // Each rejected stage is planned twice when overlapped: first on, then in order.
@@ -372,24 +489,24 @@ TEST(BoardPlanner, TheCabinetPlansInOrderAndRepairsForObstaclesAndBlockedGoals) 
     for (std::size_t i = 0; i < overlapped.attempts.size(); ++i) {
       EXPECT_EQ(overlapped.attempts[i].outcome, in_order.attempts[i].outcome) << "attempt " << i;
     }
-    if (overlapped.solved()) expect_plan_well_formed(*model, s, overlapped);
+    if (overlapped.solved()) expect_plan_well_formed(model(), s, overlapped);
   }
   EXPECT_GT(rejected, 0) << "the stricter validator must reject something";
+}
 
-  // A box beside the exchange where the receiving arm cannot reach some grasps at the first
-  // goals' robot-robot pose (found by trying boxes around it on this database): once a grasp's
-  // reach fails at a board pose, the goal's other chains come before that grasp at that pose
-  // again (held there by another suction grasp).
-  {
-    const std::string name = "back_lower";
-    online::Scene boxed = scene_of.at(name);
-    boxed.obstacles.push_back(box_at(
-        "crate", plan_of.at(name).robot_handover.translation() + Eigen::Vector3d(0, 0.22, 0), 0.1));
-    const auto plan = planner.plan(boxed, name, in_seconds(120.0));
-    print_plan(plan);
-    ASSERT_TRUE(plan.solved()) << plan.reason;
-    expect_plan_well_formed(*model, boxed, plan);
-    EXPECT_GT(expect_failed_receives_tried_last(*model, name, plan), 0)
-        << "no grasp came back to a board pose where its reach had failed";
-  }
+// A box beside back_lower's exchange where the receiving arm cannot reach some grasps at the
+// first goals' robot-robot pose (found by trying boxes around it on this database): once a
+// grasp's reach fails at a board pose, the goal's other chains come before that grasp at that
+// pose again (held there by another suction grasp).
+TEST_F(BoardPlanner, AGraspWhoseReceiveFailedAtABoardPoseComesBackLast) {
+  const std::string name = "back_lower";
+  online::Scene boxed = scene_of(name);
+  boxed.obstacles.push_back(box_at(
+      "crate", plan_of(name).robot_handover.translation() + Eigen::Vector3d(0, 0.22, 0), 0.1));
+  const auto plan = online::BoardPlanner(model()).plan(boxed, name, in_seconds(120.0));
+  print_plan(plan);
+  ASSERT_TRUE(plan.solved()) << plan.reason;
+  expect_plan_well_formed(model(), boxed, plan);
+  EXPECT_GT(expect_failed_receives_tried_last(model(), name, plan), 0)
+      << "no grasp came back to a board pose where its reach had failed";
 }

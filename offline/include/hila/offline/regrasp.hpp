@@ -33,10 +33,10 @@ struct RegraspSettings {
   // A receiving-arm transfer the filtered roadmap cannot make (a bridge) gets up to this many
   // other bridges between the same ends (samples projected onto the slip limit), stored as
   // parallel transfer edges after it: online, a scene that blocks one often leaves another.
-  // Two until session 22: lateral_left got 1 (most tries fail under its 17 deg limit), and a
-  // box on both stored bridges sent v15 to a 0.1 s repair; with 6 it gets 2 and v15 follows one.
+  // Six: under a tight slip limit most tries fail, and it takes more than one stored bridge for
+  // a box to leave one free.
   int bridge_alternatives = 6;
-  long alternative_checks = 200000;  // each alternative's budget (lateral_left's needs > 40000)
+  long alternative_checks = 200000;  // each alternative's budget (tight slip limits need many)
   std::uint64_t seed = 1;            // bridges' samplers
   double lift = 0.15;  // m, straight up from the stack (the build uses HandoverSettings::pick_lift)
   // The receiving arm's way in at the exchange: a pre-grasp this far (m) back from the grasp or

@@ -26,8 +26,8 @@ struct RoadmapSettings {
   // space (rad, Euclidean over the six joints).
   double resolution = 0.05;
   // Each joint's range in the roadmap: within this much of home (and the limits). A UR's +-2 pi
-  // joints would otherwise leave the milestones far apart (measured: 28 components, mean edge
-  // 2 rad at 3000 milestones); IK solutions are wrapped nearest home, so goals fall inside. A
+  // joints would otherwise leave the milestones far apart (a roadmap in many components, its
+  // edges long); IK solutions are wrapped nearest home, so goals fall inside. A
   // joint limited to less (the elbow, +-pi) keeps its limits (core::joint_box).
   double joint_range = 3.14159265358979323846;
   std::uint64_t seed = 1;

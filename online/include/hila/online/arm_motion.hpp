@@ -112,38 +112,35 @@ const char* to_string(MotionPlannerKind kind);
 
 struct MotionSettings {
   MotionPlannerKind planner = MotionPlannerKind::kRoadmap;
-  // Roadmap nodes tried per end, nearest first, until `attachments` valid ones: with 40, the
-  // staging poses of lateral_left's exchange attached in too few scene variations (19/20
-  // planned, median 1.33 s; with 150, 20/20 and 0.73 s).
+  // Roadmap nodes tried per end, nearest first, until `attachments` valid ones: where the scene
+  // crowds an end (a staging pose beside the board at the exchange), its nearest valid nodes can
+  // lie well past the first few dozen.
   int attach_neighbours = 150;
   int attachments = 6;  // valid attachments kept per end
   // The same where the joins are checked (an end whose unchecked joins failed, a stored path's
   // end): each kept node costs a whole segment's checks, and past the second they rarely
-  // shorten the path. 2 instead of 6: per problem x0.80-0.91 (bench seeds 1 and 2), x0.999
-  // (seed 3), robot motion over the 140 plans 4026 -> 4013 s (docs/online.md, Session 24).
+  // shorten the path.
   int checked_attachments = 2;
   int max_searches = 200;
   int staging_searches = 20;  // per staging try (MotionRequest::max_searches)
   // Segment checks while holding a board (rad): finer than the roadmap's 0.05, since a long
   // board sweeps far between those samples; the empty arm uses the roadmap's. The validator's
   // 0.01 pass catches what falls between samples (a step it rejects is planned again at 0.01,
-  // fine_checks). 0.02 until session 16: 0.04 gave the same 140/140 bench problems (seeds 1
-  // and 2) with the same robot motion, a median board 17.0 -> 12.9 ms and a p95 0.24 -> 0.16 s;
-  // 0.05 lost lateral_left v7.
+  // fine_checks). 0.04: finer finds the same plans more slowly; at the roadmap's 0.05 some
+  // held-board motions are no longer found.
   double held_resolution = 0.04;
   // A fine retry's (MotionRequest::fine_checks): the validator's 0.01.
   double fine_resolution = 0.01;
-  // A bridge's validity-check budget (also bounded by the deadline). 4000 left the arm unable to
-  // go home from beside the human's hands on back_lower and shelf_middle (the whole goal was then
-  // abandoned after every other motion was planned); 10000 bridges them.
+  // A bridge's validity-check budget (also bounded by the deadline): enough for the receiving
+  // arm's way home from beside the human's hands, where a failed bridge gives up the whole goal
+  // after every other motion of it is planned.
   long bridge_checks = 10000;
   // A bridge for an end wedged in by the scene (no straight join reaches a roadmap node): a
   // `wedged_focus` share of its samples drawn around that end (a Gaussian of `focus_sigma` rad
   // per joint, core::BridgeSettings::focus), within `wedged_bridge_checks` (and bridge_checks)
-  // until the larger bridges' round. Uniform samples alone left the wedged end's tree at its
-  // root: 20 of 35 wedged bridges in bench_online got through, needing a median of 1 400 checks
-  // and up to 6 800; drawn around the end, 19 of 31, needing a median of 400 and at most 4 300.
-  // The hopeless ones then cost 3 000 checks each instead of 10 000 (docs/online.md, session 23).
+  // until the larger bridges' round. Uniform samples alone seldom grow the wedged end's tree
+  // past its root; drawn around the end, a bridge that gets through at all does so within a few
+  // thousand checks, so the smaller cap costs the hopeless ones less and loses little.
   long wedged_bridge_checks = 3000;
   double wedged_focus = 0.6;
   double focus_sigma = 0.5;  // rad
@@ -152,17 +149,14 @@ struct MotionSettings {
   // roadmap fails and before a bridge across the whole motion: with `repair_checks` per
   // repair (0: off), and `wedged_repair_checks` when an end attaches to no roadmap node. A board
   // whose every goal failed gets `escalated_repair_checks` with the larger bridges. Where a
-  // stored transfer under a 17 deg slip limit threads between finished boards and a box blocks
-  // it further on (lateral_left in bench_online), the repair gets through where a whole-motion
-  // bridge needs luck: with the wedged repairs lateral_left's median went 0.26 -> 0.09 s; with
-  // repairs before every whole-motion bridge (20000), the median board went 0.10 -> 0.19 s.
-  // A wedged repair gets the larger round's budget from the start (20000, was 10000):
-  // lateral_left's v3, v7 and v8 needed it, and got it only after every goal had failed once
-  // (median of 3 runs 273/318/364 -> 67/85/134 ms, the same 140 plans).
+  // stored transfer under a tight slip limit threads between finished boards and a box blocks
+  // it further on, the repair gets through where a whole-motion bridge needs luck; repairs
+  // before every whole-motion bridge cost more than they save, so repair_checks is 0 (off).
+  // A wedged repair gets the larger round's budget from the start: otherwise the motions that
+  // need it get it only after every goal has failed once.
   // Wedged repairs first go over every stored path at `wedged_first_repair_checks` each, then
-  // at the full budget: of three stored transfers the first may need 15 000 checks round a box
-  // where another gets round it in 3 000 (lateral_left v3, v7, v16: 55-85 -> 23-29 ms, p95
-  // 45 -> 30 ms; docs/online.md, Session 24). 0: the full budget only.
+  // at the full budget: one stored path may need several times the checks another needs round
+  // the same box. 0: the full budget only.
   long repair_checks = 0;
   long wedged_repair_checks = 20000;
   long wedged_first_repair_checks = 3000;
@@ -295,8 +289,8 @@ class ArmMotionPlanner {
   // path and kept while the context stands. Within a context edges are only ever taken out
   // (blocked_edges_), so ends in different components stay apart for every later search under
   // that filter, and A* is not run to find that out again: a search that fails explores the
-  // whole of the entries' component (1-2 ms on a 38 000-edge roadmap), and a motion whose ends
-  // the filtered roadmap does not join used to search 4 times.
+  // whole of the entries' component, and a motion whose ends the filtered roadmap does not join
+  // is asked for again and again (its retries, other goals sharing its stage).
   struct Components {
     const std::vector<bool>* filter = nullptr;  // the request's (nullptr: every edge)
     std::vector<int> label;                     // per node

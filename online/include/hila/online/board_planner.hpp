@@ -40,12 +40,12 @@ struct BoardPlanSettings {
   bool overlap_validation = true;
   // With the overlap: while the second thread is behind, a step is smoothed on the planner's
   // thread rather than queued with its validation (the plan is the same either way). false
-  // queues every step's smoothing: the median board went x1.10 slower (bench_online, session 19).
+  // queues every step's smoothing: slower, the work piling onto the thread already behind.
   bool smooth_here_when_behind = true;
   // Before the exchange is planned for a goal and grasp, whether the receiving arm reaches the
   // goal's robot-human pose with that grasp at all (the transfer to the human's own first
   // check): the same plans, without planning exchanges for grasps the goal cannot use. false
-  // plans the exchange first (before session 25).
+  // plans the exchange first.
   bool reach_human_pose_first = true;
   // The human who is there. The stored goals are evaluated again for the scene's human (comfort
   // Q of paper Eq. 4, by the database's comfort maps). Those with Q of at least this (or of at
