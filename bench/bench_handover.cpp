@@ -29,10 +29,10 @@ namespace {
 struct Problem {
   std::shared_ptr<const core::Cell> cell = core::Cell::load(HILA_DATA_DIR "/cell/cell.yaml");
   core::ProductSpec product = core::load_product(HILA_DATA_DIR "/cabinet/product.yaml");
-  std::vector<offline::ComfortMap> maps;
+  std::vector<core::ComfortMap> maps;
   Problem() {
     for (const auto& arm : cell->human_arms()) {
-      maps.push_back(offline::ComfortMap::build(arm.chain, {}));
+      maps.push_back(core::ComfortMap::build(arm.chain, {}));
     }
   }
 };
@@ -46,11 +46,11 @@ void BM_ComfortMapsBothArms(benchmark::State& state) {
   const auto cell = core::Cell::load(HILA_DATA_DIR "/cell/cell.yaml");
   long filled = 0;
   for (auto _ : state) {
-    std::vector<offline::ComfortMap> maps(cell->human_arms().size());
+    std::vector<core::ComfortMap> maps(cell->human_arms().size());
     std::vector<std::thread> threads;
     for (std::size_t a = 0; a < maps.size(); ++a) {
       threads.emplace_back(
-          [&, a] { maps[a] = offline::ComfortMap::build(cell->human_arms()[a].chain, {}); });
+          [&, a] { maps[a] = core::ComfortMap::build(cell->human_arms()[a].chain, {}); });
     }
     for (auto& t : threads) t.join();
     filled = 0;

@@ -21,9 +21,35 @@ Eigen::VectorXd positive_degrees_vector(const YamlNode& node, std::size_t n) {
   return degrees_vector(node, n);
 }
 
+// An arm's payload: {rated_kg, allowed_kg (default rated_kg), tooling: [{name, mass_kg, com}]}.
+// Masses within (0, 1000] kg; a tooling item within (0, rated].
+PayloadSpec parse_payload(const YamlNode& node) {
+  node.expect_only({"rated_kg", "allowed_kg", "tooling"});
+  PayloadSpec p;
+  p.stated = true;
+  p.rated = node.at("rated_kg").as_double_in(1e-3, 1000.0);
+  p.allowed = p.rated;
+  if (const auto a = node.find("allowed_kg")) {
+    p.allowed = a->as_double_in(p.rated, 1000.0);
+  }
+  if (const auto tooling = node.find("tooling")) {
+    if (!tooling->is_sequence()) tooling->fail("a list of {name, mass_kg, com}", "another node");
+    for (std::size_t i = 0; i < tooling->size(); ++i) {
+      const YamlNode t = tooling->at(i);
+      t.expect_only({"name", "mass_kg", "com"});
+      ToolingMass m;
+      m.name = t.at("name").as_string();
+      m.mass = t.at("mass_kg").as_double_in(1e-6, p.allowed);
+      if (const auto com = t.find("com")) m.com = com->as_vec3();
+      p.tooling.push_back(m);
+    }
+  }
+  return p;
+}
+
 ArmSpec parse_arm(const YamlNode& node) {
   node.expect_only({"name", "base_link", "tip_link", "flange_link", "finger_joint", "kinematics",
-                    "home_deg", "max_velocity_deg_s", "max_acceleration_deg_s2"});
+                    "home_deg", "max_velocity_deg_s", "max_acceleration_deg_s2", "payload"});
   ArmSpec arm;
   arm.name = node.at("name").as_string();
   arm.base_link = node.at("base_link").as_string();
@@ -52,6 +78,7 @@ ArmSpec parse_arm(const YamlNode& node) {
       positive_degrees_vector(node.at("max_velocity_deg_s"), node.at("max_velocity_deg_s").size());
   arm.max_acceleration = positive_degrees_vector(node.at("max_acceleration_deg_s2"),
                                                  node.at("max_acceleration_deg_s2").size());
+  if (const auto p = node.find("payload")) arm.payload = parse_payload(*p);
   return arm;
 }
 
@@ -158,7 +185,7 @@ CellSpec load_cell_spec(const std::string& path) {
 
   const YamlNode suction = root.at("suction");
   suction.expect_only({"tool_urdf", "handle_link", "cup_link", "handle_width", "cup_radius",
-                       "max_force", "max_moment", "handle_in_tcp"});
+                       "max_force", "max_moment", "handle_in_tcp", "mass_kg", "com"});
   cell.suction.tool_urdf = suction.resolve_path(suction.at("tool_urdf").as_string());
   cell.suction.handle_link = suction.at("handle_link").as_string();
   cell.suction.cup_link = suction.at("cup_link").as_string();
@@ -167,6 +194,8 @@ CellSpec load_cell_spec(const std::string& path) {
   cell.suction.max_force = suction.at("max_force").as_positive();
   cell.suction.max_moment = suction.at("max_moment").as_positive();
   cell.suction.handle_in_tcp = suction.at("handle_in_tcp").as_pose();
+  if (const auto m = suction.find("mass_kg")) cell.suction.mass = m->as_double_in(0.0, 100.0);
+  if (const auto c = suction.find("com")) cell.suction.com = c->as_vec3();
 
   if (const auto obstacles = root.find("obstacles")) {
     for (std::size_t i = 0; i < obstacles->size(); ++i) {

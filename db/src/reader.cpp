@@ -674,6 +674,21 @@ const PartRecord& Database::part(const std::string& name) const {
       "no such part");
 }
 
+std::vector<ComfortMapRecord> Database::read_comfort_maps() const {
+  const auto connection = detail::open_hila_database(path_);
+  const auto meta_map = detail::read_meta_table(*connection);
+  const std::string fix = detail::rebuild_hint(path_, meta_map);
+  const Meta now = parse_meta(path_, meta_map, detail::stored_schema_version(path_, meta_map));
+  if (now.created_at != meta_.created_at || now.settings_hash != meta_.settings_hash ||
+      now.cell_hash != meta_.cell_hash || now.product_hash != meta_.product_hash ||
+      now.seed != meta_.seed) {
+    throw DatabaseError(path_, "meta", "the database opened (created " + meta_.created_at + ")",
+                        "a file rebuilt or replaced since (created " + now.created_at + ")",
+                        "open it again");
+  }
+  return load_comfort_maps(*connection, path_, fix);
+}
+
 const ComfortMapRecord& Database::comfort_map(const std::string& arm) const {
   if (!comfort_maps_loaded_) {
     throw core::InputError(

@@ -23,6 +23,22 @@ namespace hila::offline {
 
 namespace {
 
+// The database record of a human arm's comfort map (the build's sample count and seed with it).
+db::ComfortMapRecord comfort_map_record(const core::ComfortMap& map, const std::string& arm,
+                                        const core::ComfortMapSettings& settings) {
+  db::ComfortMapRecord record;
+  record.arm = arm;
+  record.origin = map.origin();
+  record.spacing = map.spacing();
+  record.dims = map.dims();
+  record.orientations = map.orientations();
+  record.values = map.values();
+  record.samples = settings.samples;
+  record.seed = settings.seed;
+  record.coverage = map.coverage();
+  return record;
+}
+
 std::string mesh_hash(const core::TriangleMesh& mesh) {
   std::string bytes;
   bytes.reserve(mesh.vertices.size() * 24 + mesh.triangles.size() * 12);
@@ -287,7 +303,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   const std::size_t roadmap_count = robot_arms.size();
   const int total = static_cast<int>(roadmap_count + arms + 2 * n);
   std::vector<PartResult> results(n);
-  std::vector<ComfortMap> maps(arms);
+  std::vector<core::ComfortMap> maps(arms);
   std::vector<ComfortMapSummary> map_summaries(arms);
   std::vector<Roadmap> roadmaps(roadmap_count);
   std::mutex progress_mutex;
@@ -302,7 +318,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     if (progress) progress(label, done, total);
   };
   auto comfort_seed = [&](std::size_t a) {
-    ComfortMapSettings comfort = settings.comfort;
+    core::ComfortMapSettings comfort = settings.comfort;
     comfort.seed = part_seed(settings.seed, "comfort:" + cell->human_arms()[a].spec.name, 3);
     return comfort;
   };
@@ -323,7 +339,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
       const std::size_t a = t - roadmap_count;
       const auto start_map = std::chrono::steady_clock::now();
       const core::HumanArm& arm = cell->human_arms()[a];
-      maps[a] = ComfortMap::build(arm.chain, comfort_seed(a));
+      maps[a] = core::ComfortMap::build(arm.chain, comfort_seed(a));
       auto& s = map_summaries[a];
       s.arm = arm.spec.name;
       s.filled_bins = maps[a].filled_bins();
@@ -444,7 +460,8 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     summary.parts.push_back(r.summary);
   }
   for (std::size_t a = 0; a < arms; ++a) {
-    writer.add_comfort_map(maps[a].to_record(cell->human_arms()[a].spec.name, comfort_seed(a)));
+    writer.add_comfort_map(
+        comfort_map_record(maps[a], cell->human_arms()[a].spec.name, comfort_seed(a)));
   }
   summary.comfort_maps = map_summaries;
   writer.commit();

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "hila/core/robot_model.hpp"
-#include "hila/offline/comfort.hpp"
+#include "hila/core/comfort.hpp"
 #include "hila/offline/handover.hpp"
 
 namespace hila::offline {
@@ -57,7 +57,7 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
   const double max_flexion = torso < 0 ? 0.0 : core::rad_to_deg(human.upper_limits()[torso]);
   Eigen::VectorXd q = cell.human_neutral();
   std::vector<core::Pose> links;
-  ComfortSettings ik;
+  core::ComfortSettings ik;
   ik.ik_attempts = settings.ik_attempts;
   ik.seed = settings.seed;
   for (double flexion = 0.0; flexion <= max_flexion + 1e-9; flexion += settings.flexion_step_deg) {
@@ -93,7 +93,7 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
       const Eigen::VectorXd seed = Eigen::VectorXd::Zero(arm.chain.dof())
                                        .cwiseMax(arm.chain.lower_limits())
                                        .cwiseMin(arm.chain.upper_limits());
-      const ComfortResult r = best_comfort(arm.chain, hand, seed, ik);
+      const core::ComfortResult r = core::best_comfort(arm.chain, hand, seed, ik);
       if (r.reachable && (!posture.reachable || r.quality > posture.quality)) {
         posture.reachable = true;
         posture.quality = r.quality;

@@ -6,13 +6,13 @@
 #include <random>
 
 #include "hila/core/collision.hpp"
+#include "hila/core/comfort.hpp"
+#include "hila/core/comfort_map.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
-#include "hila/offline/comfort.hpp"
-#include "hila/offline/comfort_map.hpp"
 #include "hila/offline/human_grasps.hpp"
 #include "hila/offline/suction_pick.hpp"
 
@@ -371,6 +371,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     return "";
   };
+  // Payload: the suction arm carries the part on the tool, the receiving arm in its jaws.
+  for (const auto& check :
+       {core::check_payload(settings.suction_arm, cell.arm(settings.suction_arm).spec.payload,
+                            part.mass, core::CarryMode::kSuction, cell.spec().suction.mass),
+        core::check_payload(settings.receiving_arm, cell.arm(settings.receiving_arm).spec.payload,
+                            part.mass, core::CarryMode::kGripper, cell.spec().suction.mass)}) {
+    if (!check.within_allowed()) return finish("over the payload: " + check.describe());
+  }
   sample_candidates(settings.candidates);
   if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates) {
     return finish(no_candidate_reason());
@@ -458,7 +466,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
   }
   const int n_favoured = static_cast<int>(orientations.size());
-  for (const auto& q : spread_orientations(settings.rr_orientations)) {
+  for (const auto& q : core::spread_orientations(settings.rr_orientations)) {
     orientations.push_back(q.toRotationMatrix());
   }
   const int n_pos = static_cast<int>(settings.rr_positions.size());
@@ -564,7 +572,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   }
 
   // --- 𝕊: members of S sharing a grasp with a robot-robot pose, in Eq. 8 order -------------
-  ComfortSettings ik_settings;
+  core::ComfortSettings ik_settings;
   ik_settings.ik_attempts = 12;
   ik_settings.seed = settings.seed;
   auto solve_human = [&](const core::Pose& board, int arm, int grasp) {
@@ -574,7 +582,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     const Eigen::VectorXd seed = Eigen::VectorXd::Zero(chain.dof())
                                      .cwiseMax(chain.lower_limits())
                                      .cwiseMin(chain.upper_limits());
-    return best_comfort(chain, hand, seed, ik_settings);
+    return core::best_comfort(chain, hand, seed, ik_settings);
   };
   int verified = 0;
   // At the robot-human pose the receiving arm and the board it holds move against the rest.
@@ -634,8 +642,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
       // are coarse, so a bin's Q may come from a neighbouring hand orientation.
       if (verified < settings.human_ik_goals) {
-        const ComfortResult first = solve_human(c.board, h.arm, h.grasp);
-        ComfortResult second;
+        const core::ComfortResult first = solve_human(c.board, h.arm, h.grasp);
+        core::ComfortResult second;
         if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
         const double q =
             h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;

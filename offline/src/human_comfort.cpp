@@ -5,7 +5,7 @@
 #include "hila/core/error.hpp"
 #include "hila/core/kinematic_chain.hpp"
 #include "hila/core/robot_model.hpp"
-#include "hila/offline/comfort.hpp"
+#include "hila/core/comfort.hpp"
 
 namespace hila::offline {
 
@@ -25,7 +25,7 @@ core::Pose base_in_world(const core::Cell& cell, const core::RobotModel& human,
 
 }  // namespace
 
-HumanComfort::HumanComfort(const core::Cell& cell, std::vector<ComfortMap> maps,
+HumanComfort::HumanComfort(const core::Cell& cell, std::vector<core::ComfortMap> maps,
                            const std::vector<core::HumanBodySpec>& bodies)
     : maps_(std::move(maps)) {
   const auto& arms = cell.human_arms();
@@ -48,7 +48,7 @@ HumanComfort::HumanComfort(const core::Cell& cell, std::vector<ComfortMap> maps,
       const core::KinematicChain chain(model, arm.spec.base_link, arm.spec.tip_link);
       body.world_to_base.push_back(base_in_world(cell, model, arm.spec.base_link).inverse());
       body.shoulder.push_back(chain.first_joint_position());
-      body.scale = characteristic_length(arm.chain) / characteristic_length(chain);
+      body.scale = core::characteristic_length(arm.chain) / core::characteristic_length(chain);
       // The lookup is exact only for a scaled copy of the cell's arm: check it.
       bool copy = chain.dof() == arm.chain.dof() &&
                   chain.lower_limits().isApprox(arm.chain.lower_limits(), 1e-12) &&

@@ -3,14 +3,19 @@
 #include <algorithm>
 #include <array>
 #include <cassert>
+#include <cmath>
+#include <iomanip>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
+#include <sstream>
 #include <string_view>
 #include <tuple>
 
 #include "hila/core/bridge.hpp"
+#include "hila/core/payload.hpp"
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
@@ -71,6 +76,10 @@ const char* to_string(BoardPlanStatus status) {
       return "no goal";
     case BoardPlanStatus::kTimeout:
       return "timeout";
+    case BoardPlanStatus::kHumanOutOfReach:
+      return "human out of reach";
+    case BoardPlanStatus::kOverPayload:
+      return "over payload";
   }
   return "unknown";
 }
@@ -198,6 +207,8 @@ class Run {
 
   const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps() const { return robot_grasps_; }
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
+  const core::Arm& suction_arm() const { return suction_; }
+  const core::Arm& receiving_arm() const { return receiving_; }
   // The run's times so far, the validator's own time on either thread included.
   int rejected_motions() const { return rejected_motions_; }
   int motions_planned() const { return motions_planned_; }
@@ -1364,14 +1375,104 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (records == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
-  // The first goals in Eq. 8 order.
-  const std::size_t goal_count =
-      std::min(records->goals.size(), static_cast<std::size_t>(std::max(0, settings_.goals)));
-  const auto goals = std::span(records->goals).first(goal_count);
-  bool any_connected_offline = false;
-  // Every goal in order under `settings`; true when one is planned (result filled in).
   Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
   running = &run;
+  // Payload: the suction arm carries the board on the tool, the receiving arm in its jaws.
+  for (const auto& check :
+       {core::check_payload(run.suction_arm().spec.name, run.suction_arm().spec.payload, part->mass,
+                            core::CarryMode::kSuction, model_.cell().spec().suction.mass),
+        core::check_payload(run.receiving_arm().spec.name, run.receiving_arm().spec.payload,
+                            part->mass, core::CarryMode::kGripper,
+                            model_.cell().spec().suction.mass)}) {
+    if (!check.within_allowed()) {
+      return finish(BoardPlanStatus::kOverPayload, "over the payload: " + check.describe());
+    }
+  }
+  // At the stance the goals were built for, their stored Q is the scene human's (the same
+  // lookup); elsewhere the comfort maps are looked up again.
+  const bool built_stance = scene.human_stance.isApprox(model_.cell().spec().human_stance, 1e-12);
+  const WorkerComfort* comfort = nullptr;
+  if (!built_stance) {
+    std::string error;
+    comfort = model_.worker_comfort(&error);
+    if (comfort == nullptr) {
+      return finish(BoardPlanStatus::kNoGoal,
+                    "the human stands elsewhere than the database's goals were built for, and "
+                    "its comfort maps could not be read: " +
+                        error);
+    }
+  }
+  // Whether the scene's human reaches a goal's grasp, by the human arms' inverse kinematics
+  // (the build's own postures where the human stands as built and the build confirmed the goal),
+  // each goal once; a goal they do not reach is never tried.
+  std::map<std::int64_t, WorkerComfort::GoalReach> reach_of;
+  std::set<std::int64_t> out_of_reach;
+  auto reach = [&](const db::HandoverCandidateRecord& goal) -> const WorkerComfort::GoalReach& {
+    const auto it = reach_of.find(goal.id);
+    if (it != reach_of.end()) return it->second;
+    WorkerComfort::GoalReach r;
+    if (built_stance && goal.human_joints.size() > 0 &&
+        (goal.second_arm.empty() || goal.second_joints.size() > 0)) {
+      r.reachable = true;
+      r.quality = goal.quality;
+      r.joints = goal.human_joints;
+      r.second_joints = goal.second_joints;
+    } else if (const WorkerComfort* c = built_stance ? model_.worker_comfort() : comfort) {
+      r = c->goal_reach(goal, records->human_grasps, scene.human_stance);
+    } else {  // as built, and the maps unreadable: the build's word
+      r.reachable = true;
+      r.quality = goal.quality;
+    }
+    if (!r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
+    return reach_of.emplace(goal.id, std::move(r)).first->second;
+  };
+  // The goals in Eq. 8 order that the scene's human can take: first those they take
+  // comfortably (by the comfort maps), then those they reach only uncomfortably, as far as the
+  // goal count needs them; the first BoardPlanSettings::goals.
+  const auto goal_limit = static_cast<std::size_t>(std::max(0, settings_.goals));
+  std::vector<const db::HandoverCandidateRecord*> goals, below_comfort;
+  std::map<std::int64_t, double> worker_quality;  // by goal id
+  double best_out_of_reach = 0.0;
+  for (const auto& goal : records->goals) {
+    const double q = built_stance
+                         ? goal.quality
+                         : comfort->goal_quality(goal, records->human_grasps, scene.human_stance);
+    worker_quality[goal.id] = q;
+    if (q >= std::min(settings_.worker_comfort_floor, goal.quality)) {
+      goals.push_back(&goal);
+    } else {
+      below_comfort.push_back(&goal);
+    }
+  }
+  for (const auto* goal : below_comfort) {
+    if (goals.size() >= goal_limit) break;
+    const auto& r = reach(*goal);
+    if (r.reachable) {
+      goals.push_back(goal);
+      worker_quality[goal->id] = r.quality;
+      ++result.goals_uncomfortable;
+    } else {
+      best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal->id]);
+    }
+  }
+  goals.resize(std::min(goals.size(), goal_limit));
+  // Where the scene's human can take none of the goals: says where they stand and how they face.
+  auto human_out_of_reach = [&]() {
+    const core::Pose& stance = scene.human_stance;
+    const double facing =
+        core::rad_to_deg(std::atan2(stance.linear()(1, 0), stance.linear()(0, 0)));
+    std::ostringstream reason;
+    reason << std::fixed << std::setprecision(2) << "the human at (" << stance.translation().x()
+           << ", " << stance.translation().y() << ", " << stance.translation().z() << ") m facing "
+           << std::setprecision(0) << facing << " deg cannot take '" << board << "' at any of its "
+           << records->goals.size() << " stored goals (best comfort Q " << std::setprecision(3)
+           << best_out_of_reach
+           << " by the maps; the arms reach none of the grasps tried): move the human or rebuild "
+              "the database for this stance";
+    return finish(BoardPlanStatus::kHumanOutOfReach, reason.str());
+  };
+  if (goals.empty() && !records->goals.empty()) return human_out_of_reach();
+  bool any_connected_offline = false;
   // One chain of a goal under the round's budgets; true when it is planned (result filled in).
   auto try_shared = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
                         const db::SharedGraspRecord& s) {
@@ -1393,7 +1494,12 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.robot_grasp_id = s.robot_grasp_id;
     result.suction_grasp_id = rr.suction_grasp_id;
     result.theta_c_deg = run.robot_grasps().at(s.robot_grasp_id).theta_c_deg;
-    result.quality = goal.quality;
+    result.quality = worker_quality.at(goal.id);
+    const auto& posture = reach_of.at(goal.id);
+    result.human_arm = goal.human_arm;
+    result.human_joints = posture.joints;
+    result.second_human_arm = goal.second_arm;
+    result.second_human_joints = posture.second_joints;
     result.robot_handover = rr.board;
     result.human_handover = goal.board;
     result.duration = result.steps.back().time.back();
@@ -1402,8 +1508,16 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.robot_q_after = end.robot_q;
     return true;
   };
+  // Every goal in order under the round's budgets; true when one is planned (result filled in).
   auto try_goals = [&](const std::string& round) {
-    for (const auto& goal : goals) {
+    for (const auto* goal_record : goals) {
+      const auto& goal = *goal_record;
+      // A goal the maps call comfortable may still be out of reach (a map bin holds the best of
+      // the samples near it): confirmed before it is planned.
+      if (!reach(goal).reachable) {
+        best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal.id]);
+        continue;
+      }
       // The shared grasps the offline regrasp graph connected for this goal first: their
       // stored paths and IK branches are what the motions re-validate.
       std::vector<db::SharedGraspRecord> shared = records->shared_grasps.at(goal.id);
@@ -1442,6 +1556,11 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
       result.larger_bridges = true;
       return finish(BoardPlanStatus::kSolved, "");
     }
+  }
+  if (!goals.empty() && std::all_of(goals.begin(), goals.end(), [&](const auto* goal) {
+        return out_of_reach.count(goal->id) > 0;
+      })) {
+    return human_out_of_reach();
   }
   if (std::chrono::steady_clock::now() >= deadline) {
     return finish(

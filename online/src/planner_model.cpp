@@ -13,7 +13,7 @@ std::shared_ptr<const PlannerModel> PlannerModel::load(const std::string& databa
   db::OpenOptions options;
   options.expected_cell_hash = db::cell_hash(cell->spec());
   options.expected_product_hash = db::product_hash(product);
-  options.comfort_maps = false;  // offline work: planning never reads them
+  options.comfort_maps = false;  // read when a scene's human first stands elsewhere
   db::Database database = db::Database::open(database_path, options);
   if (database.meta().product_name != product.name) {
     throw db::DatabaseError(database_path, "meta.product_name",
@@ -43,6 +43,7 @@ PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::Product
     for (const auto& goal : b.goals) b.shared_grasps[goal.id] = database_.shared_grasps(goal.id);
     for (auto& g : database_.robot_grasps(part.id)) b.robot_grasps[g.id] = std::move(g);
     for (auto& g : database_.suction_grasps(part.id)) b.suction_grasps[g.id] = std::move(g);
+    for (auto& g : database_.human_grasps(part.id)) b.human_grasps[g.id] = std::move(g);
     for (auto& h : database_.robot_handovers(part.id)) b.robot_handovers[h.id] = std::move(h);
     for (auto& f : database_.roadmap_filters(part.id)) {
       b.filters[{f.grasp_kind, f.grasp_id}] = std::move(f.edges);
@@ -51,6 +52,31 @@ PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::Product
     for (const auto& n : b.regrasp_nodes) b.node_by_id[n.id] = &n;
     b.regrasp_edges = database_.regrasp_edges(part.id);
   }
+}
+
+void PlannerModel::load_worker_comfort() const {
+  std::call_once(worker_comfort_once_, [this] {
+    try {
+      worker_comfort_ = std::make_unique<const WorkerComfort>(*cell_, database_.read_comfort_maps(),
+                                                              database_.path());
+    } catch (const std::exception& e) {
+      worker_comfort_error_ = e.what();
+    }
+  });
+  if (worker_comfort_ == nullptr) {
+    throw db::DatabaseError(database_.path(), "comfort_maps", "readable comfort maps",
+                            worker_comfort_error_);
+  }
+}
+
+const WorkerComfort* PlannerModel::worker_comfort(std::string* error) const noexcept {
+  try {
+    load_worker_comfort();
+  } catch (const std::exception& e) {
+    if (error != nullptr) *error = e.what();
+    return nullptr;
+  }
+  return worker_comfort_.get();
 }
 
 const BoardRecords* PlannerModel::board_records(const std::string& board) const {

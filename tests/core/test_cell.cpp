@@ -263,6 +263,12 @@ TEST(Cell, OtherBadValues) {
       {"kinematics: {type: ur,", "kinematics: {type: ux,", "robot.arms[0].kinematics.type", "'ux'"},
       {"- name: right", "- name: left", "robot.arms[1].name", "unique"},
       {"handle_link: tool_handle", "handle_link: tool_grip", "suction.handle_link", "'tool_grip'"},
+      {"allowed_kg: 3.5", "allowed_kg: 2.5", "robot.arms[0].payload.allowed_kg", "[3, 1000]"},
+      {"rated_kg: 3.0", "rated_kg: -3", "robot.arms[0].payload.rated_kg", "[0.001, 1000]"},
+      {"mass_kg: 0.925", "mass_kg: 4", "robot.arms[0].payload.tooling[2].mass_kg", "3.5"},
+      {"mass_kg: 0.25", "mass_kg: -1", "suction.mass_kg", "[0, 100]"},
+      {"rated_kg: 3.0", "rated_kg: 3.0\n        payload_kg: 3", "robot.arms[0].payload",
+       "payload_kg"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     SCOPED_TRACE(cases[i].field);

@@ -185,6 +185,29 @@ TEST_F(ReaderRoundTrip, ComfortMapByArm) {
        "got no such arm"});
 }
 
+// A database opened without its comfort maps reads them later, the same as an open with them;
+// a file replaced in between is refused rather than mixed with what was opened.
+TEST_F(ReaderRoundTrip, ComfortMapsReadLaterAreTheOnesOpened) {
+  OpenOptions without;
+  without.comfort_maps = false;
+  const Database lazy = Database::open(path_, without);
+  ASSERT_TRUE(lazy.comfort_maps().empty());
+  const auto later = lazy.read_comfort_maps();
+  const Database full = Database::open(path_);
+  ASSERT_EQ(later.size(), full.comfort_maps().size());
+  for (std::size_t i = 0; i < later.size(); ++i) {
+    EXPECT_EQ(later[i].arm, full.comfort_maps()[i].arm);
+    EXPECT_EQ(later[i].dims, full.comfort_maps()[i].dims);
+    EXPECT_EQ(later[i].values, full.comfort_maps()[i].values);
+  }
+  Sample rebuilt = make_sample();
+  rebuilt.meta.created_at = "2031-01-01T00:00:00Z";
+  std::filesystem::remove(path_);
+  write_sample(path_, rebuilt);
+  expect_input_error([&] { lazy.read_comfort_maps(); },
+                     {path_ + ": meta", "a file rebuilt or replaced since"});
+}
+
 TEST_F(ReaderRoundTrip, PerPartFilteringKeepsIdOrderAcrossInterleavedWrites) {
   // Records of two parts written alternately: ids interleave, each part's list stays ordered.
   const std::string path = temp_dir("db_reader_interleaved") + "/p.db";

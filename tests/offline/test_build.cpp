@@ -74,9 +74,9 @@ TEST(Build, CabinetDatabaseHoldsEveryBoardWithGraspsOfEachKind) {
   // One comfort map per human arm, equal to one built directly with the same settings and seed.
   ASSERT_EQ(database.comfort_maps().size(), 2u);
   const auto cell = test::reference_cell();
-  offline::ComfortMapSettings comfort = quick_settings().comfort;
+  core::ComfortMapSettings comfort = quick_settings().comfort;
   comfort.seed = offline::part_seed(7, "comfort:right", 3);
-  const auto direct = offline::ComfortMap::build(cell->human_arms()[1].chain, comfort);
+  const auto direct = core::ComfortMap::build(cell->human_arms()[1].chain, comfort);
   EXPECT_EQ(database.comfort_map("right").values, direct.values());
   EXPECT_EQ(database.comfort_map("right").dims, direct.dims());
   EXPECT_EQ(files_in(dir), (std::vector<std::string>{"cabinet.hila"}));  // no temporary left
@@ -135,6 +135,34 @@ TEST(Build, AHumanStanceInsideTheTableIsRejectedBeforeAnyWork) {
       },
       {"human.stance", "table"});
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+}
+
+// With the UR3's datasheet payload (3.0 kg, the reference cell's allowance of 3.5 kg taken out),
+// the 1.8 kg laterals on the suction tool are over it: the build gives them no goals and says
+// why; the lighter boards are unaffected.
+TEST(Build, APartOverThePayloadGetsNoGoalAndTheReason) {
+  const std::string dir = test::temp_dir("build_payload");
+  std::string cell = test::read_file(test::cell_path());
+  const std::string from = "        allowed_kg: 3.5\n";
+  ASSERT_NE(cell.find(from), std::string::npos);
+  cell.replace(cell.find(from), from.size(), "");
+  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
+    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
+  }
+  const std::string path = test::write_file(dir, "cell.yaml", cell);
+  const offline::BuildSummary summary =
+      offline::build_database(test::product_path(), path, dir + "/x.hila", quick_settings());
+  for (const auto& part : summary.parts) {
+    SCOPED_TRACE(part.name);
+    if (part.mass > 1.45) {
+      EXPECT_EQ(part.goals, 0);
+      EXPECT_EQ(part.handover_failure,
+                "over the payload: part 1.80 kg + tooling 1.30 kg + suction tool 0.25 kg = 3.35 kg "
+                "> 3.00 kg allowed at arm 'right'");
+    } else {
+      EXPECT_EQ(part.handover_failure.find("payload"), std::string::npos);
+    }
+  }
 }
 
 TEST(Build, SameSeedSameDigestForAnyNumberOfJobs) {

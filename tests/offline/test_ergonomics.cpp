@@ -16,11 +16,11 @@ namespace {
 const offline::HumanComfort& comfort() {
   static const offline::HumanComfort c = [] {
     const auto cell = test::reference_cell();
-    std::vector<offline::ComfortMap> maps;
-    offline::ComfortMapSettings s;
+    std::vector<core::ComfortMap> maps;
+    core::ComfortMapSettings s;
     s.samples = 300000;
     for (const auto& arm : cell->human_arms())
-      maps.push_back(offline::ComfortMap::build(arm.chain, s));
+      maps.push_back(core::ComfortMap::build(arm.chain, s));
     return offline::HumanComfort(*cell, maps);
   }();
   return c;

@@ -4,7 +4,7 @@
 
 #include "hila/core/generic_ik.hpp"
 #include "hila/core/robot_model.hpp"
-#include "hila/offline/comfort.hpp"
+#include "hila/core/comfort.hpp"
 #include "hila/offline/human_comfort.hpp"
 #include "util/test_util.hpp"
 
@@ -12,12 +12,12 @@ using namespace hila;
 
 namespace {
 
-std::vector<offline::ComfortMap> maps(long samples) {
-  std::vector<offline::ComfortMap> out;
-  offline::ComfortMapSettings s;
+std::vector<core::ComfortMap> maps(long samples) {
+  std::vector<core::ComfortMap> out;
+  core::ComfortMapSettings s;
   s.samples = samples;
   for (const auto& arm : test::reference_cell()->human_arms()) {
-    out.push_back(offline::ComfortMap::build(arm.chain, s));
+    out.push_back(core::ComfortMap::build(arm.chain, s));
   }
   return out;
 }
@@ -62,7 +62,7 @@ TEST(HumanComfort, OtherBodiesMatchDirectIkOfTheirOwnArms) {
     for (int i = 0; i < n; ++i) {
       const Eigen::VectorXd q = core::random_configuration(chain, rng);
       const core::Pose hand = base * chain.fk(q);
-      const auto direct = offline::best_comfort(chain, base.inverse() * hand, q);
+      const auto direct = core::best_comfort(chain, base.inverse() * hand, q);
       ASSERT_TRUE(direct.reachable);
       error += std::abs(comfort.body_quality(b, arm, hand) - direct.quality);
     }

@@ -11,6 +11,7 @@
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/online/board_planner.hpp"
+#include "util/quick_build.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -509,4 +510,34 @@ TEST_F(BoardPlanner, AGraspWhoseReceiveFailedAtABoardPoseComesBackLast) {
   expect_plan_well_formed(model(), boxed, plan);
   EXPECT_GT(expect_failed_receives_tried_last(model(), name, plan), 0)
       << "no grasp came back to a board pose where its reach had failed";
+}
+
+// Under the UR3's datasheet payload (the reference cell's allowance of 3.5 kg taken out), the
+// 1.8 kg laterals on the suction tool are over it: the planner says so, with the sums, before
+// anything is planned; a 0.8 kg board is planned as usual.
+TEST(BoardPlannerPayload, APartOverThePayloadIsRefusedWithTheSums) {
+  const std::string dir = test::temp_dir("board_planner_payload");
+  std::string cell = test::read_file(test::cell_path());
+  const std::string from = "        allowed_kg: 3.5\n";
+  ASSERT_NE(cell.find(from), std::string::npos);
+  cell.replace(cell.find(from), from.size(), "");
+  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
+    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
+  }
+  const std::string cell_path = test::write_file(dir, "cell.yaml", cell);
+  offline::build_database(test::product_path(), cell_path, dir + "/cabinet.hila",
+                          test::quick_build_settings(7, 2));
+  const auto model =
+      online::PlannerModel::load(dir + "/cabinet.hila", cell_path, test::product_path());
+  online::BoardPlanner planner(*model);
+  const online::Scene scene = online::nominal_scene(model->cell(), model->product());
+  const online::BoardPlan lateral = planner.plan(scene, "lateral_right", in_seconds(30));
+  EXPECT_EQ(lateral.status, online::BoardPlanStatus::kOverPayload);
+  EXPECT_EQ(lateral.reason,
+            "over the payload: part 1.80 kg + tooling 1.30 kg + suction tool 0.25 kg = 3.35 kg > "
+            "3.00 kg allowed at arm 'right'");
+  EXPECT_STREQ(online::to_string(lateral.status), "over payload");
+  EXPECT_EQ(lateral.motions_planned, 0);
+  const online::BoardPlan base = planner.plan(scene, "base", in_seconds(30));
+  EXPECT_NE(base.status, online::BoardPlanStatus::kOverPayload) << base.reason;
 }

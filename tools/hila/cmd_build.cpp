@@ -20,7 +20,7 @@ struct BuildOptions {
   std::string cell_file;
   std::uint64_t seed = 1;
   int jobs = 1;
-  long comfort_samples = offline::ComfortMapSettings{}.samples;
+  long comfort_samples = core::ComfortMapSettings{}.samples;
   int handover_candidates = offline::HandoverSettings{}.candidates;
   double comfort_threshold = offline::HandoverSettings{}.comfort_threshold;
   std::string bodies;

@@ -63,7 +63,9 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                         {"queued_validation", 1e3 * plan.times.queued_validation},
                         {"queued_smoothing", 1e3 * plan.times.queued_smoothing}}},
                       {"attempts", attempts},
-                      {"rejected_motions", plan.rejected_motions}};
+                      {"rejected_motions", plan.rejected_motions},
+                      {"goals_out_of_reach", plan.goals_out_of_reach},
+                      {"goals_uncomfortable", plan.goals_uncomfortable}};
   if (plan.solved()) {
     j["goal_rank"] = plan.goal_rank;
     j["candidate"] = plan.candidate_id;
@@ -71,6 +73,14 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
     j["suction_grasp"] = plan.suction_grasp_id;
     j["theta_c_deg"] = plan.theta_c_deg;
     j["quality"] = plan.quality;
+    nlohmann::json posture = nlohmann::json::object();
+    auto joints = [](const Eigen::VectorXd& q) {
+      return std::vector<double>(q.data(), q.data() + q.size());
+    };
+    if (!plan.human_arm.empty()) posture[plan.human_arm] = joints(plan.human_joints);
+    if (!plan.second_human_arm.empty())
+      posture[plan.second_human_arm] = joints(plan.second_human_joints);
+    j["human_posture_rad"] = posture;
     j["robot_handover"] = pose_to_json(plan.robot_handover);
     j["human_handover"] = pose_to_json(plan.human_handover);
     j["duration_s"] = plan.duration;

@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "hila/core/cell.hpp"
 #include "hila/core/collision.hpp"
+#include "hila/core/payload.hpp"
 #include "hila/core/product.hpp"
 
 namespace hila::tools {
@@ -59,6 +60,47 @@ int run_product_check(const ProductCheckOptions& opt) {
                                {"triangles", part.mesh.triangles.size()},
                                {"target_xyz", {target.x(), target.y(), target.z()}}});
   }
+  // Payload: every arm carrying every part in its jaws and on the suction tool. A part no arm
+  // lifts either way is a problem; one over an arm's rated payload (within what the cell
+  // allows) is reported.
+  bool all_liftable = true;
+  report["payload"] = nlohmann::json::array();
+  std::vector<std::string> payload_lines;
+  for (const auto& part : product.parts) {
+    bool liftable = false;
+    nlohmann::json carries = nlohmann::json::array();
+    std::string over_rated, best_refusal;
+    for (const auto& arm : cell->arms()) {
+      for (const auto mode : {core::CarryMode::kGripper, core::CarryMode::kSuction}) {
+        const core::PayloadCheck c = core::check_payload(arm.spec.name, arm.spec.payload, part.mass,
+                                                         mode, cell->spec().suction.mass);
+        liftable = liftable || c.within_allowed();
+        carries.push_back({{"arm", arm.spec.name},
+                           {"mode", core::to_string(mode)},
+                           {"stated", c.stated},
+                           {"total_kg", c.total()},
+                           {"allowed_kg", c.allowed},
+                           {"rated_kg", c.rated},
+                           {"within_allowed", c.within_allowed()},
+                           {"within_rated", c.within_rated()}});
+        if (c.within_allowed() && !c.within_rated() && over_rated.empty()) {
+          over_rated =
+              std::string(core::to_string(mode)) + " at '" + arm.spec.name + "': " + c.describe();
+        }
+        if (!c.within_allowed() && best_refusal.empty()) best_refusal = c.describe();
+      }
+    }
+    all_liftable = all_liftable && liftable;
+    report["payload"].push_back(
+        {{"part", part.name}, {"liftable", liftable}, {"carries", carries}});
+    if (!liftable) {
+      payload_lines.push_back(part.name + ": OVER THE PAYLOAD of every arm (" + best_refusal + ")");
+    } else if (!over_rated.empty()) {
+      payload_lines.push_back(
+          part.name + ": over the rated payload, within what the cell allows (" + over_rated + ")");
+    }
+  }
+  report["all_parts_liftable"] = all_liftable;
   report["targets_collision_free"] = target_pairs.empty();
   report["target_collisions"] = target_pairs;
   report["initial_collision_free"] = initial_pairs.empty();
@@ -84,8 +126,14 @@ int run_product_check(const ProductCheckOptions& opt) {
     std::cout << "  initial poses: "
               << (initial_pairs.empty() ? "no parts interpenetrate" : "INTERPENETRATING") << "\n";
     for (const auto& p : initial_pairs) std::cout << "    " << p << "\n";
+    std::cout << "  payload: "
+              << (!all_liftable           ? "a part no arm can lift"
+                  : payload_lines.empty() ? "every part within every arm's rated payload"
+                                          : "every part liftable")
+              << "\n";
+    for (const auto& l : payload_lines) std::cout << "    " << l << "\n";
   }
-  return target_pairs.empty() && initial_pairs.empty() ? 0 : 1;
+  return target_pairs.empty() && initial_pairs.empty() && all_liftable ? 0 : 1;
 }
 }  // namespace
 

@@ -9,6 +9,7 @@
 
 #include "hila/core/collision.hpp"
 #include "hila/core/kinematic_chain.hpp"
+#include "hila/core/payload.hpp"
 #include "hila/core/pose.hpp"
 #include "hila/core/robot_model.hpp"
 #include "hila/core/ur_ik.hpp"
@@ -51,6 +52,8 @@ struct SuctionSpec {
   double max_moment = 0.8;  // N·m
   // The handle frame in the gripper's TCP frame while the gripper holds the tool.
   Pose handle_in_tcp = Pose::Identity();
+  double mass = 0.0;                              // kg, carried on top of the arm's tooling
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();  // m, handle frame
 };
 
 struct ArmSpec {
@@ -63,6 +66,7 @@ struct ArmSpec {
   Eigen::VectorXd home;              // rad
   Eigen::VectorXd max_velocity;      // rad/s
   Eigen::VectorXd max_acceleration;  // rad/s^2
+  PayloadSpec payload;               // what the arm may carry at its flange
 };
 
 // The human hand as a 1-DoF gripper (paper §IV): fingertip pads of skin (mu = 0.8) closing along

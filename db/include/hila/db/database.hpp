@@ -155,6 +155,10 @@ class Database {
   // (OpenOptions::comfort_maps).
   const std::vector<ComfortMapRecord>& comfort_maps() const { return comfort_maps_; }
   const ComfortMapRecord& comfort_map(const std::string& arm) const;  // throws core::InputError
+  // The comfort maps read from the file now, for a database opened without them. Throws
+  // DatabaseError when the file is no longer the one opened (its meta table differs: rebuilt or
+  // replaced) or its comfort_maps table is damaged.
+  std::vector<ComfortMapRecord> read_comfort_maps() const;
 
   // Handover goals and ergonomics. The part's stage, or nullptr when the database has none for it
   // (the pointer stays valid as long as this Database). All stages in id order.

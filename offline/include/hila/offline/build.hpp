@@ -9,7 +9,7 @@
 #include "hila/core/human_model.hpp"
 #include "hila/core/product.hpp"
 #include "hila/db/provenance.hpp"
-#include "hila/offline/comfort_map.hpp"
+#include "hila/core/comfort_map.hpp"
 #include "hila/offline/ergonomics.hpp"
 #include "hila/offline/handover.hpp"
 #include "hila/offline/human_grasps.hpp"
@@ -25,7 +25,7 @@ struct BuildSettings {
   RobotGraspSettings robot;
   SuctionSettings suction;
   HumanGraspSettings human;
-  ComfortMapSettings comfort;  // one map per human arm of the cell
+  core::ComfortMapSettings comfort;  // one map per human arm of the cell
   HandoverSettings handover;
   ErgonomicsSettings ergonomics;
   RoadmapSettings roadmap;  // one per arm; suction_arm follows handover.suction_arm

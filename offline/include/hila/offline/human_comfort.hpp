@@ -7,7 +7,7 @@
 #include "hila/core/cell.hpp"
 #include "hila/core/human_model.hpp"
 #include "hila/core/pose.hpp"
-#include "hila/offline/comfort_map.hpp"
+#include "hila/core/comfort_map.hpp"
 
 namespace hila::offline {
 
@@ -23,13 +23,13 @@ namespace hila::offline {
 class HumanComfort {
  public:
   // `maps[i]` belongs to cell.human_arms()[i].
-  HumanComfort(const core::Cell& cell, std::vector<ComfortMap> maps,
+  HumanComfort(const core::Cell& cell, std::vector<core::ComfortMap> maps,
                const std::vector<core::HumanBodySpec>& bodies = {});
 
   int arm_count() const { return static_cast<int>(maps_.size()); }
   const std::string& arm_name(int arm) const { return arm_names_[static_cast<std::size_t>(arm)]; }
   int body_count() const { return static_cast<int>(bodies_.size()); }  // 0: the cell's human
-  const ComfortMap& map(int arm) const { return maps_[static_cast<std::size_t>(arm)]; }
+  const core::ComfortMap& map(int arm) const { return maps_[static_cast<std::size_t>(arm)]; }
 
   // The cell's human arm base (torso, upright) in the world.
   const core::Pose& arm_base(int arm) const { return arm_base_[static_cast<std::size_t>(arm)]; }
@@ -47,7 +47,7 @@ class HumanComfort {
     std::vector<Eigen::Vector3d> shoulder;  // per arm, base frame
     double scale = 1.0;                     // cell reach / this body's reach
   };
-  std::vector<ComfortMap> maps_;
+  std::vector<core::ComfortMap> maps_;
   std::vector<std::string> arm_names_;
   std::vector<core::Pose> arm_base_;
   std::vector<core::Pose> world_to_base_;

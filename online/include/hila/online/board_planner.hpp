@@ -47,6 +47,13 @@ struct BoardPlanSettings {
   // check): the same plans, without planning exchanges for grasps the goal cannot use. false
   // plans the exchange first.
   bool reach_human_pose_first = true;
+  // The human who is there. The stored goals are evaluated again for the scene's human (comfort
+  // Q of paper Eq. 4, by the database's comfort maps). Those with Q of at least this (or of at
+  // least their stored Q where that is lower, so that at the built stance every stored goal
+  // qualifies and the order is the database's) are tried first, in Eq. 8 order; then those the
+  // human's arm reaches by inverse kinematics, uncomfortably; the rest are never tried. The
+  // build's comfort threshold (paper §VI-B).
+  double worker_comfort_floor = 0.06;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
@@ -72,7 +79,11 @@ struct GoalAttempt {
   std::string outcome;  // "planned" or the reason
 };
 
-enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout };
+// kHumanOutOfReach: the scene's human can take the board at none of its stored goals (where they
+// stand, or how they face, puts every goal out of comfortable reach).
+// kOverPayload: an arm would carry more than its payload (the part, its tooling and, on the
+// suction cup, the tool: core::check_payload).
+enum class BoardPlanStatus { kSolved, kNoGoal, kTimeout, kHumanOutOfReach, kOverPayload };
 const char* to_string(BoardPlanStatus status);
 
 // Where a board's planning time went (s, wall clock, summed over every goal attempt; the rest is
@@ -101,7 +112,16 @@ struct BoardPlan {
   std::int64_t robot_grasp_id = 0;
   std::int64_t suction_grasp_id = 0;
   double theta_c_deg = 90.0;
-  double quality = 0.0;                                // the human's comfort at the goal
+  double quality = 0.0;  // the comfort Q of the scene's human at the goal (paper Eq. 4)
+  // Stored goals the scene's human reaches only uncomfortably (tried after the comfortable ones)
+  // or not at all (never tried), among those checked (BoardPlanSettings::worker_comfort_floor).
+  int goals_out_of_reach = 0;
+  int goals_uncomfortable = 0;
+  // The human's receiving posture at the goal: each hand's arm and its joints (rad), from the
+  // human arm's inverse kinematics for the scene's stance (the build's own where it stands as
+  // built). Empty second arm for a one-hand goal.
+  std::string human_arm, second_human_arm;
+  Eigen::VectorXd human_joints, second_human_joints;
   core::Pose robot_handover = core::Pose::Identity();  // board poses (world)
   core::Pose human_handover = core::Pose::Identity();
   std::vector<PlanStep> steps;

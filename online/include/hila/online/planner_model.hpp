@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "hila/core/product.hpp"
 #include "hila/db/database.hpp"
 #include "hila/online/arm_motion.hpp"
+#include "hila/online/worker_comfort.hpp"
 
 namespace hila::online {
 
@@ -22,6 +24,7 @@ struct BoardRecords {
   std::map<std::int64_t, std::vector<db::SharedGraspRecord>> shared_grasps;  // by goal, id order
   std::map<std::int64_t, db::RobotGraspRecord> robot_grasps;
   std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps;
+  std::map<std::int64_t, db::HumanGraspRecord> human_grasps;
   std::map<std::int64_t, db::RobotHandoverRecord> robot_handovers;
   std::map<std::pair<std::string, std::int64_t>, std::vector<bool>> filters;  // by grasp kind, id
   std::vector<db::RegraspNodeRecord> regrasp_nodes;
@@ -47,6 +50,13 @@ class PlannerModel {
   const db::Database& database() const { return database_; }
   // Throws core::InputError naming the database for an arm without a roadmap.
   const ArmRoadmap& roadmap(const std::string& arm) const;
+  // The comfort of the human the scene has at the stored goals, from the database's comfort maps
+  // (about 13 MB per human arm: read from the file on first use, once, by whichever thread asks
+  // first; load_worker_comfort() pays that at start-up). nullptr when the maps cannot be read,
+  // with the reason in `error`. Never throws.
+  const WorkerComfort* worker_comfort(std::string* error = nullptr) const noexcept;
+  // Reads the comfort maps now. Throws db::DatabaseError when they cannot be read.
+  void load_worker_comfort() const;
   // The board's records; nullptr when the database has no such board.
   const BoardRecords* board_records(const std::string& board) const;
 
@@ -57,6 +67,9 @@ class PlannerModel {
   std::shared_ptr<const core::Cell> cell_;
   core::ProductSpec product_;
   db::Database database_;
+  mutable std::once_flag worker_comfort_once_;
+  mutable std::unique_ptr<const WorkerComfort> worker_comfort_;
+  mutable std::string worker_comfort_error_;
   std::map<std::string, std::unique_ptr<ArmRoadmap>> roadmaps_;
   std::map<std::string, std::unique_ptr<BoardRecords>> boards_;  // in place: node_by_id points in
 };

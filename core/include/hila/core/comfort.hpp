@@ -6,7 +6,7 @@
 #include "hila/core/kinematic_chain.hpp"
 #include "hila/core/pose.hpp"
 
-namespace hila::offline {
+namespace hila::core {
 
 // Human comfort of paper Eq. 4: Q = sigma_min / sigma_max of the arm's 6 x n Jacobian. The
 // translational rows are divided by a characteristic length L (the arm's reach) so that Q is
@@ -19,6 +19,10 @@ double characteristic_length(const core::KinematicChain& arm);
 
 struct ComfortSettings {
   int ik_attempts = 24;  // seeded restarts over the arm's self-motion (7 joints, 6 constraints)
+  // Restarts made after the first solution is found; negative: all ik_attempts (the most
+  // comfortable posture). A reach check with a good seed needs few.
+  int attempts_after_found = -1;
+  double tolerance = 1e-10;  // m and rad: the hand pose error a solution may leave
   std::uint64_t seed = 1;
 };
 
@@ -35,4 +39,4 @@ ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& ha
                            const Eigen::VectorXd& seed_joints,
                            const ComfortSettings& settings = {});
 
-}  // namespace hila::offline
+}  // namespace hila::core

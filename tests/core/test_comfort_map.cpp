@@ -4,8 +4,8 @@
 #include <random>
 
 #include "hila/core/generic_ik.hpp"
-#include "hila/offline/comfort.hpp"
-#include "hila/offline/comfort_map.hpp"
+#include "hila/core/comfort.hpp"
+#include "hila/core/comfort_map.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -15,8 +15,8 @@ const core::KinematicChain& right_arm() {
   return test::reference_cell()->human_arms()[1].chain;
 }
 
-offline::ComfortMapSettings small_settings() {
-  offline::ComfortMapSettings s;
+core::ComfortMapSettings small_settings() {
+  core::ComfortMapSettings s;
   s.spacing = 0.06;
   s.orientations = 100;
   s.samples = 100000;
@@ -24,14 +24,14 @@ offline::ComfortMapSettings small_settings() {
   return s;
 }
 
-const offline::ComfortMap& small_map() {
-  static const offline::ComfortMap map = offline::ComfortMap::build(right_arm(), small_settings());
+const core::ComfortMap& small_map() {
+  static const core::ComfortMap map = core::ComfortMap::build(right_arm(), small_settings());
   return map;
 }
 }  // namespace
 
 TEST(ComfortMap, OrientationsAreUnitAndSpreadEvenly) {
-  const auto set = offline::spread_orientations(128);
+  const auto set = core::spread_orientations(128);
   ASSERT_EQ(set.size(), 128u);
   double min_gap = core::kPi;
   for (std::size_t i = 0; i < set.size(); ++i) {
@@ -46,7 +46,7 @@ TEST(ComfortMap, OrientationsAreUnitAndSpreadEvenly) {
   double worst = 0.0;
   for (int i = 0; i < 20000; ++i) {
     const Eigen::Quaterniond q(test::random_pose(rng).linear());
-    worst = std::max(worst, q.angularDistance(set[offline::nearest_orientation(set, q)]));
+    worst = std::max(worst, q.angularDistance(set[core::nearest_orientation(set, q)]));
   }
   EXPECT_LT(core::rad_to_deg(worst), 50.0);
   EXPECT_GT(core::rad_to_deg(min_gap), 10.0);
@@ -57,7 +57,7 @@ TEST(ComfortMap, FastIndexEqualsTheSvdIndex) {
   for (int i = 0; i < 200; ++i) {
     const Eigen::VectorXd q = core::random_configuration(right_arm(), rng);
     const core::Jacobian j = right_arm().jacobian(q);
-    EXPECT_NEAR(offline::comfort_index_fast(j, 0.6), offline::comfort_index(j, 0.6), 1e-7);
+    EXPECT_NEAR(core::comfort_index_fast(j, 0.6), core::comfort_index(j, 0.6), 1e-7);
   }
 }
 
@@ -66,14 +66,14 @@ TEST(ComfortMap, EveryBinHoldsTheBestQOfTheSamplesThatLandedInIt) {
   const auto& map = small_map();
   const auto settings = small_settings();
   const auto& arm = right_arm();
-  const double reach = offline::characteristic_length(arm);
+  const double reach = core::characteristic_length(arm);
   std::vector<std::uint8_t> expected(map.values().size(), 0);
   std::mt19937_64 rng(settings.seed);
   const std::size_t n_orient = map.orientations().size();
   for (long s = 0; s < settings.samples; ++s) {
     const Eigen::VectorXd q = core::random_configuration(arm, rng);
     const core::Pose tip = arm.fk(q);
-    const double quality = offline::comfort_index(arm.jacobian(q), reach);
+    const double quality = core::comfort_index(arm.jacobian(q), reach);
     const Eigen::Vector3i node = map.nearest_node(tip.translation());
     // Brute-force nearest orientation by angle.
     std::size_t best = 0;
@@ -131,7 +131,7 @@ TEST(ComfortMap, AgreesWithDirectEvaluationAtReachablePoses) {
   for (int i = 0; i < 60; ++i) {
     const Eigen::VectorXd q = core::random_configuration(arm, rng);
     const core::Pose pose = arm.fk(q);
-    const auto direct = offline::best_comfort(arm, pose, q);
+    const auto direct = core::best_comfort(arm, pose, q);
     ASSERT_TRUE(direct.reachable);
     errors.push_back(std::abs(map.lookup(pose) - direct.quality));
   }
@@ -140,7 +140,7 @@ TEST(ComfortMap, AgreesWithDirectEvaluationAtReachablePoses) {
 }
 
 TEST(ComfortMap, SameSeedSameMap) {
-  const auto again = offline::ComfortMap::build(right_arm(), small_settings());
+  const auto again = core::ComfortMap::build(right_arm(), small_settings());
   EXPECT_EQ(again.values(), small_map().values());
   EXPECT_GT(small_map().coverage(), 0.0);
   EXPECT_LT(small_map().coverage(), 1.0);
@@ -152,8 +152,8 @@ TEST(ComfortMap, SameSeedSameMap) {
 // in that bin).
 TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
   const auto& arm = right_arm();
-  const offline::ComfortMapSettings settings;  // the database's defaults
-  const offline::ComfortMap map = offline::ComfortMap::build(arm, settings);
+  const core::ComfortMapSettings settings;  // the database's defaults
+  const core::ComfortMap map = core::ComfortMap::build(arm, settings);
   std::mt19937_64 rng(21);
 
   double error_sum = 0.0;
@@ -161,7 +161,7 @@ TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
   for (int i = 0; i < queries; ++i) {
     const Eigen::VectorXd q = core::random_configuration(arm, rng);
     const core::Pose pose = arm.fk(q);
-    const auto direct = offline::best_comfort(arm, pose, q);
+    const auto direct = core::best_comfort(arm, pose, q);
     ASSERT_TRUE(direct.reachable);
     error_sum += std::abs(map.lookup(pose) - direct.quality);
   }
@@ -203,7 +203,7 @@ TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
         aim.linear() =
             centre.linear() *
             Eigen::AngleAxisd(0.4 * std::abs(normal(rng)), axis.normalized()).toRotationMatrix();
-        if (offline::nearest_orientation(map.orientations(), Eigen::Quaterniond(aim.linear())) !=
+        if (core::nearest_orientation(map.orientations(), Eigen::Quaterniond(aim.linear())) !=
             o) {
           continue;
         }
@@ -211,7 +211,7 @@ TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
       const auto r = core::solve_ik(arm, aim, core::random_configuration(arm, rng), rng, ik);
       const core::Pose reached = arm.fk(r.q);
       found = map.nearest_node(reached.translation()) == node &&
-              offline::nearest_orientation(map.orientations(),
+              core::nearest_orientation(map.orientations(),
                                            Eigen::Quaterniond(reached.linear())) == o;
     }
     confirmed += found ? 1 : 0;
@@ -225,15 +225,15 @@ TEST(ComfortMap, DefaultResolutionMatchesDirectIkAndMarksOnlyReachableBins) {
 
 TEST(ComfortMap, OrientationIndexEqualsTheLinearScan) {
   for (const int count : {100, 128, 300}) {
-    const auto set = offline::spread_orientations(count);
-    const offline::OrientationIndex index(set);
+    const auto set = core::spread_orientations(count);
+    const core::OrientationIndex index(set);
     EXPECT_LT(index.mean_candidates(), 0.2 * count);  // the point of the index
     std::mt19937_64 rng(static_cast<std::uint64_t>(count));
     std::normal_distribution<double> n(0.0, 1.0);
     for (int i = 0; i < 50000; ++i) {
       Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
       q.normalize();
-      ASSERT_EQ(index.nearest(q), offline::nearest_orientation(set, q)) << i;
+      ASSERT_EQ(index.nearest(q), core::nearest_orientation(set, q)) << i;
     }
     // Exactly on the members, and at their negatives (the same rotations).
     for (int i = 0; i < count; ++i) {

@@ -1,11 +1,11 @@
-#include "hila/offline/comfort.hpp"
+#include "hila/core/comfort.hpp"
 
 #include <Eigen/SVD>
 #include <random>
 
 #include "hila/core/generic_ik.hpp"
 
-namespace hila::offline {
+namespace hila::core {
 
 double comfort_index(const core::Jacobian& jacobian, double characteristic_length) {
   core::Jacobian scaled = jacobian;
@@ -30,11 +30,19 @@ ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& ha
   std::mt19937_64 rng(settings.seed);
   core::GenericIkSettings ik;
   ik.max_attempts = 1;  // restarts are ours, so that every solution is scored
+  ik.position_tolerance = settings.tolerance;
+  ik.orientation_tolerance = settings.tolerance;
+  int found_at = -1;
   for (int attempt = 0; attempt < settings.ik_attempts; ++attempt) {
+    if (found_at >= 0 && settings.attempts_after_found >= 0 &&
+        attempt - found_at > settings.attempts_after_found) {
+      break;
+    }
     const Eigen::VectorXd start = attempt == 0 ? seed_joints : core::random_configuration(arm, rng);
     const core::GenericIkResult r = core::solve_ik(arm, hand_in_base, start, rng, ik);
     if (!r.success) continue;
     const double q = comfort_index(arm.jacobian(r.q), length);
+    if (found_at < 0) found_at = attempt;
     if (!best.reachable || q > best.quality) {
       best.reachable = true;
       best.quality = q;
@@ -44,4 +52,4 @@ ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& ha
   return best;
 }
 
-}  // namespace hila::offline
+}  // namespace hila::core

@@ -7,9 +7,8 @@
 
 #include "hila/core/kinematic_chain.hpp"
 #include "hila/core/pose.hpp"
-#include "hila/db/records.hpp"
 
-namespace hila::offline {
+namespace hila::core {
 
 // `count` rotations spread evenly over SO(3) (super-Fibonacci spirals, Alexa 2022): deterministic,
 // no clustering at the poles as with Euler-angle grids.
@@ -27,7 +26,8 @@ struct ComfortMapSettings {
 };
 
 // Best comfort Q (paper Eq. 4) per hand position x orientation, for one human arm, in the arm's
-// base frame. Built by forward sampling: random joint configurations inside the limits, their
+// base frame: built offline, stored in the database, looked up by the build's handover search and
+// by the online planner for the human standing where the scene says. Built by forward sampling: random joint configurations inside the limits, their
 // hand pose binned to the nearest grid node and nearest orientation, each bin keeping the best Q
 // seen. Q is stored in 1/255 steps (one byte per bin). Lookups interpolate trilinearly between
 // the eight nodes around the position at the nearest orientation; bins never reached hold 0.
@@ -53,10 +53,13 @@ class OrientationIndex {
 class ComfortMap {
  public:
   static ComfortMap build(const core::KinematicChain& arm, const ComfortMapSettings& settings);
-  // To and from the database record (the arm's name and the build's sample count and seed are
-  // the record's).
-  static ComfortMap from_record(const db::ComfortMapRecord& record);
-  db::ComfortMapRecord to_record(const std::string& arm, const ComfortMapSettings& settings) const;
+  // A map from its grid and its bins in node-major order, the database's
+  // (((x * dims.y + y) * dims.z + z) * orientations + o), as values() returns them.
+  static ComfortMap from_grid(const Eigen::Vector3d& origin, double spacing,
+                              const Eigen::Vector3i& dims,
+                              std::vector<Eigen::Quaterniond> orientations,
+                              const std::vector<std::uint8_t>& node_major_values,
+                              double coverage);
 
   double lookup(const core::Pose& hand_in_base) const;
   // Index of the map's orientation nearest to `rotation`.
@@ -97,4 +100,4 @@ class ComfortMap {
 // comfort_index(J, length).
 double comfort_index_fast(const core::Jacobian& jacobian, double characteristic_length);
 
-}  // namespace hila::offline
+}  // namespace hila::core

@@ -1,14 +1,15 @@
-#include "hila/offline/comfort_map.hpp"
+#include "hila/core/comfort_map.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
+#include "hila/core/comfort.hpp"
 #include "hila/core/generic_ik.hpp"
-#include "hila/offline/comfort.hpp"
 
-namespace hila::offline {
+namespace hila::core {
 
 std::vector<Eigen::Quaterniond> spread_orientations(int count) {
   constexpr double kPhi = 1.4142135623730951;    // sqrt(2)
@@ -224,33 +225,29 @@ double ComfortMap::lookup(const core::Pose& hand) const {
   return ((1.0 - t.x()) * y0 + t.x() * y1) * (1.0 / 255.0);
 }
 
-ComfortMap ComfortMap::from_record(const db::ComfortMapRecord& record) {
+ComfortMap ComfortMap::from_grid(const Eigen::Vector3d& origin, double spacing,
+                                 const Eigen::Vector3i& dims,
+                                 std::vector<Eigen::Quaterniond> orientations,
+                                 const std::vector<std::uint8_t>& node_major_values,
+                                 double coverage) {
+  if (dims.minCoeff() < 2 || !(spacing > 0.0) || orientations.empty() ||
+      node_major_values.size() !=
+          static_cast<std::size_t>(dims.prod()) * orientations.size()) {
+    throw std::invalid_argument(
+        "ComfortMap::from_grid: expected at least 2 nodes per axis, a positive spacing and "
+        "dims.prod() * orientations bins");
+  }
   ComfortMap map;
-  map.origin_ = record.origin;
-  map.spacing_ = record.spacing;
-  map.dims_ = record.dims;
-  map.orientations_ = record.orientations;
+  map.origin_ = origin;
+  map.spacing_ = spacing;
+  map.dims_ = dims;
+  map.orientations_ = std::move(orientations);
   map.orientation_index_ = OrientationIndex(map.orientations_);
-  map.values_.assign(record.values.size(), 0);
+  map.values_.assign(node_major_values.size(), 0);
   for_each_bin(map.dims_, map.orientations_.size(),
-               [&](std::size_t db, std::size_t mem) { map.values_[mem] = record.values[db]; });
-  map.coverage_ = record.coverage;
+               [&](std::size_t db, std::size_t mem) { map.values_[mem] = node_major_values[db]; });
+  map.coverage_ = coverage;
   return map;
-}
-
-db::ComfortMapRecord ComfortMap::to_record(const std::string& arm,
-                                           const ComfortMapSettings& settings) const {
-  db::ComfortMapRecord record;
-  record.arm = arm;
-  record.origin = origin_;
-  record.spacing = spacing_;
-  record.dims = dims_;
-  record.orientations = orientations_;
-  record.values = values();
-  record.samples = settings.samples;
-  record.seed = settings.seed;
-  record.coverage = coverage_;
-  return record;
 }
 
 ComfortMap ComfortMap::build(const core::KinematicChain& arm, const ComfortMapSettings& settings) {
@@ -296,4 +293,4 @@ ComfortMap ComfortMap::build(const core::KinematicChain& arm, const ComfortMapSe
   return map;
 }
 
-}  // namespace hila::offline
+}  // namespace hila::core

@@ -1,0 +1,218 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <random>
+
+#include "hila/core/comfort_map.hpp"
+#include "hila/offline/build.hpp"
+#include "hila/offline/human_comfort.hpp"
+#include "hila/online/board_planner.hpp"
+#include "hila/online/planner_model.hpp"
+#include "hila/online/scene.hpp"
+#include "hila/online/worker_comfort.hpp"
+#include "util/quick_build.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+// A small but complete cabinet database (no body set: the stored Q is the cell human's), built
+// and loaded once for the file.
+class WorkerComfortTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const std::string dir = test::temp_dir("worker_comfort");
+    const std::string out = dir + "/cabinet.hila";
+    // Quick, with maps dense enough that every board has goals.
+    offline::BuildSettings settings = test::quick_build_settings(7, 2);
+    settings.comfort.samples = 400000;
+    settings.handover.candidates = 200;
+    settings.handover.max_candidates = 400;
+    offline::build_database(test::product_path(), test::cell_path(), out, settings);
+    model_ = online::PlannerModel::load(out, test::cell_path(), test::product_path());
+  }
+  static void TearDownTestSuite() { model_.reset(); }
+
+  static std::shared_ptr<const online::PlannerModel> model_;
+};
+std::shared_ptr<const online::PlannerModel> WorkerComfortTest::model_;
+
+core::Pose moved(const core::Pose& stance, const Eigen::Vector3d& by, double yaw) {
+  core::Pose p = stance;
+  p.translation() += by;
+  p.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * p.linear();
+  return p;
+}
+
+}  // namespace
+
+// At the stance the goals were built for, every stored goal's comfort is found again exactly:
+// the online lookup is the build's.
+TEST_F(WorkerComfortTest, AtTheCellsStanceEveryGoalHasItsStoredQuality) {
+  const auto& cell = model_->cell();
+  int goals = 0;
+  for (const auto& part : model_->product().parts) {
+    const online::BoardRecords* b = model_->board_records(part.name);
+    ASSERT_NE(b, nullptr);
+    for (const auto& goal : b->goals) {
+      const double q =
+          model_->worker_comfort()->goal_quality(goal, b->human_grasps, cell.spec().human_stance);
+      EXPECT_NEAR(q, goal.quality, 1e-12) << part.name << " goal " << goal.id;
+      ++goals;
+    }
+  }
+  EXPECT_GT(goals, 7);
+}
+
+// A human standing elsewhere sees the world moved the other way: Q of a hand pose H for the
+// human at stance S equals the build's Q (offline::HumanComfort, the cell's stance S0) of the
+// hand pose S0 S^-1 H. Checked over random stances and hand poses near the human.
+TEST_F(WorkerComfortTest, AMovedHumanIsTheBuildsHumanInAMovedWorld) {
+  const auto& cell = model_->cell();
+  std::vector<core::ComfortMap> maps;
+  const auto records = model_->database().read_comfort_maps();
+  for (const auto& arm : cell.human_arms()) {
+    const auto& r = *std::find_if(records.begin(), records.end(),
+                                  [&](const auto& m) { return m.arm == arm.spec.name; });
+    maps.push_back(core::ComfortMap::from_grid(r.origin, r.spacing, r.dims, r.orientations,
+                                               r.values, r.coverage));
+  }
+  const offline::HumanComfort build_comfort(cell, maps);
+  const core::Pose s0 = cell.spec().human_stance;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int reachable = 0;
+  for (int i = 0; i < 400; ++i) {
+    const core::Pose stance = moved(s0, Eigen::Vector3d(0.3 * u(rng), 0.3 * u(rng), 0.0), u(rng));
+    // A hand pose in front of the moved human at chest height.
+    core::Pose hand = test::random_pose(rng, 0.25);
+    hand.translation() += stance * Eigen::Vector3d(0.35, 0.0, 1.2);
+    const int a = i % 2;
+    const std::string& arm = cell.human_arms()[static_cast<std::size_t>(a)].spec.name;
+    const double online_q =
+        model_->worker_comfort()->hand_quality(arm, hand, core::Pose::Identity(), stance);
+    const double build_q = build_comfort.quality(a, s0 * stance.inverse() * hand);
+    EXPECT_NEAR(online_q, build_q, 1e-9) << "sample " << i;
+    reachable += build_q > 0.0 ? 1 : 0;
+  }
+  EXPECT_GT(reachable, 50);  // the comparison is not all zeros
+}
+
+// Where the human cannot take the board at any stored goal, the planner says so before any
+// motion is planned, and names where the human stands.
+TEST_F(WorkerComfortTest, AHumanOutOfReachGetsItsOwnStatus) {
+  online::Scene scene = online::nominal_scene(model_->cell(), model_->product());
+  const core::Pose s0 = scene.human_stance;
+  online::BoardPlanner planner(*model_);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (const Eigen::Vector3d& by :
+       {Eigen::Vector3d(5.0, 0.0, 0.0), Eigen::Vector3d(0.0, 0.0, 2.0)}) {
+    scene.human_stance = moved(s0, by, 0.0);
+    const online::BoardPlan plan = planner.plan(scene, "base", deadline);
+    EXPECT_EQ(plan.status, online::BoardPlanStatus::kHumanOutOfReach) << plan.reason;
+    EXPECT_NE(plan.reason.find("cannot take 'base' at any of its"), std::string::npos)
+        << plan.reason;
+    EXPECT_EQ(plan.motions_planned, 0);
+    EXPECT_EQ(plan.goals_out_of_reach,
+              static_cast<int>(model_->board_records("base")->goals.size()));
+    EXPECT_STREQ(online::to_string(plan.status), "human out of reach");
+  }
+  // The same scene with the human where the goals were built for: the goals are used.
+  scene.human_stance = s0;
+  const online::BoardPlan plan = planner.plan(scene, "base", deadline);
+  EXPECT_NE(plan.status, online::BoardPlanStatus::kHumanOutOfReach) << plan.reason;
+  EXPECT_EQ(plan.goals_out_of_reach, 0);
+}
+
+// A human turned away or stepped aside: goals they take comfortably come first, then goals they
+// reach uncomfortably, never goals out of their reach; whatever is planned is handed over where
+// that human's arms hold the grasp in the posture the plan gives (checked by forward kinematics).
+TEST_F(WorkerComfortTest, EveryPlanIsTakenByTheHumanWhoIsThere) {
+  const auto& cell = model_->cell();
+  online::Scene scene = online::nominal_scene(cell, model_->product());
+  const core::Pose s0 = scene.human_stance;
+  const online::BoardRecords* b = model_->board_records("base");
+  ASSERT_NE(b, nullptr);
+  online::BoardPlanner planner(*model_);
+  const online::BoardPlanSettings settings;
+  std::vector<core::Pose> links;
+  cell.human().link_poses(cell.human_neutral(), links);
+  // The plan's human posture holds `hand` (world) for the human at `stance`: forward kinematics
+  // of the arm's joints, within the joint limits, to 1e-6 m and rad.
+  auto holds = [&](const std::string& arm_name, const Eigen::VectorXd& q, const core::Pose& hand,
+                   const core::Pose& stance) {
+    for (const auto& arm : cell.human_arms()) {
+      if (arm.spec.name != arm_name) continue;
+      if (q.size() != arm.chain.dof()) return false;
+      const core::Pose base =
+          stance * links[static_cast<std::size_t>(cell.human().link_index(arm.spec.base_link))];
+      const core::Pose at = base * arm.chain.fk(q);
+      const bool within = (q.array() >= arm.chain.lower_limits().array() - 1e-9).all() &&
+                          (q.array() <= arm.chain.upper_limits().array() + 1e-9).all();
+      return within && (at.translation() - hand.translation()).norm() < 1e-6 &&
+             Eigen::AngleAxisd(at.linear().transpose() * hand.linear()).angle() < 1e-6;
+    }
+    return false;
+  };
+  int uncomfortable = 0, out_of_reach = 0, solved = 0;
+  for (const double yaw_deg : {0.0, 20.0, 45.0, 90.0, 180.0}) {
+    for (const double dy : {0.0, 0.1, 0.25}) {
+      scene.human_stance = moved(s0, Eigen::Vector3d(0.0, dy, 0.0), core::deg_to_rad(yaw_deg));
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      const online::BoardPlan plan = planner.plan(scene, "base", deadline);
+      SCOPED_TRACE("yaw " + std::to_string(yaw_deg) + " dy " + std::to_string(dy));
+      std::map<std::int64_t, bool> comfortable;  // by the maps, every stored goal
+      int comfortable_count = 0;
+      for (const auto& goal : b->goals) {
+        const double q =
+            model_->worker_comfort()->goal_quality(goal, b->human_grasps, scene.human_stance);
+        comfortable[goal.id] = q >= std::min(settings.worker_comfort_floor, goal.quality);
+        comfortable_count += comfortable[goal.id] ? 1 : 0;
+      }
+      uncomfortable += plan.goals_uncomfortable;
+      out_of_reach += plan.goals_out_of_reach;
+      // The uncomfortable goals are checked only among those the maps call uncomfortable; those
+      // out of reach may be either kind (a comfortable one is confirmed before it is planned).
+      EXPECT_LE(comfortable_count + plan.goals_uncomfortable, static_cast<int>(b->goals.size()));
+      EXPECT_LE(plan.goals_out_of_reach, static_cast<int>(b->goals.size()));
+      if (comfortable_count < settings.goals) {
+        EXPECT_GT(plan.goals_uncomfortable + plan.goals_out_of_reach, 0);
+      }
+      // The attempts never go back from an uncomfortable goal to a comfortable one.
+      bool left_comfort = false;
+      for (const auto& attempt : plan.attempts) {
+        const bool c = comfortable.at(attempt.candidate_id);
+        EXPECT_FALSE(left_comfort && c);
+        left_comfort = left_comfort || !c;
+      }
+      if (!plan.solved()) continue;
+      ++solved;
+      const auto& goal = *std::find_if(b->goals.begin(), b->goals.end(),
+                                       [&](const auto& g) { return g.id == plan.candidate_id; });
+      EXPECT_EQ(plan.human_arm, goal.human_arm);
+      EXPECT_TRUE(holds(goal.human_arm, plan.human_joints,
+                        goal.board * b->human_grasps.at(goal.human_grasp_id).hand,
+                        scene.human_stance))
+          << "comfortable by the maps: " << comfortable.at(goal.id) << ", Q " << plan.quality;
+      EXPECT_EQ(plan.second_human_arm, goal.second_arm);
+      if (!goal.second_arm.empty()) {
+        EXPECT_TRUE(holds(goal.second_arm, plan.second_human_joints,
+                          goal.board * b->human_grasps.at(goal.second_grasp_id).hand,
+                          scene.human_stance));
+      }
+      if (comfortable.at(goal.id)) {
+        EXPECT_NEAR(
+            plan.quality,
+            model_->worker_comfort()->goal_quality(goal, b->human_grasps, scene.human_stance),
+            1e-12);
+      }
+    }
+  }
+  // These stances do exercise every tier.
+  EXPECT_GT(uncomfortable, 0);
+  EXPECT_GT(out_of_reach, 0);
+  EXPECT_GT(solved, 0);
+}
