@@ -8,9 +8,10 @@
 int main(int argc, char** argv) {
   if (argc != 3) return 2;
   namespace online = hila::online;
-  // The cell and product files the scene names: the database must have been built from them.
+  // The database with the cell and product files the scene names (it must have been built from
+  // them), loaded once for every query.
   const online::SceneFiles files = online::read_scene_files(argv[2]);
-  const auto model = online::PlannerModel::load(argv[1], files.cell, files.product);  // once
+  const auto model = online::PlannerModel::load(argv[1], files.cell, files.product);
   const online::Scene scene = online::load_scene(argv[2], model->cell(), model->product());
   online::BoardPlanner planner(*model);  // one per thread, for any number of boards and scenes
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
