@@ -13,7 +13,7 @@
 #include <cmath>
 #include <memory>
 
-#include "hila/core/ompl_state.hpp"
+#include "hila/core/internal/ompl_state.hpp"
 #include "ompl_joint_space.hpp"
 
 namespace ob = ompl::base;

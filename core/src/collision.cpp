@@ -16,7 +16,7 @@
 #include <limits>
 
 #include "hila/core/error.hpp"
-#include "hila/core/obb_separation.hpp"
+#include "hila/core/internal/obb_separation.hpp"
 
 namespace hila::core {
 

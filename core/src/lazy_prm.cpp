@@ -9,7 +9,7 @@
 #include <ompl/util/Console.h>
 
 #include "hila/core/bridge.hpp"
-#include "hila/core/ompl_state.hpp"
+#include "hila/core/internal/ompl_state.hpp"
 #include "ompl_joint_space.hpp"
 
 namespace ob = ompl::base;

@@ -19,8 +19,8 @@
 
 #include "hila/core/collision.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/internal/ompl_state.hpp"
 #include "hila/core/joint_box.hpp"
-#include "hila/core/ompl_state.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"

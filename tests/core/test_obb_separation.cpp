@@ -3,7 +3,7 @@
 #include <Eigen/Geometry>
 #include <random>
 
-#include "hila/core/obb_separation.hpp"
+#include "hila/core/internal/obb_separation.hpp"
 
 using hila::core::separating_axis;
 

@@ -1,6 +1,8 @@
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <system_error>
 
 #include "commands.hpp"
 #include "hila/core/cell.hpp"
@@ -151,11 +153,26 @@ void add_product_command(CLI::App& app, Action& action) {
   check->callback([opt, &action] { action = [opt] { return run_product_check(*opt); }; });
 }
 
+namespace {
+// The bundled cell and product: installed, HILA_INSTALLED_DATA_DIR from the folder the hila
+// command is in (share/hila/meshes beside bin/); in the build tree, the source's meshes/.
+std::string data_dir() {
+  std::error_code error;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const std::filesystem::path installed =
+        (exe.parent_path() / HILA_INSTALLED_DATA_DIR).lexically_normal();
+    if (std::filesystem::exists(installed / "cell" / "cell.yaml", error)) return installed.string();
+  }
+  return HILA_DATA_DIR;
+}
+}  // namespace
+
 std::string default_cell_path() {
-  return HILA_DATA_DIR "/cell/cell.yaml";
+  return data_dir() + "/cell/cell.yaml";
 }
 std::string default_product_path() {
-  return HILA_DATA_DIR "/cabinet/product.yaml";
+  return data_dir() + "/cabinet/product.yaml";
 }
 
 }  // namespace hila::tools
