@@ -122,13 +122,8 @@ TEST(Build, HandoverStagesGoalsAndErgonomicsAreStoredForEveryBoard) {
 
 TEST(Build, AHumanStanceInsideTheTableIsRejectedBeforeAnyWork) {
   const std::string dir = test::temp_dir("build_stance");
-  std::string cell = test::read_file(test::cell_path());
-  const std::string from = "stance: {xyz: [1.15, 0.0, 0.1]";
-  cell.replace(cell.find(from), from.size(), "stance: {xyz: [0.70, 0.0, 0.1]");
-  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
-    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
-  }
-  const std::string path = test::write_file(dir, "cell.yaml", cell);
+  const std::string path =
+      test::cell_variant(dir, "stance: {xyz: [1.15, 0.0, 0.1]", "stance: {xyz: [0.70, 0.0, 0.1]");
   test::expect_input_error(
       [&] {
         offline::build_database(test::product_path(), path, dir + "/x.hila", quick_settings());
@@ -142,14 +137,7 @@ TEST(Build, AHumanStanceInsideTheTableIsRejectedBeforeAnyWork) {
 // why; the lighter boards are unaffected.
 TEST(Build, APartOverThePayloadGetsNoGoalAndTheReason) {
   const std::string dir = test::temp_dir("build_payload");
-  std::string cell = test::read_file(test::cell_path());
-  const std::string from = "        allowed_kg: 3.5\n";
-  ASSERT_NE(cell.find(from), std::string::npos);
-  cell.replace(cell.find(from), from.size(), "");
-  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
-    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
-  }
-  const std::string path = test::write_file(dir, "cell.yaml", cell);
+  const std::string path = test::cell_variant(dir, "        allowed_kg: 3.5\n", "");
   const offline::BuildSummary summary =
       offline::build_database(test::product_path(), path, dir + "/x.hila", quick_settings());
   for (const auto& part : summary.parts) {

@@ -517,14 +517,7 @@ TEST_F(BoardPlanner, AGraspWhoseReceiveFailedAtABoardPoseComesBackLast) {
 // anything is planned; a 0.8 kg board is planned as usual.
 TEST(BoardPlannerPayload, APartOverThePayloadIsRefusedWithTheSums) {
   const std::string dir = test::temp_dir("board_planner_payload");
-  std::string cell = test::read_file(test::cell_path());
-  const std::string from = "        allowed_kg: 3.5\n";
-  ASSERT_NE(cell.find(from), std::string::npos);
-  cell.replace(cell.find(from), from.size(), "");
-  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
-    test::write_file(dir, f, test::read_file(test::data_path(std::string("cell/") + f)));
-  }
-  const std::string cell_path = test::write_file(dir, "cell.yaml", cell);
+  const std::string cell_path = test::cell_variant(dir, "        allowed_kg: 3.5\n", "");
   offline::build_database(test::product_path(), cell_path, dir + "/cabinet.hila",
                           test::quick_build_settings(7, 2));
   const auto model =

@@ -51,6 +51,17 @@ std::string write_file(const std::string& dir, const std::string& name, const st
   return path;
 }
 
+std::string cell_variant(const std::string& dir, const std::string& from, const std::string& to) {
+  std::string cell = read_file(cell_path());
+  const auto at = cell.find(from);
+  EXPECT_NE(at, std::string::npos) << "cell.yaml no longer contains '" << from << "'";
+  if (at != std::string::npos) cell.replace(at, from.size(), to);
+  for (const char* f : {"dual_ur3.urdf", "suction_tool.urdf", "human.urdf"}) {
+    write_file(dir, f, read_file(data_path(std::string("cell/") + f)));
+  }
+  return write_file(dir, "cell.yaml", cell);
+}
+
 std::string read_file(const std::string& path) {
   std::ifstream in(path);
   std::stringstream buffer;

@@ -29,6 +29,9 @@ std::string temp_dir(const std::string& name);
 // Writes `text` to `dir/name` and returns the path.
 std::string write_file(const std::string& dir, const std::string& name, const std::string& text);
 std::string read_file(const std::string& path);
+// The reference cell with one text change (`from`, which must occur, replaced by `to`), written
+// into `dir` with the URDFs it names; returns the cell file's path.
+std::string cell_variant(const std::string& dir, const std::string& from, const std::string& to);
 
 core::Pose random_pose(std::mt19937_64& rng, double position_range = 1.0);
 
