@@ -484,10 +484,21 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
               .ok();
     }
   }
+  if (n_suction == 0) {
+    return finish("no suction grasp: no flat face of the part takes the " +
+                  core::format_number(cell.spec().suction.cup_radius) +
+                  " m cup with the weight and its moment within the cup's limits, and the "
+                  "planner picks by suction only (a direct gripper pick is not planned yet)");
+  }
   if (std::count(pickable.begin(), pickable.end(), 1) == 0) {
-    return finish("the " + suction_arm.spec.name + " arm cannot take the board from the stack " +
-                  "with any of its " + std::to_string(n_suction) +
-                  " suction grasps (IK, collision at the initial pose, or the lift)");
+    const Eigen::Vector3d at = part.initial.translation();
+    return finish("the " + suction_arm.spec.name + " arm cannot pick the part by suction at its " +
+                  "initial pose (" + core::format_number(at.x()) + ", " +
+                  core::format_number(at.y()) + ", " + core::format_number(at.z()) +
+                  ") m with any of its " + std::to_string(n_suction) +
+                  " suction grasps: out of the arm's reach there, in collision at the pick or the "
+                  "approach, or the lift blocked; place the part within the " +
+                  suction_arm.spec.name + " arm's reach, clear of the parts around it");
   }
   std::vector<int> favoured, spread;
   for (int i = 0; i < n_pos * n_orient * n_suction; ++i) {

@@ -153,6 +153,26 @@ TEST(Build, APartOverThePayloadGetsNoGoalAndTheReason) {
   }
 }
 
+// A part laid out in front of the left arm, out of the suction arm's reach: the build's reason
+// names the arm, the check and the pose, and what to change.
+TEST(Build, APartOutOfTheSuctionArmsReachIsNamedWithItsPose) {
+  const std::string dir = test::temp_dir("build_reach");
+  const std::string product = product_variant(dir, "initial: {xyz: [0.30, -0.30, 1.0965]",
+                                              "initial: {xyz: [0.30, 0.55, 1.0965]");
+  const offline::BuildSummary summary =
+      offline::build_database(product, test::cell_path(), dir + "/x.hila", quick_settings());
+  const auto& last = summary.parts.back();
+  EXPECT_EQ(last.goals, 0);
+  EXPECT_EQ(last.handover_failure.rfind(
+                "the right arm cannot pick the part by suction at its initial pose (0.3, 0.55, "
+                "1.0965) m with any of its ",
+                0),
+            0u)
+      << last.handover_failure;
+  EXPECT_NE(last.handover_failure.find("place the part within the right arm's reach"),
+            std::string::npos);
+}
+
 TEST(Build, SameSeedSameDigestForAnyNumberOfJobs) {
   const std::string dir = test::temp_dir("build_digest");
   const std::string a = build(dir, "a.hila", quick_settings(7, 1));
