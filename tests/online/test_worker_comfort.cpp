@@ -167,12 +167,17 @@ TEST_F(WorkerComfortTest, EveryPlanIsTakenByTheHumanWhoIsThere) {
     return false;
   };
   int uncomfortable = 0, out_of_reach = 0, solved = 0;
+  // Stepped back, aside or turned: from the stance as built to out of reach.
   for (const double yaw_deg : {0.0, 20.0, 45.0, 90.0, 180.0}) {
-    for (const double dy : {0.0, 0.1, 0.25}) {
-      scene.human_stance = moved(s0, Eigen::Vector3d(0.0, dy, 0.0), core::deg_to_rad(yaw_deg));
+    for (const Eigen::Vector3d& by :
+         {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.0, 0.1, 0.0),
+          Eigen::Vector3d(0.0, 0.25, 0.0), Eigen::Vector3d(0.1, 0.0, 0.0),
+          Eigen::Vector3d(0.2, 0.0, 0.0), Eigen::Vector3d(0.1, -0.15, 0.0)}) {
+      scene.human_stance = moved(s0, by, core::deg_to_rad(yaw_deg));
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
       const online::BoardPlan plan = planner.plan(scene, "base", deadline);
-      SCOPED_TRACE("yaw " + std::to_string(yaw_deg) + " dy " + std::to_string(dy));
+      SCOPED_TRACE("yaw " + std::to_string(yaw_deg) + " by " + std::to_string(by.x()) + ", " +
+                   std::to_string(by.y()));
       std::map<std::int64_t, bool> comfortable;  // by the maps, every stored goal
       int comfortable_count = 0;
       for (const auto& goal : b->goals) {
