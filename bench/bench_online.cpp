@@ -67,7 +67,7 @@ constexpr const char* kUsage =
 
 constexpr const char* kBuildHint =
     "build it with `tools/demo`, or `build/release/tools/hila build meshes/cabinet/product.yaml "
-    "--cell meshes/cell/cell.yaml -o out/cabinet.hila --jobs 2` (about 150 s), or point --db or "
+    "--cell meshes/cell/cell.yaml -o out/cabinet.hila --jobs 2` (about a minute), or point --db or "
     "HILA_BENCH_DATABASE at one";
 
 struct Options {

@@ -257,7 +257,7 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
       EXPECT_TRUE(e.path.front().isApprox(from.solutions.front(), 1e-12)) << "edge " << e.id;
       EXPECT_TRUE(e.path.back().isApprox(to.solutions.front(), 1e-12)) << "edge " << e.id;
       EXPECT_NEAR(e.cost, path_length(e.path), 1e-9) << "edge " << e.id;
-      // Since 0.7.0 the receiving arm's transit to the exchange ends with its way in: home ->
+      // The receiving arm's transit to the exchange ends with its way in: home ->
       // pre-grasp -> grasp, the last segment a straight approach of at most 5 cm, and the whole
       // path clear of the board standing there in the suction arm's hand, at the empty arm's
       // resolution (the online planner follows it as it is).
@@ -276,7 +276,7 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
         EXPECT_EQ(exchange.contact_along(left, e.path, empty_resolution, right, suction_q), "")
             << "transit edge " << e.id << " into the exchange";
       }
-      // Since 0.3.0 the chains are planned at the board's stage: a held board never passes
+      // The chains are planned at the board's stage: a held board never passes
       // through the boards assembled before it, checked every 0.01 rad as online.
       if (e.kind == "transfer") {
         const core::Arm& arm = e.arm == "left" ? left : right;
@@ -343,7 +343,7 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
   }
   std::string missing;
   for (const auto& n : unconnected_boards) missing += n + " ";
-  // Every board: since 0.4.0 the roadmaps span the elbow's whole +-pi (core::joint_box), which
+  // Every board: the roadmaps span the elbow's whole +-pi (core::joint_box), which
   // reaches lateral_left's exchange from home.
   EXPECT_EQ(connected_boards.size(), database.parts().size())
       << "boards without a connected transfer: " << missing;
