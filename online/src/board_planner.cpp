@@ -1417,11 +1417,9 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
       r.quality = goal.quality;
       r.joints = goal.human_joints;
       r.second_joints = goal.second_joints;
-    } else if (const WorkerComfort* c = built_stance ? model_.worker_comfort() : comfort) {
-      r = c->goal_reach(goal, records->human_grasps, scene.human_stance);
-    } else {  // as built, and the maps unreadable: the build's word
-      r.reachable = true;
-      r.quality = goal.quality;
+    } else {  // the human arms' IK: no comfort maps needed
+      r = WorkerComfort::goal_reach(model_.cell(), goal, records->human_grasps, scene.human_stance);
+      if (built_stance) r.quality = goal.quality;  // the stored Q is this human's
     }
     if (!r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
     return reach_of.emplace(goal.id, std::move(r)).first->second;

@@ -19,11 +19,11 @@ WorkerComfort::WorkerComfort(const core::Cell& cell, const std::vector<db::Comfo
                              "a comfort map for the human arm '" + arm.spec.name + "'",
                              "none (rebuild the database with hila build)");
     }
-    arms_.push_back(Arm{
-        arm.spec.name,
-        core::ComfortMap::from_grid(it->origin, it->spacing, it->dims, it->orientations, it->values,
-                                    it->coverage),
-        links[static_cast<std::size_t>(cell.human().link_index(arm.spec.base_link))], &arm.chain});
+    arms_.push_back(
+        Arm{arm.spec.name,
+            core::ComfortMap::from_grid(it->origin, it->spacing, it->dims, it->orientations,
+                                        it->values, it->coverage),
+            links[static_cast<std::size_t>(cell.human().link_index(arm.spec.base_link))]});
   }
 }
 
@@ -35,26 +35,30 @@ const WorkerComfort::Arm* WorkerComfort::arm(const std::string& name) const {
 }
 
 WorkerComfort::GoalReach WorkerComfort::goal_reach(
-    const db::HandoverCandidateRecord& goal,
+    const core::Cell& cell, const db::HandoverCandidateRecord& goal,
     const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps, const core::Pose& stance,
-    const core::ComfortSettings& ik) const {
+    const core::ComfortSettings& ik) {
+  std::vector<core::Pose> links;
+  cell.human().link_poses(cell.human_neutral(), links);
   auto hand = [&](const std::string& name, std::int64_t grasp_id, const Eigen::VectorXd& built) {
-    const Arm* a = arm(name);
+    const auto a = std::find_if(cell.human_arms().begin(), cell.human_arms().end(),
+                                [&](const core::HumanArm& h) { return h.spec.name == name; });
     const auto it = human_grasps.find(grasp_id);
-    if (a == nullptr || it == human_grasps.end()) return core::ComfortResult{};
-    const core::Pose in_base =
-        (stance * a->base_in_stance).inverse() * (goal.board * it->second.hand);
+    if (a == cell.human_arms().end() || it == human_grasps.end()) return core::ComfortResult{};
+    const core::Pose base_in_stance =
+        links[static_cast<std::size_t>(cell.human().link_index(a->spec.base_link))];
+    const core::Pose in_base = (stance * base_in_stance).inverse() * (goal.board * it->second.hand);
     // Beyond the stretched arm from the shoulder: out of reach without solving.
-    const double reach = core::characteristic_length(*a->chain);
-    if ((in_base.translation() - a->chain->first_joint_position()).norm() > reach) {
+    const double reach = core::characteristic_length(a->chain);
+    if ((in_base.translation() - a->chain.first_joint_position()).norm() > reach) {
       return core::ComfortResult{};
     }
-    const Eigen::VectorXd seed = built.size() == a->chain->dof()
+    const Eigen::VectorXd seed = built.size() == a->chain.dof()
                                      ? built
-                                     : Eigen::VectorXd::Zero(a->chain->dof())
-                                           .cwiseMax(a->chain->lower_limits())
-                                           .cwiseMin(a->chain->upper_limits());
-    return core::best_comfort(*a->chain, in_base, seed, ik);
+                                     : Eigen::VectorXd::Zero(a->chain.dof())
+                                           .cwiseMax(a->chain.lower_limits())
+                                           .cwiseMin(a->chain.upper_limits());
+    return core::best_comfort(a->chain, in_base, seed, ik);
   };
   GoalReach r;
   if (goal.human_arm.empty()) return r;

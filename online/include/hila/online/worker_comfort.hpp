@@ -51,10 +51,11 @@ class WorkerComfort {
     double quality = 0.0;                   // the weaker hand's Q at the postures found
     Eigen::VectorXd joints, second_joints;  // goal.human_arm's, goal.second_arm's (rad)
   };
-  GoalReach goal_reach(const db::HandoverCandidateRecord& goal,
-                       const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
-                       const core::Pose& stance,
-                       const core::ComfortSettings& ik = reach_settings()) const;
+  // Needs the cell's human arms only, not the maps: callable without loading them.
+  static GoalReach goal_reach(const core::Cell& cell, const db::HandoverCandidateRecord& goal,
+                              const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
+                              const core::Pose& stance,
+                              const core::ComfortSettings& ik = reach_settings());
   // For a reach check: 8 attempts, stopping at the first solution, to 1e-7 m and rad (far below
   // what a human hand notices).
   static core::ComfortSettings reach_settings() {
@@ -70,7 +71,6 @@ class WorkerComfort {
     std::string name;
     core::ComfortMap map;
     core::Pose base_in_stance;  // the arm's base (torso) in the human's floor frame, neutral
-    const core::KinematicChain* chain = nullptr;  // the cell's, which outlives this
   };
   const Arm* arm(const std::string& name) const;
   std::vector<Arm> arms_;
