@@ -73,6 +73,9 @@ class DatabaseWriter {
   // candidate_id, robot_grasp_id and robot_handover_id are taken from each record and must name
   // written records.
   void add_shared_grasps(const std::vector<SharedGraspRecord>& grasps);
+  // candidate_id and robot_grasp_id are taken from each record and must name written records;
+  // arm must be non-empty (schema version 5).
+  void add_direct_grasps(const std::vector<DirectGraspRecord>& grasps);
   // method must be "hila", "table" or "alone", at most one row per part and method (DatabaseError:
   // CHECK / UNIQUE constraint failed).
   void add_ergonomics(std::int64_t part_id, const std::vector<ErgonomicsRecord>& rows);
@@ -169,6 +172,7 @@ class Database {
   // The part's candidates with status "goal", by rank ascending (then id).
   std::vector<HandoverCandidateRecord> handover_goals(std::int64_t part_id) const;
   std::vector<SharedGraspRecord> shared_grasps(std::int64_t candidate_id) const;  // id order
+  std::vector<DirectGraspRecord> direct_grasps(std::int64_t candidate_id) const;  // id order
   std::vector<ErgonomicsRecord> ergonomics(std::int64_t part_id) const;  // id (write) order
 
   // Roadmaps and the regrasp graph (schema version 4). The arm's roadmap, or nullptr when the
@@ -194,6 +198,7 @@ class Database {
   std::vector<RobotHandoverRecord> robot_handovers_;
   std::vector<HandoverCandidateRecord> handover_candidates_;
   std::vector<SharedGraspRecord> shared_grasps_;
+  std::vector<DirectGraspRecord> direct_grasps_;
   std::vector<ErgonomicsRecord> ergonomics_;
   std::vector<RoadmapRecord> roadmaps_;
   std::vector<RoadmapFilterRecord> roadmap_filters_;  // id order: roadmap_filter() bisects

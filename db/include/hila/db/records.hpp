@@ -140,7 +140,8 @@ struct HandoverCandidateRecord {
   Eigen::VectorXd second_joints;  // goals of two-hand boards: IK of second_arm
 };
 
-// A robot grasp valid at both handover poses of a goal (the receiving arm's IK at each).
+// A robot grasp valid at both handover poses of a goal (the receiving arm's IK at each): the
+// part reaches the human through a robot-robot exchange.
 struct SharedGraspRecord {
   std::int64_t id = 0;
   std::int64_t candidate_id = 0;  // a "goal" candidate
@@ -150,6 +151,19 @@ struct SharedGraspRecord {
   Eigen::VectorXd joints_rr;           // at the robot-robot pose, rad
   Eigen::VectorXd joints_rh;           // at the robot-human pose, rad
   double inclination_rr_deg = 0.0;     // opening axis vs gravity at each pose (<= theta_c)
+  double inclination_rh_deg = 0.0;
+};
+
+// A robot grasp with which one arm's gripper takes the part where it lies and holds it at a
+// goal's robot-human pose: the part goes to the human without an exchange (schema version 5).
+struct DirectGraspRecord {
+  std::int64_t id = 0;
+  std::int64_t candidate_id = 0;  // a "goal" candidate
+  std::int64_t robot_grasp_id = 0;
+  std::string arm;                    // the arm that picks and delivers
+  Eigen::VectorXd joints_pick;        // at the part's initial pose, rad
+  Eigen::VectorXd joints_rh;          // at the robot-human pose, rad
+  double inclination_pick_deg = 0.0;  // opening axis vs gravity at each pose (<= theta_c)
   double inclination_rh_deg = 0.0;
 };
 
