@@ -35,7 +35,8 @@ int arm_index_of(const core::Cell& cell, const core::Arm& arm) {
 ArmWorkspace::ArmWorkspace(const core::Cell& cell, const std::string& arm,
                            const std::string& suction_arm, const core::TriangleMesh* board,
                            const std::vector<core::PlacedPart>& finished,
-                           const std::vector<core::PlacedPart>& stacked)
+                           const std::vector<core::PlacedPart>& stacked,
+                           const core::Pose* tool_on_table)
     : cell_(cell),
       arm_(cell.arm(arm)),
       arm_index_(arm_index_of(cell, arm_)),
@@ -45,7 +46,8 @@ ArmWorkspace::ArmWorkspace(const core::Cell& cell, const std::string& arm,
       arm_bodies_(scene_.cell.arm_bodies[static_cast<std::size_t>(arm_index_)]),
       board_bodies_{scene_.board},
       base_(core::arm_base_in_world(cell, arm_)),
-      robot_q_(cell.home_configuration()) {
+      robot_q_(cell.home_configuration()),
+      tool_on_table_(tool_on_table != nullptr) {
   if (!board) scene_.cell.model.set_enabled(scene_.board, false);
   // While held, the board is rigid with the last arm link and everything below it (the hand, and
   // the tool on the suction arm): the grasp planners checked those pairs at the grasp, and they
@@ -61,7 +63,7 @@ ArmWorkspace::ArmWorkspace(const core::Cell& cell, const std::string& arm,
       root = j.parent_link;
     }
     std::vector<int> rigid = core::subtree_bodies(robot, scene_.cell.robot, root);
-    if (is_suction_arm())
+    if (holds_tool())
       rigid.insert(rigid.end(), scene_.tool_bodies.begin(), scene_.tool_bodies.end());
     for (const int b : rigid) scene_.cell.model.allow(scene_.board, b);
   }
@@ -73,14 +75,18 @@ ArmWorkspace::ArmWorkspace(const core::Cell& cell, const std::string& arm,
       moving_links_.emplace_back(static_cast<int>(link), b);
     }
   }
-  if (is_suction_arm()) {
+  if (holds_tool()) {
     arm_bodies_.insert(arm_bodies_.end(), scene_.tool_bodies.begin(), scene_.tool_bodies.end());
   }
   core::set_cell_state(cell_, scene_.cell, data_, robot_q_, cell_.human_neutral());
-  const core::Arm& tool_arm = cell_.arms()[static_cast<std::size_t>(scene_.suction_arm)];
-  core::set_tool_held(
-      cell_, scene_, data_,
-      core::arm_base_in_world(cell_, tool_arm) * tool_arm.chain.fk(tool_arm.spec.home));
+  if (tool_on_table != nullptr) {
+    core::set_robot_pose(data_, scene_.tool, scene_.tool_links_in_handle, *tool_on_table);
+  } else {
+    const core::Arm& tool_arm = cell_.arms()[static_cast<std::size_t>(scene_.suction_arm)];
+    core::set_tool_held(
+        cell_, scene_, data_,
+        core::arm_base_in_world(cell_, tool_arm) * tool_arm.chain.fk(tool_arm.spec.home));
+  }
   data_.set_body_pose(scene_.board, kParked);
 }
 
@@ -91,7 +97,7 @@ void ArmWorkspace::pose_arm(const Eigen::VectorXd& q) {
     data_.set_body_pose(body, link_poses_[static_cast<std::size_t>(link)]);
   }
   const core::Pose tcp_world = tcp(q);
-  if (is_suction_arm()) core::set_tool_held(cell_, scene_, data_, tcp_world);
+  if (holds_tool()) core::set_tool_held(cell_, scene_, data_, tcp_world);
   if (holding_) data_.set_body_pose(scene_.board, tcp_world * board_in_tcp_);
   posed_ = q;
 }
@@ -108,7 +114,7 @@ void ArmWorkspace::hold(const core::Pose& board_in_tcp, double jaw) {
   }
   board_in_tcp_ = board_in_tcp;
   holding_ = true;
-  if (!is_suction_arm()) cell_.set_jaw(robot_q_, arm_, jaw);
+  if (!holds_tool()) cell_.set_jaw(robot_q_, arm_, jaw);
   posed_.resize(0);
 }
 
@@ -122,7 +128,7 @@ void ArmWorkspace::place_board(const core::Pose& world) {
 
 void ArmWorkspace::release() {
   holding_ = false;
-  if (!is_suction_arm()) cell_.set_jaw(robot_q_, arm_, cell_.spec().gripper.jaw_max);
+  if (!holds_tool()) cell_.set_jaw(robot_q_, arm_, cell_.spec().gripper.jaw_max);
   data_.set_body_pose(scene_.board, kParked);
   posed_.resize(0);
 }
@@ -130,6 +136,10 @@ void ArmWorkspace::release() {
 void ArmWorkspace::pose_rest(const Eigen::VectorXd& robot_q) {
   robot_q_ = robot_q;
   core::set_robot_state(cell_, scene_.cell, data_, robot_q_);
+  if (tool_on_table_) {
+    posed_.resize(0);
+    return;
+  }
   const core::Arm& tool_arm = cell_.arms()[static_cast<std::size_t>(scene_.suction_arm)];
   core::set_tool_held(cell_, scene_, data_,
                       core::arm_base_in_world(cell_, tool_arm) *

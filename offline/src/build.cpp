@@ -181,6 +181,12 @@ HandoverIds write_handover(db::DatabaseWriter& writer, std::int64_t part_id,
     s.robot_handover_id = id_of(rr_ids, s.robot_handover_id);
   }
   writer.add_shared_grasps(shared);
+  std::vector<db::DirectGraspRecord> direct = h.direct;
+  for (auto& d : direct) {
+    d.candidate_id = id_of(candidate_ids, d.candidate_id);
+    d.robot_grasp_id = id_of(robot_ids, d.robot_grasp_id);
+  }
+  writer.add_direct_grasps(direct);
   return {rr_ids, candidate_ids};
 }
 
@@ -262,7 +268,7 @@ std::string settings_hash(const BuildSettings& s) {
        << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.two_hand_separation << ' '
        << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
        << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' ' << h.rr_per_grasp
-       << ' ' << h.human_ik_goals << ' ' << h.pick_lift << ' ' << h.pick_resolution << ' '
+       << ' ' << h.human_ik_goals << ' ' << h.direct << ' ' << h.direct_stored << ' ' << h.pick_lift << ' ' << h.pick_resolution << ' '
        << h.exchange_approach << ' ' << h.exchange_resolution;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;

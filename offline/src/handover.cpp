@@ -13,6 +13,7 @@
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
+#include "hila/offline/gripper_pick.hpp"
 #include "hila/offline/human_grasps.hpp"
 #include "hila/offline/suction_pick.hpp"
 
@@ -371,14 +372,34 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     return "";
   };
-  // Payload: the suction arm carries the part on the tool, the receiving arm in its jaws.
+  // Payload. The exchange: the suction arm carries the part on the tool, the receiving arm in its
+  // jaws. A direct pick: the picking arm in its jaws. A way whose arm would be over its payload
+  // is not searched; with none left the part has no goal.
+  std::string exchange_failure, over_payload;
   for (const auto& check :
        {core::check_payload(settings.suction_arm, cell.arm(settings.suction_arm).spec.payload,
                             part.mass, core::CarryMode::kSuction, cell.spec().suction.mass),
         core::check_payload(settings.receiving_arm, cell.arm(settings.receiving_arm).spec.payload,
                             part.mass, core::CarryMode::kGripper, cell.spec().suction.mass)}) {
-    if (!check.within_allowed()) return finish("over the payload: " + check.describe());
+    if (!check.within_allowed() && exchange_failure.empty()) {
+      exchange_failure = "over the payload: " + check.describe();
+      if (over_payload.empty()) over_payload = exchange_failure;
+    }
   }
+  std::vector<const core::Arm*> direct_candidates;  // arms that may pick the part directly
+  if (settings.direct) {
+    for (const std::string& name : {settings.receiving_arm, settings.suction_arm}) {
+      const core::Arm& a = cell.arm(name);
+      const auto check = core::check_payload(name, a.spec.payload, part.mass,
+                                             core::CarryMode::kGripper, cell.spec().suction.mass);
+      if (check.within_allowed()) {
+        direct_candidates.push_back(&a);
+      } else if (over_payload.empty()) {
+        over_payload = "over the payload: " + check.describe();
+      }
+    }
+  }
+  if (!exchange_failure.empty() && direct_candidates.empty()) return finish(over_payload);
   sample_candidates(settings.candidates);
   if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates) {
     return finish(no_candidate_reason());
@@ -401,31 +422,31 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // Receiving-arm IK for grasp g with the board at `board`: the first collision-free solution
   // (nearest to home first) of the receiving arm's bodies against everything else as posed.
   core::UrIkSolutions ik;
+  // `arm` holding the board at `board` with robot grasp g: its first collision-free IK solution
+  // (nearest home first) of `bodies` against everything else as posed, the slip within θc.
   // `way_in`: the gripper must also have a way in (the robot-robot exchange); at the human's
   // pose the online planner finds its way out or falls back to the next goal.
-  auto receive = [&](const core::Pose& board, int g, const std::vector<int>& bodies, bool way_in,
-                     Receiving& out) {
+  auto reach_with = [&](const core::Arm& arm, const core::Pose& base_inv, const core::Pose& board,
+                        int g, const std::vector<int>& bodies, bool way_in, Receiving& out) {
     const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
     const double slip = slip_at(board, g);
     if (slip > grasp.theta_c_deg) return false;
-    const core::Pose tcp = receiving_base_inv * board * grasp.tcp;
-    const int n = receiving_arm.ur_ik->solve(tcp, receiving_arm.spec.home, ik);
-    cell.set_jaw(robot_q, receiving_arm,
-                 std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + jaw_margin));
-    // The receiving arm (the suction arm holding the board as posed) clear at q.
+    const core::Pose tcp = base_inv * board * grasp.tcp;
+    const int n = arm.ur_ik->solve(tcp, arm.spec.home, ik);
+    cell.set_jaw(robot_q, arm, std::min(cell.spec().gripper.jaw_max, grasp.jaw_width + jaw_margin));
+    // The arm (the rest of the robot and the board as posed) clear at q.
     auto clear = [&](const Eigen::VectorXd& q) {
-      cell.set_arm(robot_q, receiving_arm, q);
+      cell.set_arm(robot_q, arm, q);
       core::set_robot_state(cell, scene.cell, data, robot_q);
       return !core::in_collision(scene.cell.model, data, bodies);
     };
     auto within = [&](const Eigen::VectorXd& q) {
-      return receiving_arm.chain.within_limits(q, 1e-9) && clear(q);
+      return arm.chain.within_limits(q, 1e-9) && clear(q);
     };
     for (int s = 0; s < n; ++s) {
       const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(s)];
-      if (clear(q) &&
-          (!way_in || core::find_pre_grasp(cell, receiving_arm, q, settings.exchange_approach,
-                                           settings.exchange_resolution, within))) {
+      if (clear(q) && (!way_in || core::find_pre_grasp(cell, arm, q, settings.exchange_approach,
+                                                       settings.exchange_resolution, within))) {
         out.grasp = g;
         out.joints = q;
         out.slip_deg = slip;
@@ -434,10 +455,72 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     return false;
   };
-  auto restore_receiving = [&] {
-    cell.set_arm(robot_q, receiving_arm, receiving_arm.spec.home);
-    cell.set_jaw(robot_q, receiving_arm, cell.spec().gripper.jaw_max);
+  auto receive = [&](const core::Pose& board, int g, const std::vector<int>& bodies, bool way_in,
+                     Receiving& out) {
+    return reach_with(receiving_arm, receiving_base_inv, board, g, bodies, way_in, out);
   };
+  auto restore_arm = [&](const core::Arm& arm) {
+    cell.set_arm(robot_q, arm, arm.spec.home);
+    cell.set_jaw(robot_q, arm, cell.spec().gripper.jaw_max);
+  };
+  auto restore_receiving = [&] { restore_arm(receiving_arm); };
+
+  // --- Direct picks: an arm's gripper takes the part where it lies --------------------------
+  // The suction arm's gripper is free only with the tool on the table (at the product's tool
+  // pose); the receiving arm's always (the suction arm at home with the tool).
+  struct DirectArm {
+    const core::Arm* arm = nullptr;
+    core::Pose base_inv = core::Pose::Identity();
+    bool tool_on_table = false;
+    std::vector<int> bodies;  // the arm's and the board's: checked at the robot-human pose
+    std::vector<Receiving> picks;  // the grasps it picks the part with, grasp order
+  };
+  std::vector<DirectArm> direct_arms;
+  for (const core::Arm* a : direct_candidates) {
+    if (!a->ur_ik) continue;
+    DirectArm d;
+    d.arm = a;
+    d.base_inv = core::arm_base_in_world(cell, *a).inverse();
+    d.tool_on_table = a == &suction_arm;
+    for (std::size_t k = 0; k < cell.arms().size(); ++k) {
+      if (&cell.arms()[k] == a) d.bodies = scene.cell.arm_bodies[k];
+    }
+    d.bodies.push_back(scene.board);
+    ArmWorkspace pick(cell, a->spec.name, suction_arm.spec.name, &part.mesh, finished,
+                      core::parts_after(product, index),
+                      d.tool_on_table ? &product.suction_tool_pose : nullptr);
+    GripperPickSettings ps;
+    ps.approach = settings.exchange_approach;
+    ps.approach_resolution = settings.exchange_resolution;
+    ps.lift = settings.pick_lift;
+    ps.resolution = settings.exchange_resolution;
+    ps.jaw_margin = jaw_margin;
+    for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+      const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
+      const double slip = slip_at(part.initial, g);
+      if (slip > grasp.theta_c_deg) continue;
+      const GripperPick p = plan_gripper_pick(pick, part.initial, grasp, ps);
+      if (!p.ok()) continue;
+      Receiving r;
+      r.grasp = g;
+      r.joints = p.grasp;
+      r.slip_deg = slip;
+      d.picks.push_back(r);
+    }
+    if (!d.picks.empty()) direct_arms.push_back(std::move(d));
+  }
+  std::string direct_failure;
+  if (!settings.direct) {
+    direct_failure = "direct picks are off";
+  } else if (direct_arms.empty()) {
+    const Eigen::Vector3d at = part.initial.translation();
+    direct_failure =
+        "no arm's gripper takes the part where it lies (" + core::format_number(at.x()) + ", " +
+        core::format_number(at.y()) + ", " + core::format_number(at.z()) + ") m with any of its " +
+        std::to_string(grasps.robot.size()) +
+        " robot grasps: out of reach, in collision at the grasp or its way in, the lift blocked "
+        "or the part would slip";
+  }
 
   // --- Robot-robot handover poses ----------------------------------------------------------
   // Board orientations: first those a transfer to the goals favours (the target orientation
@@ -484,21 +567,25 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
               .ok();
     }
   }
-  if (n_suction == 0) {
-    return finish("no suction grasp: no flat face of the part takes the " +
-                  core::format_number(cell.spec().suction.cup_radius) +
-                  " m cup with the weight and its moment within the cup's limits, and the "
-                  "planner picks by suction only (a direct gripper pick is not planned yet)");
-  }
-  if (std::count(pickable.begin(), pickable.end(), 1) == 0) {
+  if (!exchange_failure.empty()) {
+    // over the payload: no exchange searched
+  } else if (n_suction == 0) {
+    exchange_failure = "no suction grasp: no flat face of the part takes the " +
+                       core::format_number(cell.spec().suction.cup_radius) +
+                       " m cup with the weight and its moment within the cup's limits";
+  } else if (std::count(pickable.begin(), pickable.end(), 1) == 0) {
     const Eigen::Vector3d at = part.initial.translation();
-    return finish("the " + suction_arm.spec.name + " arm cannot pick the part by suction at its " +
-                  "initial pose (" + core::format_number(at.x()) + ", " +
-                  core::format_number(at.y()) + ", " + core::format_number(at.z()) +
-                  ") m with any of its " + std::to_string(n_suction) +
-                  " suction grasps: out of the arm's reach there, in collision at the pick or the "
-                  "approach, or the lift blocked; place the part within the " +
-                  suction_arm.spec.name + " arm's reach, clear of the parts around it");
+    exchange_failure = "the " + suction_arm.spec.name +
+                       " arm cannot pick the part by suction at its initial pose (" +
+                       core::format_number(at.x()) + ", " + core::format_number(at.y()) + ", " +
+                       core::format_number(at.z()) + ") m with any of its " +
+                       std::to_string(n_suction) +
+                       " suction grasps: out of the arm's reach there, in collision at the pick "
+                       "or the approach, or the lift blocked; place the part within the " +
+                       suction_arm.spec.name + " arm's reach, clear of the parts around it";
+  }
+  if (!exchange_failure.empty() && direct_arms.empty()) {
+    return finish(exchange_failure + "; " + direct_failure);
   }
   std::vector<int> favoured, spread;
   for (int i = 0; i < n_pos * n_orient * n_suction; ++i) {
@@ -513,7 +600,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   std::vector<std::vector<int>> rr_of_grasp(grasps.robot.size());
   int examined = 0;
   for (const int combo : order) {
-    if (examined >= settings.rr_poses) break;
+    if (examined >= settings.rr_poses || !exchange_failure.empty()) break;
     const int s = combo % n_suction;
     if (!pickable[static_cast<std::size_t>(s)]) continue;
     const int o = (combo / n_suction) % n_orient;
@@ -571,15 +658,18 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   }
   reset_state();
   stage.robot_handovers = static_cast<int>(result.robot_handovers.size());
-  if (stage.robot_handovers == 0) {
-    return finish(examined == 0
-                      ? "no robot-robot handover pose: the " + suction_arm.spec.name +
-                            " arm cannot hold the board by suction clear of the cell at any of "
-                            "the shared-workspace poses"
-                      : "no robot-robot handover pose: the " + receiving_arm.spec.name +
-                            " arm reaches no grasp within its slip limit at the " +
-                            std::to_string(examined) + " poses the " + suction_arm.spec.name +
-                            " arm can hold");
+  if (stage.robot_handovers == 0 && exchange_failure.empty()) {
+    exchange_failure = examined == 0
+                           ? "no robot-robot handover pose: the " + suction_arm.spec.name +
+                                 " arm cannot hold the board by suction clear of the cell at any "
+                                 "of the shared-workspace poses"
+                           : "no robot-robot handover pose: the " + receiving_arm.spec.name +
+                                 " arm reaches no grasp within its slip limit at the " +
+                                 std::to_string(examined) + " poses the " +
+                                 suction_arm.spec.name + " arm can hold";
+  }
+  if (!exchange_failure.empty() && direct_arms.empty()) {
+    return finish(exchange_failure + "; " + direct_failure);
   }
 
   // --- 𝕊: members of S sharing a grasp with a robot-robot pose, in Eq. 8 order -------------
@@ -648,8 +738,41 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         if (shared >= settings.shared_stored) break;  // membership in 𝕊 is settled
       }
       restore_receiving();
+      int direct = 0;
+      for (const DirectArm& d : direct_arms) {
+        if (d.tool_on_table) {
+          core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                               product.suction_tool_pose);
+        }
+        int stored = 0;
+        for (const Receiving& at_pick : d.picks) {
+          Receiving at_rh;
+          if (!reach_with(*d.arm, d.base_inv, c.board, at_pick.grasp, d.bodies, false, at_rh)) {
+            continue;
+          }
+          db::DirectGraspRecord r;
+          r.candidate_id = ci;
+          r.robot_grasp_id = at_pick.grasp;
+          r.arm = d.arm->spec.name;
+          r.joints_pick = at_pick.joints;
+          r.joints_rh = at_rh.joints;
+          r.inclination_pick_deg = at_pick.slip_deg;
+          r.inclination_rh_deg = at_rh.slip_deg;
+          result.direct.push_back(r);
+          ++direct;
+          if (++stored >= settings.direct_stored) break;
+        }
+        restore_arm(*d.arm);
+        reset_state();
+        place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
+        if (h.second_grasp >= 0) {
+          const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+          place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
+        }
+        data.set_body_pose(scene.board, c.board);
+      }
       reset_state();
-      if (shared == 0) continue;
+      if (shared == 0 && direct == 0) continue;
       // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
       // are coarse, so a bin's Q may come from a neighbouring hand orientation.
       if (verified < settings.human_ik_goals) {
@@ -668,6 +791,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
               std::remove_if(result.shared.begin(), result.shared.end(),
                              [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; }),
               result.shared.end());
+          result.direct.erase(
+              std::remove_if(result.direct.begin(), result.direct.end(),
+                             [&](const db::DirectGraspRecord& r) { return r.candidate_id == ci; }),
+              result.direct.end());
           continue;
         }
         ++verified;
@@ -701,14 +828,30 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
 
   if (!no_candidate_reason().empty()) return finish(no_candidate_reason());
   if (stage.goals == 0) {
-    return finish(
-        "no comfortable candidate shares a grasp with a robot-robot handover pose (|S| = " +
-        std::to_string(stage.comfortable) + ", " + std::to_string(stage.robot_handovers) +
-        " robot-robot poses)");
+    std::string why = "no comfortable candidate (|S| = " + std::to_string(stage.comfortable) + ")";
+    why += exchange_failure.empty() ? " shares a grasp with a robot-robot handover pose (" +
+                                          std::to_string(stage.robot_handovers) +
+                                          " robot-robot poses)"
+                                    : " is reached through an exchange (" + exchange_failure + ")";
+    if (!direct_arms.empty()) {
+      std::string arms;
+      for (const DirectArm& d : direct_arms) {
+        arms += (arms.empty() ? "" : " or ") + d.arm->spec.name;
+      }
+      why += " or by the " + arms + " arm's gripper from where the part lies";
+    } else {
+      why += "; " + direct_failure;
+    }
+    return finish(why);
   }
   // Shared grasps by goal rank.
   std::stable_sort(result.shared.begin(), result.shared.end(),
                    [&](const db::SharedGraspRecord& a, const db::SharedGraspRecord& b) {
+                     return result.candidates[static_cast<std::size_t>(a.candidate_id)].rank <
+                            result.candidates[static_cast<std::size_t>(b.candidate_id)].rank;
+                   });
+  std::stable_sort(result.direct.begin(), result.direct.end(),
+                   [&](const db::DirectGraspRecord& a, const db::DirectGraspRecord& b) {
                      return result.candidates[static_cast<std::size_t>(a.candidate_id)].rank <
                             result.candidates[static_cast<std::size_t>(b.candidate_id)].rank;
                    });

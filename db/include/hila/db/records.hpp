@@ -103,7 +103,7 @@ struct HandoverStageRecord {
   int candidates = 0;   // poses satisfying Eq. 1 (rotation < 45 deg, offset < 0.5 m, no collision)
   int comfortable = 0;  // |S|: best human grasp above the comfort threshold (every body of the set)
   int comfortable_default_body = 0;  // |S| for the cell's own human alone
-  int goals = 0;                     // |𝕊|: members of S with a shared grasp
+  int goals = 0;                     // |𝕊|: members of S with a shared or direct grasp
   int robot_handovers = 0;           // feasible robot-robot handover poses
   bool two_hands = false;            // no one-hand human grasp holds the board
   std::string failure;               // empty when goals > 0, else why there is none
@@ -120,7 +120,8 @@ struct RobotHandoverRecord {
 };
 
 // A sampled robot-human handover pose (Eq. 1) with its evaluation. Status: "uncomfortable" (not
-// in S), "no_shared_grasp" (in S, not in 𝕊), "goal" (in 𝕊; rank is its Eq. 8 position).
+// in S), "no_shared_grasp" (in S, not in 𝕊: no shared nor direct grasp), "goal" (in 𝕊; rank is
+// its Eq. 8 position).
 struct HandoverCandidateRecord {
   std::int64_t id = 0;
   std::int64_t part_id = 0;

@@ -20,14 +20,20 @@ class ArmWorkspace {
   // `board`: the mesh a held board has (nullptr: the arm never holds one).
   // `finished`: parts standing in the cell (static), e.g. core::parts_before(product, index);
   // `stacked`: those still in the stack, e.g. core::parts_after(product, index).
+  // `tool_on_table`: the suction tool's handle pose (world) where it stands on the table, not in
+  // any hand (nullptr: in the suction arm's hand); the suction arm is then a gripper arm.
   ArmWorkspace(const core::Cell& cell, const std::string& arm, const std::string& suction_arm,
                const core::TriangleMesh* board = nullptr,
                const std::vector<core::PlacedPart>& finished = {},
-               const std::vector<core::PlacedPart>& stacked = {});
+               const std::vector<core::PlacedPart>& stacked = {},
+               const core::Pose* tool_on_table = nullptr);
 
+  const core::Cell& cell() const { return cell_; }
   const core::Arm& arm() const { return arm_; }
   int arm_index() const { return arm_index_; }
   bool is_suction_arm() const { return arm_index_ == scene_.suction_arm; }
+  // This arm holds the tool (the suction arm, the tool not standing on the table).
+  bool holds_tool() const { return is_suction_arm() && !tool_on_table_; }
   const core::Pose& base() const { return base_; }
   const core::StageScene& scene() const { return scene_; }
 
@@ -77,6 +83,7 @@ class ArmWorkspace {
   bool holding_ = false;
   Eigen::VectorXd robot_q_;
   Eigen::VectorXd posed_;  // arm joints the scene is posed for
+  bool tool_on_table_ = false;
 };
 
 }  // namespace hila::offline

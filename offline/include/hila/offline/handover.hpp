@@ -55,6 +55,11 @@ struct HandoverSettings {
   // The first goals in Eq. 8 order are confirmed by direct IK of the human arm (best Q over
   // restarts; a candidate failing it leaves S) and carry the human's posture.
   int human_ik_goals = 10;
+  // Direct picks: either arm's gripper takes the part where it lies and holds it at the goal
+  // (no tool, no exchange; the suction arm only with the tool put down on the table). Up to
+  // direct_stored robot grasps per goal and arm are stored.
+  bool direct = true;
+  int direct_stored = 4;
   std::uint64_t seed = 3;
 };
 
@@ -66,6 +71,7 @@ struct HandoverResult {
   std::vector<db::RobotHandoverRecord> robot_handovers;
   std::vector<db::HandoverCandidateRecord> candidates;  // in sample order
   std::vector<db::SharedGraspRecord> shared;            // for the goals, by rank
+  std::vector<db::DirectGraspRecord> direct;            // for the goals, by rank
   double seconds = 0.0;
 };
 
@@ -78,8 +84,9 @@ struct BoardGrasps {
 
 // Handover goals of product.parts[index] at its assembly stage (the parts before it finished at
 // their targets): Eq. 1 candidates, S by the comfort maps, robot-robot handover poses, 𝕊 by
-// shared grasps (receiving-arm IK, slip angle within theta_c and collision-free at both poses),
-// ranked by Eq. 8. Never throws for an infeasible board: stage.failure says why.
+// shared grasps (receiving-arm IK, slip angle within theta_c and collision-free at both poses)
+// and by direct grasps (an arm's gripper picks the part where it lies and holds it at the
+// goal), ranked by Eq. 8. Never throws for an infeasible board: stage.failure says why.
 HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSpec& product,
                                    std::size_t index, const BoardGrasps& grasps,
                                    const HumanComfort& comfort, const HandoverSettings& settings);
