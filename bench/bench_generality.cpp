@@ -287,6 +287,9 @@ struct PartResult {
   double duration = 0.0;
   double path_length = 0.0;
   std::string start_collision;  // the part at its start pose touches this (empty: nothing)
+  std::string way;              // "exchange" or "direct" (delivered parts)
+  std::string delivering_arm;
+  bool tool_in_hand_after = true;  // the suction arm holds the tool after the part
 };
 
 std::string most_frequent_outcome(const online::BoardPlan& plan) {
@@ -349,6 +352,13 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
     return r;
   }
   r.delivered = plan.solved();
+  if (r.delivered) {
+    r.way = online::to_string(plan.mode);
+    r.delivering_arm = plan.delivering_arm;
+    r.tool_in_hand_after = plan.tool_in_hand_after;
+  } else {
+    r.tool_in_hand_after = scene.tool_in_hand;
+  }
   r.status = online::to_string(plan.status);
   r.reason = plan.reason;
   r.plan_s = plan.planning_seconds;
@@ -423,9 +433,10 @@ std::vector<PartResult> plan_all(online::BoardPlanner& planner, const online::Pl
               << (r.delivered && !r.recheck_valid ? "  !!! INVALID" : "")
               << (r.start_collision.empty() ? "" : "  [start touches " + r.start_collision + "]")
               << std::endl;
+    const bool tool_in_hand = r.tool_in_hand_after;
     results.push_back(std::move(r));
     scene = scene.with_finished(model.product(), part.name);
-    scene.tool_in_hand = true;
+    scene.tool_in_hand = tool_in_hand;
     for (const auto& arm : model.cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
   }
   return results;

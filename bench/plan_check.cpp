@@ -79,7 +79,8 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       if (c.id == plan.suction_grasp_id) cup = c;
     }
   }
-  if (!grasp || !cup) {
+  const bool exchange = plan.mode == online::DeliveryMode::kExchange;
+  if (!grasp || (exchange && !cup)) {
     problem(plan.board, "the plan's robot or suction grasp is not in the database");
     return out;
   }
@@ -94,7 +95,8 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
   const core::Arm& receiving = cell.arms()[stage.suction_arm == 0 ? 1u : 0u];
 
   // The board in each hand, and the slip of the gripper's hold (the cup has no slip limit).
-  const core::Pose board_in_cup_tcp = stage.cup_in_tcp * cup->cup.inverse();
+  const core::Pose board_in_cup_tcp =
+      cup ? stage.cup_in_tcp * cup->cup.inverse() : core::Pose::Identity();
   const core::Pose board_in_gripper_tcp = grasp->tcp.inverse();
   const Eigen::Vector3d opening = cell.spec().gripper.opening_axis.normalized();
   const Eigen::Vector3d lever_part = core::lever_direction(
@@ -111,14 +113,15 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     if (it != scene.robot.end()) cell.set_arm(robot_q, arm, it->second);
   }
   bool tool_in_hand = scene.tool_in_hand;
-  bool on_cup = false, in_gripper = false, handed_over = false;
+  bool on_cup = false, handed_over = false;
+  const core::Arm* in_gripper = nullptr;  // the arm whose gripper holds the board
   core::Pose board_world = scene.initial_pose(part);  // while neither hand holds it
   auto tcp_of = [&](const core::Arm& arm) {
     return core::arm_base_in_world(cell, arm) * arm.chain.fk(cell.arm_joints(robot_q, arm));
   };
   auto board_now = [&]() {
     if (on_cup) return tcp_of(suction) * board_in_cup_tcp;
-    if (in_gripper) return tcp_of(receiving) * board_in_gripper_tcp;
+    if (in_gripper) return tcp_of(*in_gripper) * board_in_gripper_tcp;
     return board_world;
   };
 
@@ -149,11 +152,11 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         board_world = board_now();
         on_cup = false;
       } else if (e == "gripper_open") {
-        if (arm != &receiving || !in_gripper) problem(where, "gripper opens without the board");
+        if (arm != in_gripper) problem(where, "gripper opens without the board");
         board_world = board_now();
-        in_gripper = false;
+        in_gripper = nullptr;
         handed_over = true;
-        cell.set_jaw(robot_q, receiving, cell.spec().gripper.jaw_max);
+        cell.set_jaw(robot_q, *arm, cell.spec().gripper.jaw_max);
       }
     }
 
@@ -170,10 +173,11 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     motion.time = step.time;
     motion.q = step.q;
     motion.robot_q = robot_q;
-    motion.holds_board = arm == &suction ? on_cup : in_gripper;
+    const bool holds_on_cup = arm == &suction && on_cup;
+    motion.holds_board = holds_on_cup || arm == in_gripper;
     if (motion.holds_board) {
-      motion.board_in_tcp = arm == &suction ? board_in_cup_tcp : board_in_gripper_tcp;
-      if (arm == &receiving) {
+      motion.board_in_tcp = holds_on_cup ? board_in_cup_tcp : board_in_gripper_tcp;
+      if (!holds_on_cup) {
         motion.slip_axis_tcp = opening;
         motion.slip_lever_tcp = lever_tcp;
         motion.theta_c_deg = grasp->theta_c_deg;
@@ -207,7 +211,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         cell.set_jaw(robot_q, suction, cell.spec().suction.handle_width);
         lifting = true;
       } else if (e == "suction_on") {
-        if (arm != &suction || !tool_in_hand || on_cup || in_gripper || handed_over) {
+        if (arm != &suction || !tool_in_hand || on_cup || in_gripper != nullptr || handed_over) {
           problem(where, "suction on without the tool or with the board already taken");
         }
         const std::string off = pose_error(tcp_of(suction) * board_in_cup_tcp, board_world);
@@ -215,15 +219,23 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         on_cup = true;
         lifting = true;
       } else if (e == "gripper_close") {
-        if (arm != &receiving || !on_cup) problem(where, "closes without the board on the cup");
-        const std::string off = pose_error(tcp_of(receiving) * board_in_gripper_tcp, board_now());
+        const std::string off = pose_error(tcp_of(*arm) * board_in_gripper_tcp, board_now());
         if (!off.empty()) problem(where, "the gripper closes " + off + " the board");
-        const std::string at = pose_error(board_now(), plan.robot_handover);
-        if (!at.empty()) problem(where, "the exchange is " + at + " the plan's robot-robot pose");
-        in_gripper = true;
-        cell.set_jaw(robot_q, receiving, holding_jaw);
+        if (on_cup) {  // the exchange: from the suction arm's cup to the other arm's gripper
+          if (arm == &suction) problem(where, "the suction arm closes on the board on its cup");
+          const std::string at = pose_error(board_now(), plan.robot_handover);
+          if (!at.empty()) problem(where, "the exchange is " + at + " the plan's robot-robot pose");
+        } else {  // a direct pick where the board lies
+          if (exchange || in_gripper != nullptr || handed_over) {
+            problem(where, "closes on a board that is not standing where it was detected");
+          }
+          if (arm == &suction && tool_in_hand) problem(where, "closes a gripper holding the tool");
+          lifting = true;
+        }
+        in_gripper = arm;
+        cell.set_jaw(robot_q, *arm, holding_jaw);
       } else if (e == "wait_for_human") {
-        if (!in_gripper || on_cup) problem(where, "waits for the human without the board");
+        if (in_gripper != arm || on_cup) problem(where, "waits for the human without the board");
         const std::string at = pose_error(board_now(), plan.human_handover);
         if (!at.empty()) problem(where, "presents the board " + at + " the robot-human pose");
       } else {

@@ -86,7 +86,10 @@ void ArmMotionPlanner::prepare(const MotionRequest& request) {
                          : held_.held        ? settings_.held_resolution
                                              : roadmap_.record.resolution,
                          roadmap_.record.resolution);
-  if (held_.held && arm_index_ != stage.suction_arm) cell.set_jaw(robot_q_, arm_, held_.jaw);
+  // A held board is on the cup of the arm holding the tool, else in the gripper's jaws.
+  if (held_.held && !(request.tool_in_hand && arm_index_ == stage.suction_arm)) {
+    cell.set_jaw(robot_q_, arm_, held_.jaw);
+  }
   moves_tool_ = request.tool_in_hand && arm_index_ == stage.suction_arm;
   moving_ = stage.cell.arm_bodies[static_cast<std::size_t>(arm_index_)];
   if (moves_tool_)

@@ -68,6 +68,16 @@ core::Pose shifted(const core::Pose& pose, const Eigen::Vector3d& by) {
 
 }  // namespace
 
+const char* to_string(DeliveryMode mode) {
+  switch (mode) {
+    case DeliveryMode::kExchange:
+      return "exchange";
+    case DeliveryMode::kDirect:
+      return "direct";
+  }
+  return "?";
+}
+
 const char* to_string(BoardPlanStatus status) {
   switch (status) {
     case BoardPlanStatus::kSolved:
@@ -364,6 +374,9 @@ class Run {
     visit(releases_);
     visit(presents_);
     visit(leaves_);
+    visit(gripper_picks_);
+    visit(direct_presents_);
+    visit(direct_leaves_);
   }
 
   // Drops the memoised stages `which` picks, to be planned again when next asked for.
@@ -380,8 +393,9 @@ class Run {
     return it == node_by_id_.end() ? nullptr : it->second;
   }
 
-  const std::vector<bool>* filter_for(const std::string& kind, std::int64_t id) const {
-    const auto it = filters_.find({kind, id});
+  const std::vector<bool>* filter_for(const core::Arm& arm, const std::string& kind,
+                                      std::int64_t id) const {
+    const auto it = filters_.find({arm.spec.name, kind, id});
     return it == filters_.end() ? nullptr : &it->second;
   }
 
@@ -722,8 +736,8 @@ class Run {
     check.tool_in_hand = stage.end.tool_in_hand;
     check.tool_world = scene_.tool;
     check.start_in_contact = request.start_in_contact;
-    if (request.held.held && &arm == &receiving_) {
-      cell_.set_jaw(check.robot_q, arm, request.held.jaw);
+    if (request.held.held && !(&arm == &suction_ && stage.end.tool_in_hand)) {
+      cell_.set_jaw(check.robot_q, arm, request.held.jaw);  // in the gripper, not on the cup
     }
     return check;
   }
@@ -936,7 +950,7 @@ class Run {
     if (!rr_q) return "transfer_to_robot_handover: no valid IK at the robot-robot pose";
     carry.start = up;
     carry.goal = *rr_q;
-    carry.filter = filter_for("suction", cup.id);
+    carry.filter = filter_for(suction_, "suction", cup.id);
     carry.hints = paths_of(stored);
     return step(st, suction_planner_, suction_, carry, "transfer_to_robot_handover", "", "");
   }
@@ -1057,10 +1071,20 @@ class Run {
   // exchange check), under `request`; nothing when the grasp can only be reached directly.
   std::optional<Eigen::VectorXd> pre_grasp(const Stage& st, const MotionRequest& request,
                                            const Eigen::VectorXd& grasp_q) {
-    first_valid(st, receiving_planner_, request, {});
-    return core::find_pre_grasp(
-        cell_, receiving_, grasp_q, settings_.approach, settings_.validator.resolution,
-        [&](const Eigen::VectorXd& q) { return receiving_planner_.valid(q); });
+    return pre_grasp(st, receiving_, request, grasp_q);
+  }
+  std::optional<Eigen::VectorXd> pre_grasp(const Stage& st, const core::Arm& arm,
+                                           const MotionRequest& request,
+                                           const Eigen::VectorXd& grasp_q) {
+    ArmMotionPlanner& planner = planner_of(arm);
+    first_valid(st, planner, request, {});
+    return core::find_pre_grasp(cell_, arm, grasp_q, settings_.approach,
+                                settings_.validator.resolution,
+                                [&](const Eigen::VectorXd& q) { return planner.valid(q); });
+  }
+
+  ArmMotionPlanner& planner_of(const core::Arm& arm) {
+    return &arm == &suction_ ? suction_planner_ : receiving_planner_;
   }
 
   // The receiving arm to `grasp_q` at the exchange: an approach from behind the grasp where the
@@ -1188,7 +1212,7 @@ class Run {
     }
     present.start = grasp_q;
     present.goal = *rh_q;
-    present.filter = filter_for("gripper", grasp.id);
+    present.filter = filter_for(receiving_, "gripper", grasp.id);
     present.hints = paths_of(stored);
     if (auto e = step(st, receiving_planner_, receiving_, present, "transfer_to_human", "",
                       "wait_for_human");
@@ -1228,35 +1252,42 @@ class Run {
     if (found != leaves_.end()) return found->second;
     Stage& st = leaves_[key];
     st.end = present(rr, grasp, goal).end;
-    cell_.set_jaw(st.end.robot_q, receiving_, cell_.spec().gripper.jaw_max);
-    const Eigen::VectorXd rh_q = arm_q(st, receiving_);
+    const Stage& presented = present(rr, grasp, goal);
+    const Stage& received = receive(rr, grasp);
+    st.failure = retreat(st, receiving_, goal, "receiving_arm_home",
+                         {{&presented, kWayBackSteps[0]},
+                          {&received, kWayBackSteps[1]},
+                          {&received, kWayBackSteps[2]}});
+    return st;
+  }
+
+  // After the human takes the board (wrist F/T): the gripper opens, `arm` backs off the way a
+  // gripper would come in (the offline search required one at this pose) and goes home. The
+  // reason when it fails.
+  // `way_back`: steps (of stages, by name) whose paths, reversed, lead the arm home where its
+  // retreat attaches to no roadmap node: from beside the human's hands a straight segment often
+  // reaches no roadmap node, while the arm's own way in, now empty-handed, is clear for a while.
+  std::string retreat(Stage& st, const core::Arm& arm, const db::HandoverCandidateRecord& goal,
+                      const std::string& home_step,
+                      const std::vector<std::pair<const Stage*, std::string_view>>& way_back_of) {
+    ArmMotionPlanner& planner = planner_of(arm);
+    cell_.set_jaw(st.end.robot_q, arm, cell_.spec().gripper.jaw_max);
+    const Eigen::VectorXd rh_q = arm_q(st, arm);
     MotionRequest release;
     release.board_world = goal.board;
-    // Out the way a gripper would come in (the offline search required one at this pose).
-    const auto away = pre_grasp(st, release, rh_q);
-    if (!away) {
-      st.failure = "release_retreat: no clear way back from the robot-human pose";
-      return st;
-    }
+    const auto away = pre_grasp(st, arm, release, rh_q);
+    if (!away) return "release_retreat: no clear way back from the robot-human pose";
     release.start = rh_q;
     release.goal = *away;
-    if (auto e = step(st, receiving_planner_, receiving_, release, "release_retreat",
-                      "gripper_open", "");
+    if (auto e = step(st, planner, arm, release, "release_retreat", "gripper_open", "");
         !e.empty()) {
-      st.failure = e;
-      return st;
+      return e;
     }
     release.start = *away;
-    release.goal = receiving_.spec.home;
-    // The way the arm came, backwards (transfer to the human, grasp, approach), as a stored path
-    // that leads into the roadmap: from beside the human's hands a straight segment often
-    // reaches no roadmap node, while the arm's own way in, now empty-handed, is clear for a
-    // while.
+    release.goal = arm.spec.home;
     // Asked for only where the retreat attaches to no roadmap node (late_hints): a queued
     // step's smoothing is then waited for, not done on this thread for every board.
     std::vector<Eigen::VectorXd> way_back;
-    const Stage& presented = present(rr, grasp, goal);
-    const Stage& received = receive(rr, grasp);
     // As executed (resampled as timed).
     const auto add_reversed = [&](const Stage& from, std::string_view name) {
       for (std::size_t i = 0; i < from.steps.size(); ++i) {
@@ -1272,19 +1303,169 @@ class Run {
     if (settings_.way_back_spacing > 0.0) {
       release.late_hints = [&]() -> Hints {
         way_back.clear();  // asked again by a re-plan of the same step
-        add_reversed(presented, kWayBackSteps[0]);
-        add_reversed(received, kWayBackSteps[1]);
-        add_reversed(received, kWayBackSteps[2]);
+        for (const auto& [from, name] : way_back_of) add_reversed(*from, name);
         return way_back.size() > 1 ? Hints{&way_back} : Hints{};
       };
     }
     // Only where the retreat attaches to no roadmap node: mostly the roadmap's way is shorter.
     release.follow_hints = false;
     // The board is the human's now; it no longer stands where the arm goes home.
-    if (auto e = step(st, receiving_planner_, receiving_, release, "receiving_arm_home", "", "");
+    return step(st, planner, arm, release, home_step, "", "");
+  }
+
+  // --- The direct way: one arm's gripper picks the board where it lies and delivers it ------
+ public:
+
+  // The whole direct chain for one goal and direct grasp: pick, present, retreat.
+  std::string direct_chain(const db::HandoverCandidateRecord& goal,
+                           const db::DirectGraspRecord& direct, std::vector<PlanStep>& steps,
+                           ArmsState& end) {
+    const auto grasp_it = robot_grasps_.find(direct.robot_grasp_id);
+    const core::Arm* arm = arm_named(direct.arm);
+    if (grasp_it == robot_grasps_.end() || arm == nullptr) {
+      return "the database's direct grasp refers to a missing record";
+    }
+    const db::RobotGraspRecord& grasp = grasp_it->second;
+    const Stage* stages[3] = {};
+    const auto plan_stages = [&] {
+      stages[0] = &gripper_pick(*arm, grasp, direct);
+      if (stages[0]->ok()) stages[1] = &direct_present(*arm, grasp, goal, direct);
+      if (stages[1] != nullptr && stages[1]->ok()) {
+        stages[2] = &direct_leave(*arm, grasp, goal, direct);
+      }
+    };
+    plan_stages();
+    if (!settle(stages)) {
+      forget([](const Stage& st) { return st.rejected_late; });
+      const bool speculating = speculate_;
+      speculate_ = false;
+      std::fill(std::begin(stages), std::end(stages), nullptr);
+      plan_stages();
+      speculate_ = speculating;
+    }
+    double clock = 0.0;
+    for (const Stage* stage : stages) {
+      if (stage == nullptr) break;
+      if (!stage->ok()) return stage->failure;
+      for (PlanStep s : stage->steps) {
+        for (double& t : s.time) t += clock;
+        steps.push_back(std::move(s));
+      }
+      if (!steps.empty()) clock = steps.back().time.back();
+      end = stage->end;
+    }
+    return "";
+  }
+
+ private:
+  const core::Arm* arm_named(const std::string& name) const {
+    if (name == suction_.spec.name) return &suction_;
+    if (name == receiving_.spec.name) return &receiving_;
+    return nullptr;
+  }
+
+  // The gripper's pick at the detected pose: the open gripper from a pre-grasp (approach) to the
+  // grasp, closed, and the lift straight up. A branch whose way in, grasp and lift are valid;
+  // the build's branch first.
+  const Stage& gripper_pick(const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                            const db::DirectGraspRecord& direct) {
+    const auto key = std::make_pair(arm.spec.name, grasp.id);
+    const auto found = gripper_picks_.find(key);
+    if (found != gripper_picks_.end()) return found->second;
+    Stage& st = gripper_picks_[key];
+    st.end = start_;
+    if (&arm == &suction_ && st.end.tool_in_hand) {
+      st.failure = "gripper_pick: the " + arm.spec.name + " arm holds the suction tool";
+      return st;
+    }
+    ArmMotionPlanner& planner = planner_of(arm);
+    const core::Pose tcp = board_initial_ * grasp.tcp;
+    const core::Pose lifted = shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift));
+    MotionRequest standing;
+    standing.board_world = board_initial_;
+    MotionRequest carry;
+    carry.held = in_gripper(grasp);
+    const Eigen::VectorXd now = arm_q(st, arm);
+    std::optional<Eigen::VectorXd> at, before, up;
+    for (const auto& q : solutions(cell_, arm, tcp, now, &direct.joints_pick)) {
+      if (!first_valid(st, planner, standing, {q})) continue;
+      const auto pre = pre_grasp(st, arm, standing, q);
+      const auto l = solutions(cell_, arm, lifted, q);
+      if (!pre || l.empty()) continue;
+      Stage holding = st;
+      cell_.set_jaw(holding.end.robot_q, arm, jaw_for(grasp));
+      if (!first_valid(holding, planner, carry, {l.front()})) continue;
+      at = q;
+      before = *pre;
+      up = l.front();
+      break;
+    }
+    if (!at) {
+      st.failure =
+          "gripper_pick: no IK branch with a way in, a valid grasp and lift at the detected board "
+          "pose";
+      return st;
+    }
+    MotionRequest r = standing;
+    r.start = now;
+    r.goal = *before;
+    if (auto e = step(st, planner, arm, r, "gripper_approach", "", ""); !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    r.start = *before;
+    r.goal = *at;
+    if (auto e = step(st, planner, arm, r, "gripper_grasp", "", "gripper_close"); !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    cell_.set_jaw(st.end.robot_q, arm, jaw_for(grasp));
+    carry.start = *at;
+    carry.goal = *up;
+    carry.start_in_contact = true;  // the board still rests where it was detected
+    if (auto e = step(st, planner, arm, carry, "lift", "", ""); !e.empty()) st.failure = e;
+    return st;
+  }
+
+  // The slip-constrained transfer from the lift to the robot-human pose.
+  const Stage& direct_present(const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                              const db::HandoverCandidateRecord& goal,
+                              const db::DirectGraspRecord& direct) {
+    const auto key = std::make_tuple(arm.spec.name, grasp.id, goal.id);
+    const auto found = direct_presents_.find(key);
+    if (found != direct_presents_.end()) return found->second;
+    Stage& st = direct_presents_[key];
+    st.end = gripper_pick(arm, grasp, direct).end;
+    ArmMotionPlanner& planner = planner_of(arm);
+    MotionRequest present;
+    present.held = in_gripper(grasp);
+    const Eigen::VectorXd up = arm_q(st, arm);
+    const auto rh_q = first_valid(
+        st, planner, present, solutions(cell_, arm, goal.board * grasp.tcp, up, &direct.joints_rh));
+    if (!rh_q) {
+      st.failure = kNoHumanPoseIk;
+      return st;
+    }
+    present.start = up;
+    present.goal = *rh_q;
+    present.filter = filter_for(arm, "gripper", grasp.id);
+    if (auto e = step(st, planner, arm, present, "transfer_to_human", "", "wait_for_human");
         !e.empty()) {
       st.failure = e;
     }
+    return st;
+  }
+
+  const Stage& direct_leave(const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                            const db::HandoverCandidateRecord& goal,
+                            const db::DirectGraspRecord& direct) {
+    const auto key = std::make_tuple(arm.spec.name, grasp.id, goal.id);
+    const auto found = direct_leaves_.find(key);
+    if (found != direct_leaves_.end()) return found->second;
+    Stage& st = direct_leaves_[key];
+    const Stage& presented = direct_present(arm, grasp, goal, direct);
+    st.end = presented.end;
+    st.failure = retreat(st, arm, goal, "arm_home", {{&presented, kWayBackSteps[0]}});
     return st;
   }
 
@@ -1299,7 +1480,7 @@ class Run {
   const std::map<std::int64_t, db::RobotGraspRecord>& robot_grasps_;
   const std::map<std::int64_t, db::SuctionGraspRecord>& suction_grasps_;
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers_;
-  const std::map<std::pair<std::string, std::int64_t>, std::vector<bool>>& filters_;
+  const std::map<std::tuple<std::string, std::string, std::int64_t>, std::vector<bool>>& filters_;
   const std::map<std::int64_t, const db::RegraspNodeRecord*>& node_by_id_;
   const std::vector<db::RegraspEdgeRecord>& edges_;
   World world_;
@@ -1335,6 +1516,10 @@ class Run {
   std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, Stage> presents_;
   std::map<std::pair<std::int64_t, std::int64_t>, bool> human_reach_;  // by (grasp, goal)
   std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, Stage> leaves_;
+  // The direct way's, by (arm, robot grasp) and (arm, robot grasp, goal).
+  std::map<std::pair<std::string, std::int64_t>, Stage> gripper_picks_;
+  std::map<std::tuple<std::string, std::int64_t, std::int64_t>, Stage> direct_presents_;
+  std::map<std::tuple<std::string, std::int64_t, std::int64_t>, Stage> direct_leaves_;
 };
 
 }  // namespace
@@ -1377,7 +1562,11 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   }
   Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
   running = &run;
-  // Payload: the suction arm carries the board on the tool, the receiving arm in its jaws.
+  // Payload. The exchange: the suction arm carries the board on the tool, the receiving arm in
+  // its jaws. A direct pick: the picking arm in its jaws. A way over an arm's payload is not
+  // tried; with none left, the status says so.
+  std::string over_payload;
+  bool exchange_within_payload = true;
   for (const auto& check :
        {core::check_payload(run.suction_arm().spec.name, run.suction_arm().spec.payload, part->mass,
                             core::CarryMode::kSuction, model_.cell().spec().suction.mass),
@@ -1385,8 +1574,23 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                             part->mass, core::CarryMode::kGripper,
                             model_.cell().spec().suction.mass)}) {
     if (!check.within_allowed()) {
-      return finish(BoardPlanStatus::kOverPayload, "over the payload: " + check.describe());
+      exchange_within_payload = false;
+      if (over_payload.empty()) over_payload = "over the payload: " + check.describe();
     }
+  }
+  std::set<std::string> direct_within_payload;
+  for (const core::Arm* arm : {&run.receiving_arm(), &run.suction_arm()}) {
+    const auto check = core::check_payload(arm->spec.name, arm->spec.payload, part->mass,
+                                           core::CarryMode::kGripper,
+                                           model_.cell().spec().suction.mass);
+    if (check.within_allowed()) {
+      direct_within_payload.insert(arm->spec.name);
+    } else if (over_payload.empty()) {
+      over_payload = "over the payload: " + check.describe();
+    }
+  }
+  if (!exchange_within_payload && direct_within_payload.empty()) {
+    return finish(BoardPlanStatus::kOverPayload, over_payload);
   }
   // At the stance the goals were built for, their stored Q is the scene human's (the same
   // lookup); elsewhere the comfort maps are looked up again.
@@ -1471,12 +1675,58 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   };
   if (goals.empty() && !records->goals.empty()) return human_out_of_reach();
   bool any_connected_offline = false;
-  // One chain of a goal under the round's budgets; true when it is planned (result filled in).
+  // What both ways fill in once a chain of a goal is planned.
+  auto planned = [&](const db::HandoverCandidateRecord& goal, std::int64_t robot_grasp_id,
+                     std::vector<PlanStep>& steps, const ArmsState& end) {
+    result.steps = std::move(steps);
+    result.goal_rank = goal.rank;
+    result.candidate_id = goal.id;
+    result.robot_grasp_id = robot_grasp_id;
+    result.theta_c_deg = run.robot_grasps().at(robot_grasp_id).theta_c_deg;
+    result.quality = worker_quality.at(goal.id);
+    const auto& posture = reach_of.at(goal.id);
+    result.human_arm = goal.human_arm;
+    result.human_joints = posture.joints;
+    result.second_human_arm = goal.second_arm;
+    result.second_human_joints = posture.second_joints;
+    result.human_handover = goal.board;
+    result.duration = result.steps.back().time.back();
+    for (const auto& st : result.steps) result.path_length += st.path_length;
+    result.validated = true;
+    result.robot_q_after = end.robot_q;
+    result.tool_in_hand_after = end.tool_in_hand;
+  };
+  // One direct chain of a goal; true when it is planned (result filled in).
+  auto try_direct = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
+                        const db::DirectGraspRecord& d) {
+    GoalAttempt attempt;
+    attempt.rank = goal.rank;
+    attempt.candidate_id = goal.id;
+    attempt.mode = DeliveryMode::kDirect;
+    attempt.arm = d.arm;
+    attempt.robot_grasp_id = d.robot_grasp_id;
+    std::vector<PlanStep> steps;
+    ArmsState end;
+    const std::string failure = run.direct_chain(goal, d, steps, end);
+    attempt.outcome = failure.empty() ? "planned" : round + failure;
+    result.attempts.push_back(attempt);
+    if (!failure.empty()) return false;
+    planned(goal, d.robot_grasp_id, steps, end);
+    result.mode = DeliveryMode::kDirect;
+    result.picking_arm = d.arm;
+    result.delivering_arm = d.arm;
+    result.suction_grasp_id = 0;
+    return true;
+  };
+  // One exchange chain of a goal under the round's budgets; true when it is planned (result
+  // filled in).
   auto try_shared = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
                         const db::SharedGraspRecord& s) {
     GoalAttempt attempt;
     attempt.rank = goal.rank;
     attempt.candidate_id = goal.id;
+    attempt.mode = DeliveryMode::kExchange;
+    attempt.arm = run.receiving_arm().spec.name;
     attempt.robot_grasp_id = s.robot_grasp_id;
     attempt.robot_handover_id = s.robot_handover_id;
     std::vector<PlanStep> steps;
@@ -1486,24 +1736,12 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
     const auto& rr = run.handovers().at(s.robot_handover_id);
-    result.steps = std::move(steps);
-    result.goal_rank = goal.rank;
-    result.candidate_id = goal.id;
-    result.robot_grasp_id = s.robot_grasp_id;
+    planned(goal, s.robot_grasp_id, steps, end);
+    result.mode = DeliveryMode::kExchange;
+    result.picking_arm = run.suction_arm().spec.name;
+    result.delivering_arm = run.receiving_arm().spec.name;
     result.suction_grasp_id = rr.suction_grasp_id;
-    result.theta_c_deg = run.robot_grasps().at(s.robot_grasp_id).theta_c_deg;
-    result.quality = worker_quality.at(goal.id);
-    const auto& posture = reach_of.at(goal.id);
-    result.human_arm = goal.human_arm;
-    result.human_joints = posture.joints;
-    result.second_human_arm = goal.second_arm;
-    result.second_human_joints = posture.second_joints;
     result.robot_handover = rr.board;
-    result.human_handover = goal.board;
-    result.duration = result.steps.back().time.back();
-    for (const auto& st : result.steps) result.path_length += st.path_length;
-    result.validated = true;
-    result.robot_q_after = end.robot_q;
     return true;
   };
   // Every goal in order under the round's budgets; true when one is planned (result filled in).
@@ -1516,6 +1754,16 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
         best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal.id]);
         continue;
       }
+      // The direct ways first: a third of the exchange's motions.
+      if (const auto direct = records->direct_grasps.find(goal.id);
+          direct != records->direct_grasps.end()) {
+        for (const auto& d : direct->second) {
+          if (std::chrono::steady_clock::now() >= deadline) return false;
+          if (direct_within_payload.count(d.arm) == 0) continue;
+          if (try_direct(round, goal, d)) return true;
+        }
+      }
+      if (!exchange_within_payload) continue;
       // The shared grasps the offline regrasp graph connected for this goal first: their
       // stored paths and IK branches are what the motions re-validate.
       std::vector<db::SharedGraspRecord> shared = records->shared_grasps.at(goal.id);

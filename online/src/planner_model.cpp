@@ -40,13 +40,18 @@ PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::Product
     auto& b = *(boards_[part.name] = std::make_unique<BoardRecords>());
     b.part = part;
     b.goals = database_.handover_goals(part.id);
-    for (const auto& goal : b.goals) b.shared_grasps[goal.id] = database_.shared_grasps(goal.id);
+    for (const auto& goal : b.goals) {
+      b.shared_grasps[goal.id] = database_.shared_grasps(goal.id);
+      b.direct_grasps[goal.id] = database_.direct_grasps(goal.id);
+    }
     for (auto& g : database_.robot_grasps(part.id)) b.robot_grasps[g.id] = std::move(g);
     for (auto& g : database_.suction_grasps(part.id)) b.suction_grasps[g.id] = std::move(g);
     for (auto& g : database_.human_grasps(part.id)) b.human_grasps[g.id] = std::move(g);
     for (auto& h : database_.robot_handovers(part.id)) b.robot_handovers[h.id] = std::move(h);
+    std::map<std::int64_t, std::string> arm_of_roadmap;
+    for (const auto& m : database_.roadmaps()) arm_of_roadmap[m.id] = m.arm;
     for (auto& f : database_.roadmap_filters(part.id)) {
-      b.filters[{f.grasp_kind, f.grasp_id}] = std::move(f.edges);
+      b.filters[{arm_of_roadmap[f.roadmap_id], f.grasp_kind, f.grasp_id}] = std::move(f.edges);
     }
     b.regrasp_nodes = database_.regrasp_nodes(part.id);
     for (const auto& n : b.regrasp_nodes) b.node_by_id[n.id] = &n;

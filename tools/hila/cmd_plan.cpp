@@ -34,6 +34,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
   for (const auto& a : plan.attempts) {
     attempts.push_back({{"rank", a.rank},
                         {"candidate", a.candidate_id},
+                        {"mode", online::to_string(a.mode)},
+                        {"arm", a.arm},
                         {"robot_grasp", a.robot_grasp_id},
                         {"robot_handover", a.robot_handover_id},
                         {"outcome", a.outcome}});
@@ -67,6 +69,20 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                       {"goals_out_of_reach", plan.goals_out_of_reach},
                       {"goals_uncomfortable", plan.goals_uncomfortable}};
   if (plan.solved()) {
+    // The way: who picks and how, the exchanges (from the cup to the other arm's gripper), who
+    // delivers.
+    nlohmann::json exchanges = nlohmann::json::array();
+    if (plan.mode == online::DeliveryMode::kExchange) {
+      exchanges.push_back({{"from", plan.picking_arm},
+                           {"to", plan.delivering_arm},
+                           {"board", pose_to_json(plan.robot_handover)}});
+    }
+    j["mode"] = {{"way", online::to_string(plan.mode)},
+                 {"pick",
+                  {{"arm", plan.picking_arm},
+                   {"by", plan.mode == online::DeliveryMode::kDirect ? "gripper" : "suction"}}},
+                 {"exchanges", exchanges},
+                 {"delivered_by", plan.delivering_arm}};
     j["goal_rank"] = plan.goal_rank;
     j["candidate"] = plan.candidate_id;
     j["robot_grasp"] = plan.robot_grasp_id;
@@ -81,7 +97,9 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
     if (!plan.second_human_arm.empty())
       posture[plan.second_human_arm] = joints(plan.second_human_joints);
     j["human_posture_rad"] = posture;
-    j["robot_handover"] = pose_to_json(plan.robot_handover);
+    if (plan.mode == online::DeliveryMode::kExchange) {
+      j["robot_handover"] = pose_to_json(plan.robot_handover);
+    }
     j["human_handover"] = pose_to_json(plan.human_handover);
     j["duration_s"] = plan.duration;
     j["path_length_rad"] = plan.path_length;
@@ -169,7 +187,7 @@ int run_plan(const PlanOptions& opt) {
     // finished, so one failure does not hide whether the rest can be planned.
     if (!plan.solved()) ++failed;
     scene = scene.with_finished(model->product(), board);
-    scene.tool_in_hand = true;
+    if (plan.solved()) scene.tool_in_hand = plan.tool_in_hand_after;
     for (const auto& arm : model->cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
   }
   if (!opt.output.empty()) write_atomically(opt.output, out.dump(1) + "\n");

@@ -70,12 +70,20 @@ struct PlanStep {
   ValidationReport validation;
 };
 
-// A handover goal tried, and why it was left.
+// How the board reaches the human. kExchange: the suction arm picks it with the tool, hands it
+// to the other arm's gripper at a robot-robot pose, and that arm delivers it. kDirect: one arm's
+// gripper picks it where it lies and delivers it (no tool, no exchange).
+enum class DeliveryMode { kExchange, kDirect };
+const char* to_string(DeliveryMode mode);
+
+// A handover goal tried by one way, and why it was left.
 struct GoalAttempt {
   int rank = -1;
   std::int64_t candidate_id = 0;
+  DeliveryMode mode = DeliveryMode::kExchange;
+  std::string arm;  // the delivering arm
   std::int64_t robot_grasp_id = 0;
-  std::int64_t robot_handover_id = 0;
+  std::int64_t robot_handover_id = 0;  // 0 for a direct pick
   std::string outcome;  // "planned" or the reason
 };
 
@@ -109,8 +117,13 @@ struct BoardPlan {
   std::string board;
   int goal_rank = -1;
   std::int64_t candidate_id = 0;
+  // The way chosen: who picks the board and how, the exchange (kExchange only: from the picking
+  // arm's cup to the delivering arm's gripper at robot_handover) and who delivers it.
+  DeliveryMode mode = DeliveryMode::kExchange;
+  std::string picking_arm;
+  std::string delivering_arm;
   std::int64_t robot_grasp_id = 0;
-  std::int64_t suction_grasp_id = 0;
+  std::int64_t suction_grasp_id = 0;  // 0 for a direct pick
   double theta_c_deg = 90.0;
   double quality = 0.0;  // the comfort Q of the scene's human at the goal (paper Eq. 4)
   // Stored goals the scene's human reaches only uncomfortably (tried after the comfortable ones)
@@ -122,7 +135,7 @@ struct BoardPlan {
   // built). Empty second arm for a one-hand goal.
   std::string human_arm, second_human_arm;
   Eigen::VectorXd human_joints, second_human_joints;
-  core::Pose robot_handover = core::Pose::Identity();  // board poses (world)
+  core::Pose robot_handover = core::Pose::Identity();  // board poses (world); kExchange only
   core::Pose human_handover = core::Pose::Identity();
   std::vector<PlanStep> steps;
   std::vector<GoalAttempt> attempts;
@@ -141,17 +154,20 @@ struct BoardPlan {
   // no clock on a shared machine measures it.
   int motions_planned = 0;
   Eigen::VectorXd robot_q_after;  // the robot when the board has been taken
+  bool tool_in_hand_after = false;  // the suction arm still holds the tool then
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };
 
-// Plans everything the robot does for one board (DESIGN §2): the tool pick when the scene has
-// it on the table, the suction pick at the detected pose with its approach and lift, the
-// transfer to the robot-robot pose, the receiving arm's approach and grasp, the suction arm's
-// release and retreat, the slip-constrained transfer to the robot-human pose and the retreat
-// after the human takes it. Goals in Eq. 8 order; each motion through the stored roadmaps
-// repaired for the scene; every step timed and re-checked by the validator: nothing invalid is
-// returned. Failing pieces shared by several goals (a cup's pick, a transfer to a robot-robot
-// pose) are planned once per call. One per thread.
+// Plans everything the robot does for one board (DESIGN §2). Goals in Eq. 8 order; for each,
+// the direct ways first (fewer motions: an arm's gripper picks the board where it lies, carries
+// it to the robot-human pose within its slip limit and retreats after the human takes it), then
+// the exchange (the tool pick when the scene has it on the table, the suction pick at the
+// detected pose with its approach and lift, the transfer to the robot-robot pose, the receiving
+// arm's approach and grasp, the suction arm's release and retreat, the slip-constrained transfer
+// to the robot-human pose and the retreat). Each motion through the stored roadmaps repaired
+// for the scene; every step timed and re-checked by the validator: nothing invalid is returned.
+// Failing pieces shared by several goals (a cup's pick, a transfer to a robot-robot pose, a
+// gripper's pick) are planned once per call. One per thread.
 class BoardPlanner {
  public:
   explicit BoardPlanner(const PlannerModel& model, const BoardPlanSettings& settings = {});

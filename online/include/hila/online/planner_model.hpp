@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -22,11 +23,13 @@ struct BoardRecords {
   db::PartRecord part;
   std::vector<db::HandoverCandidateRecord> goals;  // Eq. 8 order: by rank (then id)
   std::map<std::int64_t, std::vector<db::SharedGraspRecord>> shared_grasps;  // by goal, id order
+  std::map<std::int64_t, std::vector<db::DirectGraspRecord>> direct_grasps;  // by goal, id order
   std::map<std::int64_t, db::RobotGraspRecord> robot_grasps;
   std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps;
   std::map<std::int64_t, db::HumanGraspRecord> human_grasps;
   std::map<std::int64_t, db::RobotHandoverRecord> robot_handovers;
-  std::map<std::pair<std::string, std::int64_t>, std::vector<bool>> filters;  // by grasp kind, id
+  // By (arm, grasp kind, grasp id): the filter of that arm's roadmap.
+  std::map<std::tuple<std::string, std::string, std::int64_t>, std::vector<bool>> filters;
   std::vector<db::RegraspNodeRecord> regrasp_nodes;
   std::map<std::int64_t, const db::RegraspNodeRecord*> node_by_id;  // into regrasp_nodes
   std::vector<db::RegraspEdgeRecord> regrasp_edges;
