@@ -51,8 +51,11 @@ void expect_plan_well_formed(const online::PlannerModel& model, const online::Sc
     if (!step.event.empty()) events += step.event + " ";
     EXPECT_TRUE(step.validation.valid()) << step.name;
   }
-  const std::vector<std::string> order{"suction_on", "gripper_close", "suction_off",
-                                       "wait_for_human", "gripper_open"};
+  const std::vector<std::string> order =
+      plan.mode == online::DeliveryMode::kExchange
+          ? std::vector<std::string>{"suction_on", "gripper_close", "suction_off",
+                                     "wait_for_human", "gripper_open"}
+          : std::vector<std::string>{"gripper_close", "wait_for_human", "gripper_open"};
   std::size_t from = 0;
   for (const auto& e : order) {
     const auto found = events.find(e, from);
