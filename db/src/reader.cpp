@@ -585,6 +585,20 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.inclination_rr_deg = s.next_double();
         r.inclination_rh_deg = s.next_double();
       });
+  db.direct_grasps_ = load_rows<DirectGraspRecord>(
+      *connection, "direct_grasps",
+      "candidate_id, robot_grasp_id, arm, joints_pick, joints_rh, inclination_pick_deg, "
+      "inclination_rh_deg",
+      fix, [&](detail::Statement& s, std::int64_t id, DirectGraspRecord& r) {
+        r.id = id;
+        r.candidate_id = s.next_int64();
+        r.robot_grasp_id = s.next_int64();
+        r.arm = s.next_text();
+        r.joints_pick = read_joints(s, path, "direct_grasps", "joints_pick", id, fix);
+        r.joints_rh = read_joints(s, path, "direct_grasps", "joints_rh", id, fix);
+        r.inclination_pick_deg = s.next_double();
+        r.inclination_rh_deg = s.next_double();
+      });
   db.ergonomics_ = load_rows<ErgonomicsRecord>(
       *connection, "ergonomics",
       "part_id, method, reachable, torso_flexion_deg, shoulder_elevated, reach, "
@@ -752,6 +766,13 @@ std::vector<SharedGraspRecord> Database::shared_grasps(std::int64_t candidate_id
   std::vector<SharedGraspRecord> selected;
   std::copy_if(shared_grasps_.begin(), shared_grasps_.end(), std::back_inserter(selected),
                [&](const SharedGraspRecord& g) { return g.candidate_id == candidate_id; });
+  return selected;
+}
+
+std::vector<DirectGraspRecord> Database::direct_grasps(std::int64_t candidate_id) const {
+  std::vector<DirectGraspRecord> selected;
+  std::copy_if(direct_grasps_.begin(), direct_grasps_.end(), std::back_inserter(selected),
+               [&](const DirectGraspRecord& g) { return g.candidate_id == candidate_id; });
   return selected;
 }
 

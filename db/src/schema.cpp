@@ -7,7 +7,7 @@ namespace hila::db {
 
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 4;
+  return 5;
 }
 
 namespace detail {
@@ -239,11 +239,32 @@ std::string create_tables_v4() {
          kCreateRegraspEdgesV4;
 }
 
+// The direct_grasps table as schema version 5 defines it (with its index): robot grasps with which
+// one arm's gripper picks the part where it lies and holds it at a goal's robot-human pose, no
+// robot-robot exchange. Both the current schema and the 4 -> 5 migration step create it from this
+// text; like the constants above, a later change goes into schema_sql() and leaves this to the
+// step. joints_pick (the arm's IK at the part's initial pose) and joints_rh (at the robot-human
+// pose) are joint vectors as in the version 3 tables: little-endian doubles, 8 bytes per joint.
+constexpr const char* kCreateDirectGraspsV5 = R"sql(
+CREATE TABLE direct_grasps (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  arm TEXT NOT NULL,
+  joints_pick BLOB NOT NULL,
+  joints_rh BLOB NOT NULL,
+  inclination_pick_deg REAL NOT NULL,
+  inclination_rh_deg REAL NOT NULL
+);
+CREATE INDEX direct_grasps_candidate_id ON direct_grasps(candidate_id);
+)sql";
+
 }  // namespace
 
 // Written out in full (not generated) so this file is the readable reference of the schema (the
 // comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
-// kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones).
+// kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones, the
+// direct_grasps table kCreateDirectGraspsV5).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
@@ -324,7 +345,7 @@ CREATE TABLE human_grasps (
 );
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql" + std::string(kCreateComfortMapsV2) +
-                                 create_tables_v3() + create_tables_v4();
+                                 create_tables_v3() + create_tables_v4() + kCreateDirectGraspsV5;
   return sql;
 }
 
@@ -342,6 +363,9 @@ const std::vector<MigrationStep>& migration_steps() {
       // 3 -> 4: roadmaps, roadmap filters and the regrasp graph (new tables, empty in a migrated
       // file until it is rebuilt; the old tables are unchanged).
       {3, create_tables_v4()},
+      // 4 -> 5: direct grasps (a new table, empty in a migrated file until it is rebuilt; the old
+      // tables are unchanged).
+      {4, kCreateDirectGraspsV5},
   };
   return steps;
 }

@@ -41,9 +41,9 @@ void bind_joints(detail::Statement& statement, const Eigen::VectorXd& joints) {
   statement.bind_blob(detail::encode_doubles(joints));
 }
 
-// Refuses non-finite values of the version 3 tables before anything is written (SQLite would turn
-// NaN into NULL and a BLOB would keep it silently): std::invalid_argument naming the call, the
-// table's column and the record, e.g. "DatabaseWriter::add_robot_handovers:
+// Refuses non-finite values of the tables since version 3 before anything is written (SQLite
+// would turn NaN into NULL and a BLOB would keep it silently): std::invalid_argument naming the
+// call, the table's column and the record, e.g. "DatabaseWriter::add_robot_handovers:
 // robot_handovers.joints[2] (record 0 of 3, part id 1) must be finite, got nan".
 class FiniteCheck {
  public:
@@ -83,7 +83,7 @@ std::string record_label(std::size_t index, std::size_t count, const std::string
   return "record " + std::to_string(index) + " of " + std::to_string(count) + ", " + owner;
 }
 
-// Refuses a record of the version 4 tables before anything of the call is written:
+// Refuses a record of the tables since version 4 before anything of the call is written:
 // std::invalid_argument "DatabaseWriter::CALL: TABLE.COLUMN (RECORD): WHAT".
 [[noreturn]] void refuse(const std::string& call, const std::string& column,
                          const std::string& record, const std::string& what) {
@@ -144,8 +144,9 @@ struct DatabaseWriter::Impl {
   // Prepared once, reused for every row; destroyed before the connection closes.
   std::optional<detail::Statement> insert_meta, insert_part, insert_placement, insert_robot,
       insert_suction, insert_human, insert_comfort, insert_stage, insert_robot_handover,
-      insert_candidate, insert_shared, insert_ergonomics, insert_roadmap, insert_filter,
-      insert_regrasp_node, insert_regrasp_edge, select_robot_grasp, select_suction_grasp;
+      insert_candidate, insert_shared, insert_direct, insert_ergonomics, insert_roadmap,
+      insert_filter, insert_regrasp_node, insert_regrasp_edge, select_robot_grasp,
+      select_suction_grasp;
   std::map<std::int64_t, RoadmapShape> roadmaps;  // by id
   bool meta_written = false;
   bool committed = false;
@@ -190,6 +191,7 @@ struct DatabaseWriter::Impl {
     insert_robot_handover.reset();
     insert_candidate.reset();
     insert_shared.reset();
+    insert_direct.reset();
     insert_ergonomics.reset();
     insert_roadmap.reset();
     insert_filter.reset();
@@ -309,6 +311,11 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
                    "candidate_id, robot_grasp_id, robot_handover_id, arm, joints_rr, joints_rh, "
                    "inclination_rr_deg, inclination_rh_deg"),
         m.context("shared_grasps"));
+    m.insert_direct.emplace(*m.connection,
+                            insert_sql("direct_grasps",
+                                       "candidate_id, robot_grasp_id, arm, joints_pick, joints_rh, "
+                                       "inclination_pick_deg, inclination_rh_deg"),
+                            m.context("direct_grasps"));
     m.insert_ergonomics.emplace(
         *m.connection,
         insert_sql("ergonomics",
@@ -644,6 +651,41 @@ void DatabaseWriter::add_shared_grasps(const std::vector<SharedGraspRecord>& gra
       bind_joints(s, g.joints_rr);
       bind_joints(s, g.joints_rh);
       s.bind_next(g.inclination_rr_deg);
+      s.bind_next(g.inclination_rh_deg);
+      s.run();
+    }
+  });
+}
+
+void DatabaseWriter::add_direct_grasps(const std::vector<DirectGraspRecord>& grasps) {
+  Impl& m = *impl_;
+  m.guarded("add_direct_grasps", [&] {
+    FiniteCheck check("add_direct_grasps", "direct_grasps");
+    for (std::size_t i = 0; i < grasps.size(); ++i) {
+      const auto& g = grasps[i];
+      const std::string record =
+          record_label(i, grasps.size(), "candidate id " + std::to_string(g.candidate_id));
+      if (g.arm.empty()) {
+        refuse("add_direct_grasps", "direct_grasps.arm", record,
+               "DirectGraspRecord::arm is empty, expected an arm name");
+      }
+      check.set_record(record);
+      check.joints("joints_pick", g.joints_pick);
+      check.joints("joints_rh", g.joints_rh);
+      check.value("inclination_pick_deg", g.inclination_pick_deg);
+      check.value("inclination_rh_deg", g.inclination_rh_deg);
+    }
+    detail::Statement& s = *m.insert_direct;
+    for (const auto& g : grasps) {
+      s.set_context(m.context("direct_grasps (candidate id " + std::to_string(g.candidate_id) +
+                              ", robot grasp id " + std::to_string(g.robot_grasp_id) + ", arm '" +
+                              g.arm + "')"));
+      s.bind_next(g.candidate_id);
+      s.bind_next(g.robot_grasp_id);
+      s.bind_next(g.arm);
+      bind_joints(s, g.joints_pick);
+      bind_joints(s, g.joints_rh);
+      s.bind_next(g.inclination_pick_deg);
       s.bind_next(g.inclination_rh_deg);
       s.run();
     }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -39,6 +40,9 @@ struct SamplePart {
   std::vector<RoadmapFilterRecord> roadmap_filters;
   std::vector<RegraspNodeRecord> regrasp_nodes;
   std::vector<RegraspEdgeRecord> regrasp_edges;
+  // Schema version 5. id, candidate_id and robot_grasp_id are the ones write_sample's writer
+  // assigns.
+  std::vector<DirectGraspRecord> direct_grasps;  // of this part's candidates
 };
 
 struct Sample {
@@ -439,10 +443,41 @@ inline void add_roadmap_records(Sample& s, std::mt19937_64& rng) {
   }
 }
 
+// Direct grasps of part 1's three goals (part 2 has none), written with the candidates
+// interleaved (2, 4, 2, 5, 4, 2, 5), so that one candidate's grasps are not consecutive ids: both
+// arms, a non-ASCII arm name, a grasp without a stored pick solution (empty joints_pick), -0.0 and
+// a subnormal in a joint blob, inclinations of exactly 0 and just below 90 degrees. From an RNG of
+// its own, so that every other record of the sample keeps the values it had before the table.
+inline void add_direct_grasps(Sample& s, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  SamplePart& p = s.parts[0];
+  std::vector<std::int64_t> goals;  // candidate ids in id order
+  for (const auto& c : p.handover_candidates) {
+    if (c.status == "goal") goals.push_back(c.id);
+  }
+  const std::size_t goal_of[] = {0, 1, 0, 2, 1, 0, 2};
+  std::int64_t id = 0;
+  for (std::size_t i = 0; i < std::size(goal_of); ++i) {
+    DirectGraspRecord g;
+    g.id = ++id;
+    g.candidate_id = goals.at(goal_of[i]);
+    g.robot_grasp_id = 1 + static_cast<std::int64_t>((3 * i) % p.robot_grasps.size());
+    g.arm = i == 4 ? "right ✋" : i % 3 == 1 ? "right" : "left";
+    if (i != 3) g.joints_pick = random_joints(rng, 6);
+    g.joints_rh = random_joints(rng, 6);
+    g.inclination_pick_deg = i == 0 ? 0.0 : 11.25 * static_cast<double>(i) + 1e-13;
+    g.inclination_rh_deg = i == 2 ? 89.999999999999986 : 45.5 - static_cast<double>(i);
+    p.direct_grasps.push_back(g);
+  }
+  p.direct_grasps[0].joints_pick[1] = -0.0;
+  p.direct_grasps[0].joints_pick[5] = std::numeric_limits<double>::denorm_min();
+  p.direct_grasps[5].joints_rh[2] = -0.0;
+}
+
 // Two parts with different record counts (part 2 has no suction grasps), values that are
 // negative, tiny, huge, subnormal and infinite, a non-ASCII part name, handover records (see
-// add_handover_records), two comfort maps, and roadmaps with the regrasp graph (see
-// add_roadmap_records).
+// add_handover_records), two comfort maps, roadmaps with the regrasp graph (see
+// add_roadmap_records) and direct grasps (see add_direct_grasps).
 inline Sample make_sample(std::uint64_t seed = 7) {
   std::mt19937_64 rng(seed);
   Sample s;
@@ -523,15 +558,17 @@ inline Sample make_sample(std::uint64_t seed = 7) {
   s.comfort_maps.push_back(make_comfort_map("right", seed + 1, {4, 3, 2}, 10));
   s.comfort_maps.push_back(make_comfort_map("left", seed + 2, {2, 5, 3}, 7, 0.5));
   add_roadmap_records(s, rng);
+  add_direct_grasps(s, seed + 3);
   return s;
 }
 
 // Writes `sample` to `path` through DatabaseWriter and returns the part ids in order: first each
-// part with its placements and grasps, then each part's handover and ergonomics records (so they
-// may refer to grasps of any part), then the comfort maps, the roadmaps and each part's roadmap
-// filters, regrasp nodes and regrasp edges. The candidate, robot handover, roadmap, filter and
-// node ids the records refer to are translated from the sample's ids to the ones the writer
-// returns (the same unless a test reorders the sample's parts); grasp ids are written as given.
+// part with its placements and grasps, then each part's handover, direct grasp and ergonomics
+// records (so they may refer to grasps of any part), then the comfort maps, the roadmaps and each
+// part's roadmap filters, regrasp nodes and regrasp edges. The candidate, robot handover, roadmap,
+// filter and node ids the records refer to are translated from the sample's ids to the ones the
+// writer returns (the same unless a test reorders the sample's parts); grasp ids are written as
+// given.
 inline std::vector<std::int64_t> write_sample(const std::string& path, const Sample& sample) {
   DatabaseWriter writer(path);
   writer.write_meta(sample.meta);
@@ -571,6 +608,9 @@ inline std::vector<std::int64_t> write_sample(const std::string& path, const Sam
       g.robot_handover_id = translate(handover_ids, g.robot_handover_id);
     }
     writer.add_shared_grasps(shared);
+    std::vector<DirectGraspRecord> direct = p.direct_grasps;
+    for (auto& g : direct) g.candidate_id = translate(candidate_ids, g.candidate_id);
+    writer.add_direct_grasps(direct);
     writer.add_ergonomics(ids[k], p.ergonomics);
   }
   for (const auto& map : sample.comfort_maps) writer.add_comfort_map(map);

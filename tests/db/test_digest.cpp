@@ -190,6 +190,33 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
     auto& path = s.parts[0].regrasp_edges[0].path;
     std::swap(path[1], path[2]);
   });
+  // Schema version 5: direct grasps.
+  add("direct grasp pick inclination ulp", [](Sample& s) {
+    double& a = s.parts[0].direct_grasps[3].inclination_pick_deg;
+    a = std::nextafter(a, 90.0);
+  });
+  add("direct grasp robot-human inclination ulp", [](Sample& s) {
+    double& a = s.parts[0].direct_grasps[2].inclination_rh_deg;
+    a = std::nextafter(a, 0.0);
+  });
+  add("direct grasp robot grasp",
+      [](Sample& s) { s.parts[0].direct_grasps[1].robot_grasp_id = 3; });
+  add("direct grasp candidate", [](Sample& s) { s.parts[0].direct_grasps[6].candidate_id = 4; });
+  add("direct grasp arm", [](Sample& s) { s.parts[0].direct_grasps[0].arm = "right"; });
+  add("direct grasp joints swapped", [](Sample& s) {
+    auto& g = s.parts[0].direct_grasps[5];
+    std::swap(g.joints_pick, g.joints_rh);
+  });
+  add("direct grasp pick joint -0.0 to +0.0",
+      [](Sample& s) { s.parts[0].direct_grasps[0].joints_pick[1] = 0.0; });
+  add("direct grasp joint ulp", [](Sample& s) {
+    double& q = s.parts[0].direct_grasps[4].joints_rh[3];
+    q = std::nextafter(q, 10.0);
+  });
+  add("direct grasps reordered",
+      [](Sample& s) { std::swap(s.parts[0].direct_grasps[0], s.parts[0].direct_grasps[2]); });
+  add("a direct grasp less", [](Sample& s) { s.parts[0].direct_grasps.pop_back(); });
+  add("no direct grasps", [](Sample& s) { s.parts[0].direct_grasps.clear(); });
   for (const auto& [name, sample] : variants) {
     const std::string path = dir + "/variant.db";
     write_sample(path, sample);

@@ -17,12 +17,13 @@ namespace fs = std::filesystem;
 namespace {
 
 // A "version 0" database: what schema 1 would look like if robot_grasps had no theta_c_deg yet
-// (and, as in schema 1, there were no comfort maps, handover, ergonomics, roadmap or regrasp
-// tables).
+// (and, as in schema 1, there were no comfort maps, handover, ergonomics, roadmap, regrasp or
+// direct grasp tables).
 std::string write_v0(const std::string& dir) {
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
   execute_script(path,
+                 "DROP TABLE direct_grasps;"
                  "DROP TABLE regrasp_edges;"
                  "DROP TABLE regrasp_nodes;"
                  "DROP TABLE roadmap_filters;"
@@ -235,6 +236,83 @@ CREATE TABLE ergonomics (
 );
 )sql";
 
+// What schema version 4 added to version 3, exactly as hila (schema 4) wrote it, frozen here like
+// kSchemaV1.
+const char* const kSchemaV4Additions = R"sql(
+CREATE TABLE roadmaps (
+  id INTEGER PRIMARY KEY,
+  arm TEXT UNIQUE NOT NULL,
+  dof INTEGER NOT NULL,
+  resolution REAL NOT NULL,
+  node_count INTEGER NOT NULL,
+  edge_count INTEGER NOT NULL,
+  node_joints BLOB NOT NULL,
+  node_gravity BLOB NOT NULL,
+  node_inclination_deg BLOB NOT NULL,
+  edge_nodes BLOB NOT NULL,
+  edge_length BLOB NOT NULL,
+  edge_max_inclination_deg BLOB NOT NULL
+);
+
+CREATE TABLE roadmap_filters (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  roadmap_id INTEGER NOT NULL REFERENCES roadmaps(id),
+  grasp_kind TEXT NOT NULL CHECK (grasp_kind IN ('gripper', 'suction')),
+  grasp_id INTEGER NOT NULL,
+  theta_c_deg REAL NOT NULL,
+  valid_edges INTEGER NOT NULL,
+  components INTEGER NOT NULL,
+  largest_component INTEGER NOT NULL,
+  edge_bits BLOB NOT NULL,
+  node_component BLOB NOT NULL,
+  UNIQUE (part_id, roadmap_id, grasp_kind, grasp_id)
+);
+
+CREATE TABLE regrasp_nodes (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  kind TEXT NOT NULL CHECK (kind IN ('home', 'pick', 'robot_handover', 'human_handover')),
+  arm TEXT NOT NULL,
+  grasp_kind TEXT NOT NULL CHECK (grasp_kind IN ('', 'gripper', 'suction')),
+  grasp_id INTEGER NOT NULL,
+  robot_handover_id INTEGER REFERENCES robot_handovers(id),
+  candidate_id INTEGER REFERENCES handover_candidates(id),
+  board_x REAL NOT NULL, board_y REAL NOT NULL, board_z REAL NOT NULL,
+  board_qw REAL NOT NULL, board_qx REAL NOT NULL, board_qy REAL NOT NULL, board_qz REAL NOT NULL,
+  dof INTEGER NOT NULL,
+  solution_count INTEGER NOT NULL,
+  solutions BLOB NOT NULL,
+  CHECK ((kind = 'home') = (grasp_kind = '')),
+  CHECK ((grasp_kind = '') = (grasp_id = 0)),
+  CHECK ((kind = 'robot_handover') = (robot_handover_id IS NOT NULL)),
+  CHECK ((kind = 'human_handover') = (candidate_id IS NOT NULL))
+);
+CREATE INDEX regrasp_nodes_part_id ON regrasp_nodes(part_id);
+
+CREATE TABLE regrasp_edges (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  kind TEXT NOT NULL CHECK (kind IN ('transit', 'transfer', 'handover')),
+  arm TEXT NOT NULL,
+  from_node INTEGER NOT NULL REFERENCES regrasp_nodes(id),
+  to_node INTEGER NOT NULL REFERENCES regrasp_nodes(id),
+  filter_id INTEGER REFERENCES roadmap_filters(id),
+  connected INTEGER NOT NULL CHECK (connected IN (0, 1)),
+  cost REAL NOT NULL,
+  path_nodes INTEGER NOT NULL,
+  via TEXT NOT NULL CHECK (via IN ('', 'roadmap', 'bridge')),
+  path_dof INTEGER NOT NULL,
+  path_waypoints INTEGER NOT NULL,
+  path BLOB NOT NULL,
+  CHECK ((kind = 'transfer') = (filter_id IS NOT NULL)),
+  CHECK (connected = 1 OR (cost = 0 AND path_nodes = 0)),
+  CHECK ((connected = 1 AND kind IN ('transit', 'transfer')) = (via <> '')),
+  CHECK ((via = '') = (path_waypoints = 0))
+);
+CREATE INDEX regrasp_edges_part_id ON regrasp_edges(part_id);
+)sql";
+
 // Meta and one part with a placement and one grasp of each kind, as rows of the version 1 tables
 // (meta without schema_version). Values are exact in binary so the writer would store the same
 // bits.
@@ -299,11 +377,31 @@ std::string write_v3(const std::string& dir) {
   return path;
 }
 
+// One roadmap without nodes or edges and a human_handover regrasp node at the goal of kV3Rows
+// (the one solution (0.5, 1.0), as in the kV3Rows blobs), as rows of the version 4 tables; the
+// version set to 4.
+const char* const kV4Rows = R"sql(
+UPDATE meta SET value = '4' WHERE key = 'schema_version';
+INSERT INTO roadmaps VALUES (1, 'left', 6, 0.0625, 0, 0, x'', x'', x'', x'', x'', x'');
+INSERT INTO regrasp_nodes VALUES (1, 1, 'human_handover', 'left', 'gripper', 1, NULL, 1,
+  0.25, 0.5, 1.0, 1.0, 0.0, 0.0, 0.0, 2, 1, x'000000000000e03f000000000000f03f');
+)sql";
+
+// A version 4 file made by hand: kV1Rows, kV3Rows and kV4Rows.
+std::string write_v4(const std::string& dir) {
+  const std::string path = dir + "/v4.db";
+  execute_script(path, std::string(kSchemaV1) + kSchemaV2Additions + kSchemaV3Additions +
+                           kSchemaV4Additions + kV1Rows + kV3Rows + kV4Rows);
+  return path;
+}
+
 // The same content written by this hila's DatabaseWriter (no handover or ergonomics records, an
-// empty meta.human_bodies), with the comfort map of write_v2 when `with_comfort_map`, and with the
-// version 3 records (and meta.human_bodies) of write_v3 when `with_handover_records`.
+// empty meta.human_bodies), with the comfort map of write_v2 when `with_comfort_map`, with the
+// version 3 records (and meta.human_bodies) of write_v3 when `with_handover_records`, and with the
+// version 4 records of write_v4 when `with_roadmap_records` (which needs the version 3 ones).
 void write_reference_content(const std::string& path, bool with_comfort_map,
-                             bool with_handover_records = false) {
+                             bool with_handover_records = false,
+                             bool with_roadmap_records = false) {
   Meta meta;
   meta.hila_version = "0.1.0";
   meta.product_name = "cabinet";
@@ -419,6 +517,23 @@ void write_reference_content(const std::string& path, bool with_comfort_map,
     ergonomics.arm = "right";
     writer.add_ergonomics(id, {ergonomics});
   }
+  if (with_roadmap_records) {
+    RoadmapRecord roadmap;
+    roadmap.arm = "left";
+    roadmap.dof = 6;
+    roadmap.resolution = 0.0625;
+    writer.add_roadmap(roadmap);
+    RegraspNodeRecord node;
+    node.part_id = id;
+    node.kind = "human_handover";
+    node.arm = "left";
+    node.grasp_kind = "gripper";
+    node.grasp_id = 1;
+    node.candidate_id = 1;
+    node.board.translation() = Eigen::Vector3d(0.25, 0.5, 1.0);
+    node.solutions = {Eigen::Vector2d(0.5, 1.0)};
+    writer.add_regrasp_nodes({node});
+  }
   writer.commit();
 }
 
@@ -462,6 +577,11 @@ void expect_no_roadmap_records(const Database& db) {
   EXPECT_TRUE(db.regrasp_edges(1).empty());
 }
 
+// A migrated file has the version 5 table, empty (the by-hand files' goal is candidate 1).
+void expect_no_direct_grasps(const Database& db) {
+  EXPECT_TRUE(db.direct_grasps(1).empty());
+}
+
 }  // namespace
 
 TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
@@ -473,10 +593,10 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v1 = content_digest(path);  // an old file still has a digest
 
-  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4
+  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 4);
+  EXPECT_EQ(db.meta().schema_version, 5);
   EXPECT_EQ(db.meta().product_name, "cabinet");
   EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
@@ -486,6 +606,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                      {path + ": comfort_maps", "a comfort map for arm 'right' (arms: none)"});
   expect_no_handover_records(db);
   expect_no_roadmap_records(db);
+  expect_no_direct_grasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v1.db"}) << "no temporary copy left";
 
   // The migrated file holds exactly what this hila writes for the same records: same tables,
@@ -508,16 +629,16 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 4), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 5), got one "
        "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_THROW(Database::open(path), DatabaseError);
   const std::string digest_v2 = content_digest(path);
 
-  migrate_in_place(path);  // 2 -> 3 -> 4
+  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 4);
+  EXPECT_EQ(db.meta().schema_version, 5);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   expect_v1_records(db);
   ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
@@ -526,6 +647,7 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   EXPECT_TRUE(db.comfort_map("right").values.empty());
   expect_no_handover_records(db);
   expect_no_roadmap_records(db);
+  expect_no_direct_grasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v2.db"}) << "no temporary copy left";
 
   // Same content as this hila writes: the new tables (empty) and meta.human_bodies ("") included.
@@ -539,22 +661,22 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(read_file(path), after);
 }
 
-TEST(Migration, Version3FileIsUpgradedToVersion4) {
+TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   const std::string dir = temp_dir("db_migration_v3");
   const std::string path = write_v3(dir);
   // Unmigrated, the file is refused as outdated, with the way out.
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 4), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 5), got one "
        "written by schema version 3 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v3 = content_digest(path);
 
-  migrate_in_place(path);  // 3 -> 4 only
+  migrate_in_place(path);  // 3 -> 4 -> 5
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 4);
+  EXPECT_EQ(db.meta().schema_version, 5);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -575,8 +697,9 @@ TEST(Migration, Version3FileIsUpgradedToVersion4) {
   EXPECT_EQ(db.shared_grasps(1)[0].inclination_rh_deg, 45.0);
   ASSERT_EQ(db.ergonomics(1).size(), 1u);
   EXPECT_EQ(db.ergonomics(1)[0].torso_flexion_deg, 17.25);
-  // The version 4 tables exist, empty.
+  // The version 4 and 5 tables exist, empty.
   expect_no_roadmap_records(db);
+  expect_no_direct_grasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v3.db"}) << "no temporary copy left";
 
   // Same content as this hila writes for the same records: the new tables (empty) included.
@@ -622,6 +745,86 @@ TEST(Migration, Version3FileThatAlreadyHasTheNewTablesFailsCleanly) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
+TEST(Migration, Version4FileIsUpgradedToVersion5) {
+  const std::string dir = temp_dir("db_migration_v4");
+  const std::string path = write_v4(dir);
+  // Unmigrated, the file is refused as outdated, with the way out.
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 5), got one "
+       "written by schema version 4 (an older hila); rebuild with: hila build product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  const std::string digest_v4 = content_digest(path);
+
+  migrate_in_place(path);  // 4 -> 5 only
+
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 5);
+  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+  EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
+  expect_v1_records(db);
+  ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
+  // The version 3 and 4 records are kept.
+  ASSERT_EQ(db.handover_goals(1).size(), 1u);
+  ASSERT_EQ(db.shared_grasps(1).size(), 1u);
+  EXPECT_EQ(db.shared_grasps(1)[0].joints_rr, Eigen::Vector2d(0.5, 1.0));
+  ASSERT_EQ(db.ergonomics(1).size(), 1u);
+  ASSERT_NE(db.roadmap("left"), nullptr);
+  EXPECT_EQ(db.roadmap("left")->resolution, 0.0625);
+  ASSERT_EQ(db.regrasp_nodes(1).size(), 1u);
+  EXPECT_EQ(db.regrasp_nodes(1)[0].candidate_id, 1);
+  ASSERT_EQ(db.regrasp_nodes(1)[0].solutions.size(), 1u);
+  EXPECT_EQ(db.regrasp_nodes(1)[0].solutions[0], Eigen::Vector2d(0.5, 1.0));
+  // The version 5 table exists, empty.
+  expect_no_direct_grasps(db);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"v4.db"}) << "no temporary copy left";
+
+  // Same content as this hila writes for the same records: the new table (empty) included.
+  const std::string fresh = dir + "/fresh.db";
+  write_reference_content(fresh, true, true, true);
+  EXPECT_EQ(content_digest(path), content_digest(fresh));
+  EXPECT_NE(content_digest(path), digest_v4);
+
+  // The migrated file takes direct grasps like a fresh one (the table and its foreign keys are
+  // there): a row by SQL, read back, then one of a candidate that does not exist.
+  execute_script(path,
+                 "INSERT INTO direct_grasps VALUES (1, 1, 1, 'left', x'000000000000e03f', x'', "
+                 "22.5, 45.0);");
+  const auto direct = Database::open(path).direct_grasps(1);
+  ASSERT_EQ(direct.size(), 1u);
+  EXPECT_EQ(direct[0].robot_grasp_id, 1);
+  EXPECT_EQ(direct[0].arm, "left");
+  EXPECT_EQ(direct[0].joints_pick, Eigen::VectorXd::Constant(1, 0.5));
+  EXPECT_EQ(direct[0].joints_rh.size(), 0);
+  EXPECT_EQ(direct[0].inclination_pick_deg, 22.5);
+  EXPECT_EQ(direct[0].inclination_rh_deg, 45.0);
+  expect_input_error(
+      [&] {
+        execute_script(path,
+                       "INSERT INTO direct_grasps VALUES (2, 2, 1, 'left', x'', x'', 0.0, 0.0);");
+      },
+      {"FOREIGN KEY constraint failed"});
+
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after) << "migrating a current file is a no-op";
+}
+
+TEST(Migration, Version4FileThatAlreadyHasTheNewTableFailsCleanly) {
+  // Version 5 content with the version number set back: the 4 -> 5 step's CREATE TABLE fails and
+  // the file is left as it was.
+  const std::string dir = temp_dir("db_migration_v4_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '4' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 4 -> 5", "table direct_grasps already exists"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
+}
+
 TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
   // A hand-made version 2 file that already has the key: the step does not overwrite it.
   const std::string dir = temp_dir("db_migration_v2_bodies");
@@ -653,7 +856,7 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   migrate_with_steps(path, steps_from_v0(), current_schema_version());
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 4);
+  EXPECT_EQ(db.meta().schema_version, 5);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -666,32 +869,35 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   EXPECT_TRUE(db.comfort_maps().empty());
   expect_no_handover_records(db);
   expect_no_roadmap_records(db);
+  expect_no_direct_grasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"}) << "no temporary copy left";
 }
 
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 4 -> 5 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3 and 3 -> 4
-  // create; listed first to prove ordering.
-  std::vector<MigrationStep> steps = {{4,
-                                       "INSERT INTO notes (text) VALUES ('from step 4');"
+  // Step 5 -> 6 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4 and
+  // 4 -> 5 create; listed first to prove ordering.
+  std::vector<MigrationStep> steps = {{5,
+                                       "INSERT INTO notes (text) VALUES ('from step 5');"
                                        "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
                                        "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
-                                       "INSERT INTO notes (text) SELECT arm FROM roadmaps;"}};
+                                       "INSERT INTO notes (text) SELECT arm FROM roadmaps;"
+                                       "INSERT INTO notes (text) SELECT arm FROM direct_grasps;"}};
   steps.push_back(migration_steps().at(1));
+  steps.push_back(migration_steps().at(3));
   steps.push_back(migration_steps().at(2));
   steps.push_back(migration_steps().at(0));
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 5));
-  migrate_with_steps(path, steps, 5);
-  // The file is now version 5: this hila (4) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 5"});
-  // Migrating to 5 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 6));
+  migrate_with_steps(path, steps, 6);
+  // The file is now version 6: this hila (5) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 6"});
+  // Migrating to 6 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 5);
+  migrate_with_steps(path, steps, 6);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -718,6 +924,9 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
   EXPECT_FALSE(can_migrate({migration_steps().at(0)}, 1, 3)) << "1 -> 2 alone does not reach 3";
   EXPECT_FALSE(can_migrate({migration_steps().at(0), migration_steps().at(1)}, 1, 4))
       << "1 -> 2 -> 3 does not reach 4";
+  EXPECT_FALSE(can_migrate(
+      {migration_steps().at(0), migration_steps().at(1), migration_steps().at(2)}, 1, 5))
+      << "1 -> 2 -> 3 -> 4 does not reach 5";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },

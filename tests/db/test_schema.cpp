@@ -33,15 +33,17 @@ std::vector<std::string> create_statements(const std::string& sql) {
 
 }  // namespace
 
-TEST(Schema, VersionIsFourWithStepsFromOneTwoAndThree) {
-  EXPECT_EQ(current_schema_version(), 4);
-  ASSERT_EQ(migration_steps().size(), 3u);
+TEST(Schema, VersionIsFiveWithStepsFromOneToFour) {
+  EXPECT_EQ(current_schema_version(), 5);
+  ASSERT_EQ(migration_steps().size(), 4u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
   EXPECT_EQ(migration_steps()[1].from_version, 2);
   EXPECT_EQ(migration_steps()[2].from_version, 3);
+  EXPECT_EQ(migration_steps()[3].from_version, 4);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 3, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 4, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
   // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
@@ -71,6 +73,16 @@ TEST(Schema, VersionIsFourWithStepsFromOneTwoAndThree) {
     EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
   }
   EXPECT_EQ(migration_steps()[2].sql.find("INSERT"), std::string::npos);
+  // 4 -> 5: the direct_grasps table and its index, as a fresh database has them, and nothing else.
+  const auto created_v5 = create_statements(migration_steps()[3].sql);
+  ASSERT_EQ(created_v5.size(), 2u) << "1 table, 1 index";
+  EXPECT_EQ(created_v5[0].rfind("CREATE TABLE direct_grasps (", 0), 0u) << created_v5[0];
+  EXPECT_EQ(created_v5[1],
+            "CREATE INDEX direct_grasps_candidate_id ON direct_grasps(candidate_id);");
+  for (const auto& statement : created_v5) {
+    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  EXPECT_EQ(migration_steps()[3].sql.find("INSERT"), std::string::npos);
 }
 
 TEST(Schema, ColumnListHelpers) {
@@ -79,7 +91,7 @@ TEST(Schema, ColumnListHelpers) {
 }
 
 TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
-  ASSERT_EQ(kTables.size(), 16u);
+  ASSERT_EQ(kTables.size(), 17u);
   EXPECT_STREQ(kTables[0].name, "meta");
   EXPECT_STREQ(kTables[1].name, "parts");
   EXPECT_STREQ(kTables[6].name, "comfort_maps");
@@ -94,7 +106,10 @@ TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
   EXPECT_STREQ(kTables[13].name, "roadmap_filters");
   EXPECT_STREQ(kTables[14].name, "regrasp_nodes");
   EXPECT_STREQ(kTables[15].name, "regrasp_edges");
-  for (std::size_t i = 12; i < kTables.size(); ++i) EXPECT_EQ(kTables[i].since_version, 4);
+  for (std::size_t i = 12; i < 16; ++i) EXPECT_EQ(kTables[i].since_version, 4);
+  // Appended last, so the digest of an older file hashes its tables as it always did.
+  EXPECT_STREQ(kTables[16].name, "direct_grasps");
+  EXPECT_EQ(kTables[16].since_version, 5);
   for (const auto& table : kTables) {
     EXPECT_NE(schema_sql().find(std::string("CREATE TABLE ") + table.name + " ("),
               std::string::npos)
@@ -201,6 +216,25 @@ TEST(Schema, RoadmapAndRegraspColumnsAreDeclared) {
   }
 }
 
+TEST(Schema, DirectGraspColumnsAreDeclared) {
+  // The table's own text, so a column of another table cannot stand in for one of these.
+  const std::string& sql = schema_sql();
+  const std::size_t start = sql.find("CREATE TABLE direct_grasps (");
+  ASSERT_NE(start, std::string::npos);
+  const std::string table = sql.substr(start, sql.find(");", start) + 2 - start);
+  EXPECT_EQ(table,
+            "CREATE TABLE direct_grasps (\n"
+            "  id INTEGER PRIMARY KEY,\n"
+            "  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),\n"
+            "  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),\n"
+            "  arm TEXT NOT NULL,\n"
+            "  joints_pick BLOB NOT NULL,\n"
+            "  joints_rh BLOB NOT NULL,\n"
+            "  inclination_pick_deg REAL NOT NULL,\n"
+            "  inclination_rh_deg REAL NOT NULL\n"
+            ");");
+}
+
 TEST(Schema, ComfortMapColumnsAreDeclaredNotNull) {
   const std::string& sql = schema_sql();
   for (const std::string column :
@@ -243,12 +277,14 @@ TEST(Schema, SqlRunsOnAnEmptyFileAndCreatesThePartIdIndexes) {
         },
         {path, "already exists"});
   }
-  expect_input_error(
-      [&] {
-        execute_script(path,
-                       "CREATE INDEX shared_grasps_candidate_id ON shared_grasps(candidate_id)");
-      },
-      {path, "already exists"});
+  for (const std::string table : {"shared_grasps", "direct_grasps"}) {
+    expect_input_error(
+        [&] {
+          execute_script(path,
+                         "CREATE INDEX " + table + "_candidate_id ON " + table + "(candidate_id)");
+        },
+        {path, "already exists"});
+  }
 }
 
 TEST(Schema, ConstraintsRejectBadRows) {

@@ -179,6 +179,7 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
     EXPECT_EQ(h["ranked_goals"].size(), h["goals"].get<std::size_t>());
     EXPECT_EQ(h["failure"], "");
     EXPECT_FALSE(h["ranked_goals"][0]["shared_grasps"].empty());
+    EXPECT_TRUE(h["ranked_goals"][0]["direct_grasps"].is_array()) << "listed, even when empty";
   }
   EXPECT_NE(build.out.find("|𝕊|"), std::string::npos) << build.out;
   // The ergonomics report: hila's handover needs no forward bend wherever the human alone does.

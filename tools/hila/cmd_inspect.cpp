@@ -3,6 +3,7 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "commands.hpp"
 #include "hila/core/error.hpp"
@@ -147,6 +148,15 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
                         {"slip_rr_deg", round_to(s.inclination_rr_deg, 0.01)},
                         {"slip_rh_deg", round_to(s.inclination_rh_deg, 0.01)}});
     }
+    // Grasps with which one arm picks the board where it lies and hands it over itself.
+    nlohmann::json direct = nlohmann::json::array();
+    for (const auto& d : database.direct_grasps(c.id)) {
+      direct.push_back({{"robot_grasp", d.robot_grasp_id},
+                        {"theta_c_deg", theta_c[d.robot_grasp_id]},
+                        {"arm", d.arm},
+                        {"slip_pick_deg", round_to(d.inclination_pick_deg, 0.01)},
+                        {"slip_rh_deg", round_to(d.inclination_rh_deg, 0.01)}});
+    }
     nlohmann::json g = {{"rank", c.rank},
                         {"candidate", c.id},
                         {"distance", round_to(c.distance, 1e-5)},
@@ -155,7 +165,8 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
                         {"human_grasp", c.human_grasp_id},
                         {"pose", pose_json(c.board)},
                         {"human_posture_solved", c.human_joints.size() > 0},
-                        {"shared_grasps", shared}};
+                        {"shared_grasps", shared},
+                        {"direct_grasps", direct}};
     if (!c.second_arm.empty()) {
       g["second_arm"] = c.second_arm;
       g["second_grasp"] = c.second_grasp_id;
@@ -290,6 +301,19 @@ int run_inspect(const InspectOptions& opt) {
         shared += (shared.empty() ? "" : ", ") + std::to_string(grasp) + " (" +
                   std::to_string(static_cast<int>(s["theta_c_deg"].get<double>())) + ") rr " + rr;
       }
+      // Direct grasps (no exchange), when the goal has any: "grasp (theta_c) arm slip P/R", the
+      // slip angles at the pick and at the robot-human pose, degrees.
+      std::string direct;
+      for (const auto& d : g["direct_grasps"]) {
+        std::ostringstream slip;
+        slip << std::fixed << std::setprecision(1) << d["slip_pick_deg"].get<double>() << "/"
+             << d["slip_rh_deg"].get<double>();
+        direct += (direct.empty() ? "" : ", ") +
+                  std::to_string(d["robot_grasp"].get<std::int64_t>()) + " (" +
+                  std::to_string(static_cast<int>(d["theta_c_deg"].get<double>())) + ") " +
+                  d["arm"].get<std::string>() + " slip " + slip.str();
+      }
+      if (!direct.empty()) shared += (shared.empty() ? "" : "; ") + std::string("direct ") + direct;
       std::cout << std::setw(6) << g["rank"].get<int>() << std::setw(12) << std::fixed
                 << std::setprecision(3) << g["distance"].get<double>() << "  " << std::setw(5)
                 << std::setprecision(3) << g["quality"].get<double>() << "  " << std::left
