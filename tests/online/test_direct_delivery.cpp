@@ -20,11 +20,11 @@ std::chrono::steady_clock::time_point in_seconds(double s) {
   return std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(s * 1e6));
 }
 
-// Two 30 x 30 x 50 mm blocks (no face takes the 40 mm cup) lying on the table: one on the
+// Two 120 x 35 x 30 mm blocks (no face takes the 40 mm cup) lying on the table: one on the
 // robot's left, 0.65 m from the left arm's base and 0.90 m from the right arm's, one mirrored on
 // its right. Their targets stand on the table in front of the human.
 std::string blocks_product(const std::string& dir) {
-  core::write_mesh(core::make_box_mesh(Eigen::Vector3d(0.05, 0.03, 0.03)), dir + "/block.stl",
+  core::write_mesh(core::make_box_mesh(Eigen::Vector3d(0.12, 0.035, 0.03)), dir + "/block.stl",
                    "stlb");
   return test::write_file(dir, "product.yaml", R"(name: blocks
 assembly_frame: {xyz: [0.62, 0.0, 1.094], rpy_deg: [0, 0, 0]}
@@ -131,7 +131,8 @@ TEST(DirectDelivery, ASmallPartIsPickedByTheGripperOfTheArmThatReachesIt) {
     ASSERT_FALSE(plan.attempts.empty());
     for (const auto& a : plan.attempts) {
       EXPECT_EQ(a.mode, online::DeliveryMode::kDirect);
-      EXPECT_EQ(a.outcome, "gripper_pick: the right arm holds the suction tool");
+      EXPECT_TRUE(a.outcome.ends_with("gripper_pick: the right arm holds the suction tool"))
+          << a.outcome;
     }
   }
 }
