@@ -72,7 +72,18 @@ TEST(PlannerModel, LoadsItsDatabaseAndRefusesOnesBuiltFromOtherInputs) {
     EXPECT_EQ(b->robot_handovers.size(), db.robot_handovers(part.id).size());
     const auto filters = db.roadmap_filters(part.id);
     EXPECT_EQ(b->filters.size(), filters.size());
-    for (const auto& f : filters) EXPECT_EQ(b->filters.at({f.grasp_kind, f.grasp_id}), f.edges);
+    for (const auto& f : filters) {
+      const db::RoadmapFilterRecord* stored = db.roadmap_filter(f.id);
+      ASSERT_NE(stored, nullptr);
+      std::string arm;
+      for (const auto& m : db.roadmaps()) {
+        if (m.id == f.roadmap_id) arm = m.arm;
+      }
+      EXPECT_EQ(b->filters.at({arm, f.grasp_kind, f.grasp_id}), f.edges);
+    }
+    for (const auto& goal : b->goals) {
+      EXPECT_EQ(b->direct_grasps.at(goal.id).size(), db.direct_grasps(goal.id).size());
+    }
     const auto nodes = db.regrasp_nodes(part.id);
     ASSERT_EQ(b->regrasp_nodes.size(), nodes.size());
     for (const auto& n : nodes) EXPECT_EQ(b->node_by_id.at(n.id)->id, n.id);
