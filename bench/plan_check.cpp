@@ -188,6 +188,8 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     motion.tool_in_hand = tool_in_hand;
     motion.tool_world = scene.tool;
     motion.start_in_contact = lifting;
+    motion.end_in_contact =
+        std::find(events.begin(), events.end(), "tool_released") != events.end();
     const online::ValidationReport report =
         online::validate_motion(world, data, motion, settings.validator);
     out.samples += report.samples;
@@ -210,6 +212,15 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         tool_in_hand = true;
         cell.set_jaw(robot_q, suction, cell.spec().suction.handle_width);
         lifting = true;
+      } else if (e == "tool_released") {
+        if (arm != &suction || !tool_in_hand || on_cup) {
+          problem(where, "sets down a tool it does not hold, or the board with it");
+        }
+        const std::string off =
+            pose_error(tcp_of(suction) * cell.spec().suction.handle_in_tcp, scene.tool);
+        if (!off.empty()) problem(where, "sets the tool down " + off + " its place");
+        tool_in_hand = false;
+        cell.set_jaw(robot_q, suction, cell.spec().gripper.jaw_max);
       } else if (e == "suction_on") {
         if (arm != &suction || !tool_in_hand || on_cup || in_gripper != nullptr || handed_over) {
           problem(where, "suction on without the tool or with the board already taken");

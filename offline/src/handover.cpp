@@ -599,6 +599,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // The first rr_per_grasp rr poses receiving each grasp, in search order.
   std::vector<std::vector<int>> rr_of_grasp(grasps.robot.size());
   int examined = 0;
+  int trapping = 0;  // held poses where the board would stand in the suction arm's home
+  std::vector<int> suction_arm_and_tool =
+      scene.cell.arm_bodies[static_cast<std::size_t>(scene.suction_arm)];
+  suction_arm_and_tool.insert(suction_arm_and_tool.end(), scene.tool_bodies.begin(),
+                              scene.tool_bodies.end());
   for (const int combo : order) {
     if (examined >= settings.rr_poses || !exchange_failure.empty()) break;
     const int s = combo % n_suction;
@@ -623,6 +628,20 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         held = true;
         suction_q = ik.q[static_cast<std::size_t>(k)];
       }
+    }
+    // An exchange here must not trap the suction arm: once the receiving arm holds the board, the
+    // suction arm goes home, so its home (with the tool) must be clear of the board at this pose.
+    if (held) {
+      cell.set_arm(robot_q, suction_arm, suction_arm.spec.home);
+      core::set_robot_state(cell, scene.cell, data, robot_q);
+      core::set_tool_held(cell, scene, data, suction_home_tcp);
+      if (core::in_collision(scene.cell.model, data, suction_arm_and_tool)) {
+        held = false;
+        ++trapping;
+      }
+      cell.set_arm(robot_q, suction_arm, suction_q);
+      core::set_robot_state(cell, scene.cell, data, robot_q);
+      core::set_tool_held(cell, scene, data, tcp);
     }
     if (held) {
       ++examined;
@@ -667,6 +686,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                                  " arm reaches no grasp within its slip limit at the " +
                                  std::to_string(examined) + " poses the " +
                                  suction_arm.spec.name + " arm can hold";
+    if (trapping > 0) {
+      exchange_failure += " (" + std::to_string(trapping) +
+                          " more held poses left out: the board there would stand where the " +
+                          suction_arm.spec.name + " arm goes home)";
+    }
   }
   if (!exchange_failure.empty() && direct_arms.empty()) {
     return finish(exchange_failure + "; " + direct_failure);

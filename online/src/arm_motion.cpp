@@ -520,7 +520,9 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
       !(request.start_in_contact && check(request.start, nullptr) == Verdict::kCollides)) {
     return finish(MotionStatus::kInvalidStart, "the start is invalid: " + why);
   }
-  if (const std::string why = why_invalid(request.goal); !why.empty()) {
+  if (const std::string why = why_invalid(request.goal);
+      !why.empty() &&
+      !(request.end_in_contact && check(request.goal, nullptr) == Verdict::kCollides)) {
     return finish(MotionStatus::kInvalidGoal, "the goal is invalid: " + why);
   }
   if (segment_valid(request.start, request.goal)) {
@@ -528,9 +530,11 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     r.via = "direct";
     return finish(MotionStatus::kSolved, "");
   }
-  // The start in contact is valid by design (the lift's first state).
+  // The start or goal in contact is valid by design (the lift's first state, the tool set
+  // down).
   const auto valid_here = [&](const Eigen::VectorXd& q) {
-    return (request.start_in_contact && q == request.start) || valid(q);
+    return (request.start_in_contact && q == request.start) ||
+           (request.end_in_contact && q == request.goal) || valid(q);
   };
   if (settings_.planner != MotionPlannerKind::kRoadmap) {
     if (settings_.planner == MotionPlannerKind::kRrtConnect) {

@@ -233,6 +233,7 @@ class Run {
   void stop_validation() {
     if (!queue_) return;
     if (tool_) abandon(*tool_);
+    if (tool_down_) abandon(*tool_down_);
     each_memo([&](auto& stages) {
       for (auto& entry : stages) abandon(entry.second);
     });
@@ -383,6 +384,7 @@ class Run {
   template <typename Which>
   void forget(Which which) {
     if (tool_ && which(*tool_)) tool_.reset();
+    if (tool_down_ && which(*tool_down_)) tool_down_.reset();
     each_memo([&](auto& stages) {
       std::erase_if(stages, [&](const auto& entry) { return which(entry.second); });
     });
@@ -528,7 +530,8 @@ class Run {
   // Whether a found path is smoothed: every one with more than one segment, unless its start
   // touches by design (a lift).
   bool smooths(const std::vector<Eigen::VectorXd>& path, const MotionRequest& request) const {
-    return settings_.smooth && path.size() > 2 && !request.start_in_contact;
+    return settings_.smooth && path.size() > 2 && !request.start_in_contact &&
+           !request.end_in_contact;
   }
 
   // Smooths `path` in place (SuiteSparse) under `checks`, prepared for the motion's request;
@@ -646,6 +649,7 @@ class Run {
       if (!st.ok()) abandon(st);  // failed as planned: its reports do not matter
     };
     if (tool_) drop_failed(*tool_);
+    if (tool_down_) drop_failed(*tool_down_);
     each_memo([&](auto& stages) {
       for (auto& entry : stages) drop_failed(entry.second);
     });
@@ -659,6 +663,7 @@ class Run {
       }
     };
     if (tool_) add(*tool_);
+    if (tool_down_) add(*tool_down_);
     each_memo([&](auto& stages) {
       for (auto& entry : stages) add(entry.second);
     });
@@ -736,6 +741,7 @@ class Run {
     check.tool_in_hand = stage.end.tool_in_hand;
     check.tool_world = scene_.tool;
     check.start_in_contact = request.start_in_contact;
+    check.end_in_contact = request.end_in_contact;
     if (request.held.held && !(&arm == &suction_ && stage.end.tool_in_hand)) {
       cell_.set_jaw(check.robot_q, arm, request.held.jaw);  // in the gripper, not on the cup
     }
@@ -841,6 +847,67 @@ class Run {
     home.goal = suction_.spec.home;
     if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home", "", ""); !e.empty()) {
       st.failure = e;
+    }
+    return st;
+  }
+
+  // The suction arm sets the tool down where the scene has its place on the table, freeing its
+  // gripper for a direct pick: above the place, straight down (the tool's foot meets the table:
+  // the last sample touches by design), the gripper opens (`tool_released`), back along the
+  // gripper's approach axis. Once per call, from the start.
+  const Stage& tool_down() {
+    if (tool_down_) return *tool_down_;
+    tool_down_.emplace();
+    Stage& st = *tool_down_;
+    st.end = start_;
+    if (!st.end.tool_in_hand) return st;
+    auto fail = [&](std::string why) -> const Stage& {
+      st.failure = "tool_place: " + std::move(why);
+      return st;
+    };
+    const core::Pose tcp = scene_.tool * cell_.spec().suction.handle_in_tcp.inverse();
+    const core::Pose pre = shifted(tcp, -settings_.approach * (tcp.linear() * approach_tcp_));
+    const core::Pose raised = shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift));
+    MotionRequest r;
+    r.board_world = board_initial_;
+    // At the place the tool stands on the table in the open hand (as the tool pick sees it).
+    Stage standing = st;
+    standing.end.tool_in_hand = false;
+    const auto at = first_valid(standing, suction_planner_, r,
+                                solutions(cell_, suction_, tcp, suction_.spec.home));
+    if (!at) return fail("no valid IK at the tool's place");
+    const auto above = solutions(cell_, suction_, raised, *at);
+    const auto before = solutions(cell_, suction_, pre, *at);
+    if (above.empty() || !first_valid(st, suction_planner_, r, {above.front()})) {
+      return fail("no valid IK above the tool's place");
+    }
+    if (before.empty() || !first_valid(standing, suction_planner_, r, {before.front()})) {
+      return fail("no valid IK to back off from the tool's handle");
+    }
+    MotionRequest to = r;
+    to.start = arm_q(st, suction_);
+    to.goal = above.front();
+    if (auto e = step(st, suction_planner_, suction_, to, "tool_to_place", "", ""); !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    MotionRequest down = r;
+    down.start = above.front();
+    down.goal = *at;
+    down.end_in_contact = true;
+    if (auto e = step(st, suction_planner_, suction_, down, "tool_lower", "", "tool_released");
+        !e.empty()) {
+      st.failure = e;
+      return st;
+    }
+    st.end.tool_in_hand = false;
+    cell_.set_jaw(st.end.robot_q, suction_, cell_.spec().gripper.jaw_max);
+    MotionRequest back = r;
+    back.start = *at;
+    back.goal = before.front();
+    if (auto e = step(st, suction_planner_, suction_, back, "tool_retreat", "", ""); !e.empty()) {
+      st.failure = e;
+      return st;
     }
     return st;
   }
@@ -1326,12 +1393,16 @@ class Run {
       return "the database's direct grasp refers to a missing record";
     }
     const db::RobotGraspRecord& grasp = grasp_it->second;
-    const Stage* stages[3] = {};
+    // The suction arm's gripper is free once the tool is set down.
+    const bool sets_tool_down = arm == &suction_ && start_.tool_in_hand;
+    const Stage* stages[4] = {};
     const auto plan_stages = [&] {
-      stages[0] = &gripper_pick(*arm, grasp, direct);
-      if (stages[0]->ok()) stages[1] = &direct_present(*arm, grasp, goal, direct);
-      if (stages[1] != nullptr && stages[1]->ok()) {
-        stages[2] = &direct_leave(*arm, grasp, goal, direct);
+      stages[0] = sets_tool_down ? &tool_down() : nullptr;
+      if (stages[0] != nullptr && !stages[0]->ok()) return;
+      stages[1] = &gripper_pick(*arm, grasp, direct);
+      if (stages[1]->ok()) stages[2] = &direct_present(*arm, grasp, goal, direct);
+      if (stages[2] != nullptr && stages[2]->ok()) {
+        stages[3] = &direct_leave(*arm, grasp, goal, direct);
       }
     };
     plan_stages();
@@ -1344,7 +1415,9 @@ class Run {
       speculate_ = speculating;
     }
     double clock = 0.0;
-    for (const Stage* stage : stages) {
+    for (std::size_t k = 0; k < std::size(stages); ++k) {
+      const Stage* stage = stages[k];
+      if (stage == nullptr && k == 0) continue;  // the tool stays where it is
       if (stage == nullptr) break;
       if (!stage->ok()) return stage->failure;
       for (PlanStep s : stage->steps) {
@@ -1373,7 +1446,7 @@ class Run {
     const auto found = gripper_picks_.find(key);
     if (found != gripper_picks_.end()) return found->second;
     Stage& st = gripper_picks_[key];
-    st.end = start_;
+    st.end = &arm == &suction_ && start_.tool_in_hand ? tool_down().end : start_;
     if (&arm == &suction_ && st.end.tool_in_hand) {
       st.failure = "gripper_pick: the " + arm.spec.name + " arm holds the suction tool";
       return st;
@@ -1509,6 +1582,7 @@ class Run {
 
   PlanTimes times_;
   std::optional<Stage> tool_;
+  std::optional<Stage> tool_down_;
   std::map<std::int64_t, Stage> picks_;                              // by suction grasp
   std::map<std::int64_t, Stage> transfers_;                          // by robot handover
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> receives_;  // by (handover, grasp)

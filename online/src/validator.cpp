@@ -197,7 +197,8 @@ void MotionValidation::check_parts(std::size_t first, std::size_t last, core::Co
         }
       }
       core::CollisionPair pair = rigid_pair;
-      const bool contact_allowed = motion.start_in_contact && i == 0;
+      const bool contact_allowed = (motion.start_in_contact && i == 0) ||
+                                   (motion.end_in_contact && i + 1 == times_.size());
       if (!contact_allowed &&
           (rigid_collides || core::in_collision(stage.cell.model, data, moving, &pair, rigid))) {
         violation.add("collision", t,

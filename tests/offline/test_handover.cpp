@@ -195,6 +195,14 @@ void check_stage(std::size_t index) {
     core::CollisionPair pair;
     EXPECT_FALSE(core::in_collision_brute_force(scene.cell.model, data, &pair))
         << "rr: " << core::describe_pair(scene.cell.model, pair);
+    // After the exchange the suction arm goes home with the tool, the board still held here by
+    // the receiving arm: the exchange must not trap it.
+    cell->set_arm(q, suction_arm, suction_arm.spec.home);
+    core::set_cell_state(*cell, scene.cell, data, q, cell->human_neutral());
+    core::set_tool_held(*cell, scene, data,
+                        suction_base * suction_arm.chain.fk(suction_arm.spec.home));
+    EXPECT_FALSE(core::in_collision_brute_force(scene.cell.model, data, &pair))
+        << "suction arm home after the exchange: " << core::describe_pair(scene.cell.model, pair);
     // Robot-human pose: the suction arm back home with the tool.
     q = cell->home_configuration();
     cell->set_arm(q, receiving, s.joints_rh);
@@ -208,6 +216,39 @@ void check_stage(std::size_t index) {
     ++checked;
   }
   EXPECT_GT(checked, 0);
+
+  // Every direct grasp re-verified: FK of the stored joints at the part's initial pose and at the
+  // goal, the slip there, and a brute-force collision check at the goal (the other arm home, the
+  // tool in the suction arm's hand or, when the suction arm delivers, on the table).
+  for (const auto& d : result.direct) {
+    const auto& c = result.candidates[static_cast<std::size_t>(d.candidate_id)];
+    ASSERT_EQ(c.status, "goal");
+    const auto& g = grasps.robot[static_cast<std::size_t>(d.robot_grasp_id)];
+    const core::Arm& arm = cell->arm(d.arm);
+    const core::Pose base = core::arm_base_in_world(*cell, arm);
+    EXPECT_LT(((base * arm.chain.fk(d.joints_pick)).matrix() - (part.initial * g.tcp).matrix())
+                  .norm(),
+              1e-6);
+    EXPECT_LT(((base * arm.chain.fk(d.joints_rh)).matrix() - (c.board * g.tcp).matrix()).norm(),
+              1e-6);
+    EXPECT_TRUE(slip_ok(part.initial, g));
+    EXPECT_TRUE(slip_ok(c.board, g));
+    Eigen::VectorXd q = cell->home_configuration();
+    cell->set_arm(q, arm, d.joints_rh);
+    cell->set_jaw(q, arm, std::min(0.085, g.jaw_width + 0.005));
+    core::set_cell_state(*cell, scene.cell, data, q, cell->human_neutral());
+    if (&arm == &suction_arm) {
+      core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                           product().suction_tool_pose);
+    } else {
+      core::set_tool_held(*cell, scene, data,
+                          suction_base * suction_arm.chain.fk(suction_arm.spec.home));
+    }
+    data.set_body_pose(scene.board, c.board);
+    core::CollisionPair pair;
+    EXPECT_FALSE(core::in_collision_brute_force(scene.cell.model, data, &pair))
+        << "direct rh: " << core::describe_pair(scene.cell.model, pair);
+  }
 
   // Goals with a solved human posture: the hand is on the chosen grasp.
   for (const auto* c : ranked) {

@@ -54,6 +54,8 @@ struct MotionRequest {
   // The start touches by design (a lift: the picked board or the grasped tool still rests on
   // the table): its own collisions are not checked, every later sample is.
   bool start_in_contact = false;
+  // The goal touches by design (the tool set down on the table): the same for the last sample.
+  bool end_in_contact = false;
   // Paths stored offline for this motion (the regrasp graph's, for the nominal scene), tried in
   // order before the roadmap: each is joined to the start and goal by straight segments within
   // its first and last few waypoints and re-validated against the scene as it is. A repair of

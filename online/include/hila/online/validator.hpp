@@ -27,6 +27,7 @@ struct Motion {
   bool tool_in_hand = true;                         // the suction arm holds the tool
   core::Pose tool_world = core::Pose::Identity();   // the tool's handle when not in hand
   bool start_in_contact = false;  // the first sample's collisions are by design (a lift)
+  bool end_in_contact = false;    // the last sample's are (the tool set down)
 };
 
 struct ValidatorSettings {
