@@ -1,6 +1,7 @@
 #include "hila/offline/handover.hpp"
 
 #include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -476,6 +477,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     std::vector<Receiving> picks;  // the grasps it picks the part with, grasp order
   };
   std::vector<DirectArm> direct_arms;
+  std::string direct_checks;  // per arm that picks nothing: how far its grasps got
   for (const core::Arm* a : direct_candidates) {
     if (!a->ur_ik) continue;
     DirectArm d;
@@ -495,31 +497,53 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     ps.lift = settings.pick_lift;
     ps.resolution = settings.exchange_resolution;
     ps.jaw_margin = jaw_margin;
+    std::map<GripperPickCheck, int> stopped;  // grasps by the check they failed
+    int slipping = 0;
     for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
       const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
       const double slip = slip_at(part.initial, g);
-      if (slip > grasp.theta_c_deg) continue;
+      if (slip > grasp.theta_c_deg) {
+        ++slipping;
+        continue;
+      }
       const GripperPick p = plan_gripper_pick(pick, part.initial, grasp, ps);
-      if (!p.ok()) continue;
+      if (!p.ok()) {
+        ++stopped[p.failed];
+        continue;
+      }
       Receiving r;
       r.grasp = g;
       r.joints = p.grasp;
       r.slip_deg = slip;
       d.picks.push_back(r);
     }
-    if (!d.picks.empty()) direct_arms.push_back(std::move(d));
+    if (!d.picks.empty()) {
+      direct_arms.push_back(std::move(d));
+      continue;
+    }
+    std::string counts;
+    for (const auto& [check, count] : stopped) {
+      counts += (counts.empty() ? "" : ", ") + std::to_string(count) + " " + to_string(check);
+    }
+    if (slipping > 0) {
+      counts += (counts.empty() ? "" : ", ") + std::to_string(slipping) +
+                " would slip (the slip angle over θc as the part lies)";
+    }
+    if (!direct_checks.empty()) direct_checks += "; ";
+    direct_checks += "the " + a->spec.name + " arm: " + (counts.empty() ? "no grasp" : counts);
   }
   std::string direct_failure;
   if (!settings.direct) {
     direct_failure = "direct picks are off";
+  } else if (direct_candidates.empty()) {
+    direct_failure = "no arm's gripper lifts it: " + over_payload;
   } else if (direct_arms.empty()) {
     const Eigen::Vector3d at = part.initial.translation();
     direct_failure =
         "no arm's gripper takes the part where it lies (" + core::format_number(at.x()) + ", " +
         core::format_number(at.y()) + ", " + core::format_number(at.z()) + ") m with any of its " +
-        std::to_string(grasps.robot.size()) +
-        " robot grasps: out of reach, in collision at the grasp or its way in, the lift blocked "
-        "or the part would slip";
+        std::to_string(grasps.robot.size()) + " robot grasps (" + direct_checks +
+        "); lay the part within an arm's reach with room for the open gripper around it";
   }
 
   // --- Robot-robot handover poses ----------------------------------------------------------

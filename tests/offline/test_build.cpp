@@ -171,6 +171,12 @@ TEST(Build, APartOutOfTheSuctionArmsReachIsNamedWithItsPose) {
       << last.handover_failure;
   EXPECT_NE(last.handover_failure.find("place the part within the right arm's reach"),
             std::string::npos);
+  // The direct picks' reason names each arm and how far its grasps got.
+  EXPECT_NE(last.handover_failure.find("no arm's gripper takes the part where it lies (0.3, 0.55, "
+                                       "1.0965) m"),
+            std::string::npos);
+  EXPECT_NE(last.handover_failure.find("(the left arm: "), std::string::npos);
+  EXPECT_NE(last.handover_failure.find("; the right arm: "), std::string::npos);
 }
 
 TEST(Build, SameSeedSameDigestForAnyNumberOfJobs) {

@@ -22,9 +22,16 @@ struct GripperPickSettings {
 // grasp, clear of the cell with the open gripper around the part standing at its initial pose,
 // with a way in from a pre-grasp, and the lift straight up with the part held, clear from the
 // first sample after the grasp (at the grasp the part still rests on what carries it).
+// How far the best IK branch got, for the reason a part cannot be picked: no IK solution at
+// the grasp (out of reach), none clear of the cell there, none with a way in, no IK for the
+// lift, the lift blocked.
+enum class GripperPickCheck { kReach, kGraspClear, kWayIn, kLiftReach, kLiftClear, kPicked };
+const char* to_string(GripperPickCheck check);
+
 struct GripperPick {
   Eigen::VectorXd grasp;  // joints at the grasp (empty: none)
   Eigen::VectorXd lift;   // joints after the lift
+  GripperPickCheck failed = GripperPickCheck::kReach;  // kPicked when ok()
   bool ok() const { return grasp.size() > 0 && lift.size() > 0; }
 };
 
