@@ -1406,7 +1406,8 @@ class Run {
       }
     };
     plan_stages();
-    if (!settle(stages)) {
+    // settle() reads a null as a chain stopped before it: without the tool stage, from the pick.
+    if (!settle(std::span<const Stage* const>(stages).subspan(sets_tool_down ? 0 : 1))) {
       forget([](const Stage& st) { return st.rejected_late; });
       const bool speculating = speculate_;
       speculate_ = false;

@@ -63,10 +63,19 @@ void expect_direct_plan(const online::PlannerModel& model, const online::Scene& 
   EXPECT_FALSE(plan.tool_in_hand_after);  // the tool was never needed
   std::map<std::string, Eigen::VectorXd> at(scene.robot.begin(), scene.robot.end());
   std::string events;
+  double clock = 0.0;
   for (const auto& step : plan.steps) {
     EXPECT_EQ(step.arm, arm) << step.name << ": only the picking arm moves";
     EXPECT_TRUE(step.q.front().isApprox(at.at(step.arm), 1e-9)) << step.name;
     at[step.arm] = step.q.back();
+    // Timed and validated (a queued step's report is in): increasing times, samples checked.
+    ASSERT_EQ(step.time.size(), step.q.size()) << step.name;
+    EXPECT_GE(step.time.front(), clock - 1e-12) << step.name;
+    for (std::size_t k = 1; k < step.time.size(); ++k) {
+      EXPECT_GT(step.time[k], step.time[k - 1]) << step.name << " waypoint " << k;
+    }
+    clock = step.time.back();
+    EXPECT_GT(step.validation.samples, 0) << step.name;
     EXPECT_TRUE(step.validation.valid()) << step.name;
     if (!step.event.empty()) events += step.event + " ";
   }
