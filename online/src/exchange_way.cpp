@@ -316,8 +316,9 @@ const Stage& Run::receive(const db::RobotHandoverRecord& rr, const db::RobotGras
       }
       abandon(attempt);
       if (first_failure.empty()) first_failure = failure;
-      if (failure.find("deadline") != std::string::npos) {
+      if (attempt.deadline_passed) {
         st.failure = failure;
+        st.deadline_passed = true;
         return true;
       }
     }

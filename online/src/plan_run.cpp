@@ -174,7 +174,10 @@ std::string Run::step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& 
                       MotionRequest request, const std::string& name,
                       const std::string& start_event, const std::string& end_event,
                       const std::vector<Eigen::VectorXd>& stagings) {
-  if (std::chrono::steady_clock::now() >= deadline_) return name + ": the deadline passed";
+  if (std::chrono::steady_clock::now() >= deadline_) {
+    stage.deadline_passed = true;
+    return name + ": the deadline passed";
+  }
   request.robot_q = stage.end.robot_q;
   request.tool_in_hand = stage.end.tool_in_hand;
   request.tool_world = scene_.tool;
@@ -193,7 +196,10 @@ std::string Run::step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& 
     via_staging.via += "+staging";
     motion = std::move(via_staging);
   }
-  if (!motion.solved()) return name + ": " + to_string(motion.status) + ": " + motion.reason;
+  if (!motion.solved()) {
+    if (motion.status == MotionStatus::kTimeout) stage.deadline_passed = true;
+    return name + ": " + to_string(motion.status) + ": " + motion.reason;
+  }
   PlanStep s;
   const Motion frame = motion_frame(stage, arm, request);
   const double clock = stage.steps.empty() ? 0.0 : stage.steps.back().time.back();

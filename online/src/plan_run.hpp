@@ -85,6 +85,10 @@ struct Stage {
   std::vector<PendingCheck> pending;
   // The validator rejected a step it had been planned past: the stage is planned again in order.
   bool rejected_late = false;
+  // The failure is the deadline's: step() found it passed, or the motion planner stopped at it
+  // (MotionStatus::kTimeout); receive() tries no other branch after it. Typed so that no
+  // decision reads the reason, which is for the attempt's outcome.
+  bool deadline_passed = false;
   bool ok() const { return failure.empty(); }
 };
 
@@ -216,6 +220,7 @@ class Run {
   // along an approach), tried as intermediate goals, roadmap only, when the goal itself cannot
   // be reached: a goal pressed against the robot's body or the other arm's load may attach to
   // no roadmap node while a pose a few centimetres away does.
+  // A failure that is the deadline's marks the stage (Stage::deadline_passed).
   std::string step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& arm,
                    MotionRequest request, const std::string& name, const std::string& start_event,
                    const std::string& end_event, const std::vector<Eigen::VectorXd>& stagings = {});
