@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "util/test_util.hpp"
@@ -180,7 +181,65 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
     EXPECT_EQ(h["failure"], "");
     EXPECT_FALSE(h["ranked_goals"][0]["shared_grasps"].empty());
     EXPECT_TRUE(h["ranked_goals"][0]["direct_grasps"].is_array()) << "listed, even when empty";
+
+    // The manipulation graph serves the goals the handover stage lists, by the same ways, and
+    // its edges join listed nodes.
+    const CommandRun graph = run("inspect " + out + " graph --part " + board + " --json");
+    ASSERT_EQ(graph.status, 0) << graph.out;
+    const auto gr = nlohmann::json::parse(json_part(graph.out));
+    int exchange = 0, direct = 0, first_exchange = -1;
+    for (const auto& goal : h["ranked_goals"]) {
+      exchange += goal["shared_grasps"].empty() ? 0 : 1;
+      direct += goal["direct_grasps"].empty() ? 0 : 1;
+      if (first_exchange < 0 && !goal["shared_grasps"].empty()) first_exchange = goal["rank"];
+    }
+    const auto& graph_summary = gr["summary"];
+    EXPECT_EQ(graph_summary["goals"], h["ranked_goals"].size()) << board;
+    EXPECT_EQ(graph_summary["goals_exchange"], exchange) << board;
+    EXPECT_EQ(graph_summary["goals_direct"], direct) << board;
+    int best_exchange = -1;
+    for (const auto& way : graph_summary["ways"]) {
+      EXPECT_LE(way["goals"].get<int>(), way["way"] == "direct" ? direct : exchange) << way.dump();
+      const int best = way["best_rank"];
+      if (way["way"] == "exchange" && (best_exchange < 0 || best < best_exchange)) {
+        best_exchange = best;
+      }
+    }
+    EXPECT_EQ(best_exchange, first_exchange) << board;
+    std::set<std::string> nodes;
+    int goal_nodes = 0;
+    for (const auto& n : gr["nodes"]) {
+      EXPECT_TRUE(nodes.insert(n["id"].get<std::string>()).second) << "listed twice: " << n["id"];
+      goal_nodes += n["kind"] == "goal" ? 1 : 0;
+    }
+    EXPECT_GE(goal_nodes, graph_summary["goals"].get<int>()) << board;
+    ASSERT_FALSE(gr["edges"].empty()) << board;
+    int dangling = 0, presented = 0;
+    std::string first_dangling;
+    for (const auto& e : gr["edges"]) {
+      if (nodes.count(e["from"].get<std::string>()) && nodes.count(e["to"].get<std::string>())) {
+        presented += e["kind"] == "present" ? 1 : 0;
+        continue;
+      }
+      if (dangling++ == 0) first_dangling = e.dump();
+    }
+    EXPECT_EQ(dangling, 0) << board << ", e.g. " << first_dangling;
+    EXPECT_EQ(presented, goal_nodes) << board << ": each goal node is presented to the human";
+    // Goals connected end to end in the stored regrasp graph, as `inspect roadmap` counts them.
+    const CommandRun roadmap = run("inspect " + out + " roadmap --part " + board + " --json");
+    ASSERT_EQ(roadmap.status, 0) << roadmap.out;
+    const auto stored = nlohmann::json::parse(json_part(roadmap.out));
+    int connected = 0;
+    for (const auto& goal : stored["boards"][0]["goals"]) {
+      connected += goal["connected"].get<bool>() ? 1 : 0;
+    }
+    EXPECT_EQ(graph_summary["goals_connected_offline"], connected) << board;
   }
+  const CommandRun graph_text = run("inspect " + out + " graph --part base --goals 2");
+  ASSERT_EQ(graph_text.status, 0) << graph_text.out;
+  EXPECT_NE(graph_text.out.find("goals in rank order (2 of "), std::string::npos) << graph_text.out;
+  EXPECT_NE(graph_text.out.find("  rank 1 "), std::string::npos) << graph_text.out;
+  EXPECT_EQ(graph_text.out.find("  rank 2 "), std::string::npos) << graph_text.out;
   EXPECT_NE(build.out.find("|𝕊|"), std::string::npos) << build.out;
   // The ergonomics report: hila's handover needs no forward bend wherever the human alone does.
   const CommandRun report = run("report ergonomics " + out + " --json");
@@ -292,6 +351,21 @@ TEST(Cli, BuildAndInspectBadInputs) {
   const CommandRun part = run("inspect " + dir + "/ok.hila grasps --part drawer");
   EXPECT_EQ(part.status, 2);
   EXPECT_NE(part.out.find("drawer"), std::string::npos) << part.out;
+  // The graph of an unknown part: the same error and exit status.
+  const CommandRun graph_part = run("inspect " + dir + "/ok.hila graph --part drawer");
+  EXPECT_EQ(graph_part.status, 2);
+  EXPECT_EQ(graph_part.out, part.out);
+  EXPECT_EQ(run("inspect " + dir + "/ok.hila graph").status, 2);  // no --part
+  // A part without a goal: no way, and the stage's reason.
+  const CommandRun no_goal = run("inspect " + dir + "/ok.hila graph --part top --json");
+  ASSERT_EQ(no_goal.status, 0) << no_goal.out;
+  const auto ng = nlohmann::json::parse(json_part(no_goal.out));
+  EXPECT_EQ(ng["summary"]["goals"], 0);
+  EXPECT_TRUE(ng["summary"]["ways"].empty());
+  EXPECT_EQ(ng["failure"], f["failure"]);
+  const CommandRun no_goal_text = run("inspect " + dir + "/ok.hila graph --part top");
+  EXPECT_NE(no_goal_text.out.find("no goal: " + f["failure"].get<std::string>()), std::string::npos)
+      << no_goal_text.out;
 }
 
 TEST(Cli, PlanBadInputsGiveClearErrorsAndExitCodeTwo) {

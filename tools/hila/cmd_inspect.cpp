@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cmd_inspect_graph.hpp"
 #include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
@@ -20,6 +21,7 @@ struct InspectOptions {
   std::string arm;
   bool json = false;
   int limit = 10;
+  int goals = 10;  // goals listed by `graph` (text)
 };
 
 double round_to(double v, double unit) {
@@ -322,9 +324,10 @@ int run_inspect(const InspectOptions& opt) {
     return 0;
   }
   if (opt.what == "roadmap") return inspect_roadmap(database, opt.arm, opt.part, opt.json);
+  if (opt.what == "graph") return inspect_graph(database, opt.part, opt.goals, opt.json);
   if (opt.what != "summary") {
     throw core::InputError("command line", "what",
-                           "summary, grasps, comfort, handover, roadmap or digest",
+                           "summary, grasps, comfort, handover, graph, roadmap or digest",
                            "'" + opt.what + "'");
   }
   const auto j = summary_json(database);
@@ -357,11 +360,12 @@ void add_inspect_command(CLI::App& app, Action& action) {
   inspect->add_option("database", opt->database, "database file")->required();
   inspect
       ->add_option("what", opt->what,
-                   "summary (default), grasps, comfort, handover, roadmap or digest")
+                   "summary (default), grasps, comfort, handover, graph, roadmap or digest")
       ->capture_default_str();
-  inspect->add_option("--part", opt->part, "part name (for grasps, handover and roadmap)");
+  inspect->add_option("--part", opt->part, "part name (for grasps, handover, graph and roadmap)");
   inspect->add_option("--limit", opt->limit, "goals listed (handover, text)")
       ->capture_default_str();
+  inspect->add_option("--goals", opt->goals, "goals listed (graph, text)")->capture_default_str();
   inspect->add_option("--arm", opt->arm, "human arm (comfort) or robot arm (roadmap) name");
   inspect->add_flag("--json", opt->json, "print JSON");
   inspect->callback([opt, &action] { action = [opt] { return run_inspect(*opt); }; });

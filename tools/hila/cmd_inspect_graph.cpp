@@ -1,0 +1,521 @@
+#include "cmd_inspect_graph.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "hila/core/error.hpp"
+
+namespace hila::tools {
+
+namespace {
+
+using Id = std::int64_t;
+using RrGrasp = std::pair<Id, Id>;                   // (robot handover, robot grasp)
+using RrGraspGoal = std::tuple<Id, Id, Id>;          // (robot handover, robot grasp, candidate)
+using WayKey = std::pair<std::string, std::string>;  // (suction arm, "" for direct; delivering arm)
+
+double round_to(double v, double unit) {
+  return std::round(v / unit) * unit;
+}
+
+// The regrasp-graph edges standing for one edge of the manipulation graph (one per IK branch,
+// plus parallel alternative bridges): how many, and the first connected one in id order (the
+// stored path the online planner follows first; alternatives come after it).
+struct Stored {
+  int edges = 0;
+  bool connected = false;
+  double cost = 0.0;  // rad, joint-space length of that edge's path
+  std::string via;    // how that edge was connected: "roadmap" or "bridge"
+
+  void add(const db::RegraspEdgeRecord& e) {
+    ++edges;
+    if (e.connected && !connected) {
+      connected = true;
+      cost = e.cost;
+      via = e.via;
+    }
+  }
+};
+
+template <class Map, class Key>
+const Stored* find(const Map& map, const Key& key) {
+  const auto it = map.find(key);
+  return it == map.end() ? nullptr : &it->second;
+}
+
+bool connected(const Stored* s) {
+  return s != nullptr && s->connected;
+}
+
+nlohmann::json stored_json(const Stored* s) {
+  if (s == nullptr) return nullptr;
+  return {{"edges", s->edges},
+          {"connected", s->connected},
+          {"cost_rad", s->connected ? nlohmann::json(round_to(s->cost, 1e-4)) : nullptr},
+          {"via", s->via}};
+}
+
+// "not stored", "not connected" or e.g. "5.21 rad roadmap".
+std::string status(const Stored* s) {
+  if (s == nullptr) return "not stored";
+  if (!s->connected) return "not connected";
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(2) << s->cost << " rad " << s->via;
+  return out.str();
+}
+
+// The part's regrasp graph indexed by what the manipulation graph's edges stand for.
+struct RegraspIndex {
+  std::map<Id, Stored> pick_transit;      // suction grasp -> the suction arm from home to the pick
+  std::map<Id, Stored> cup_transfer;      // robot handover -> the suction arm's transfer to it
+  std::map<RrGrasp, Stored> way_in;       // the receiving arm from home into the exchange grasp
+  std::map<RrGrasp, Stored> exchange;     // suction cup -> receiving gripper
+  std::map<RrGraspGoal, Stored> to_goal;  // the receiving arm's transfer to the goal
+
+  RegraspIndex(const std::vector<db::RegraspNodeRecord>& nodes,
+               const std::vector<db::RegraspEdgeRecord>& edges) {
+    std::map<Id, const db::RegraspNodeRecord*> node;
+    for (const auto& n : nodes) node[n.id] = &n;
+    for (const auto& e : edges) {
+      const auto& from = *node.at(e.from_node);
+      const auto& to = *node.at(e.to_node);
+      if (e.kind == "transit" && to.kind == "pick") {
+        pick_transit[to.grasp_id].add(e);
+      } else if (e.kind == "transit" && to.kind == "robot_handover") {
+        way_in[{to.robot_handover_id, to.grasp_id}].add(e);
+      } else if (e.kind == "transfer" && to.kind == "robot_handover") {
+        cup_transfer[to.robot_handover_id].add(e);
+      } else if (e.kind == "handover") {
+        exchange[{to.robot_handover_id, to.grasp_id}].add(e);
+      } else if (e.kind == "transfer" && to.kind == "human_handover") {
+        to_goal[{from.robot_handover_id, to.grasp_id, to.candidate_id}].add(e);
+      }
+    }
+  }
+
+  // Every stored edge of the exchange from the table to the goal is connected: the chain the
+  // online planner follows (as `inspect roadmap` counts a goal connected).
+  bool chain(const db::RobotHandoverRecord& rr, Id grasp, Id candidate) const {
+    return connected(find(pick_transit, rr.suction_grasp_id)) &&
+           connected(find(cup_transfer, rr.id)) &&
+           connected(find(exchange, RrGrasp{rr.id, grasp})) &&
+           connected(find(way_in, RrGrasp{rr.id, grasp})) &&
+           connected(find(to_goal, RrGraspGoal{rr.id, grasp, candidate}));
+  }
+};
+
+struct Goal {
+  db::HandoverCandidateRecord candidate;
+  std::vector<db::SharedGraspRecord> shared;
+  std::vector<db::DirectGraspRecord> direct;
+};
+
+// One way to the human: a direct pick by `arm`, or an exchange from `suction_arm`'s cup to
+// `arm`'s gripper.
+struct Way {
+  std::string suction_arm;  // "" for direct
+  std::string arm;          // the arm that delivers
+  std::set<int> ranks;      // goals served
+  std::set<int> connected;  // goals whose chain the regrasp graph connects (exchange)
+  std::set<Id> gripper_grasps, suction_grasps, robot_handovers;
+
+  bool direct() const { return suction_arm.empty(); }
+  std::string name() const {
+    return direct() ? "direct by " + arm : "exchange " + suction_arm + " -> " + arm;
+  }
+};
+
+std::string goal_node(int rank, const std::string& arm) {
+  return "goal:" + std::to_string(rank) + ":" + arm;
+}
+std::string cup_node(const std::string& arm, Id suction_grasp) {
+  return "cup:" + arm + ":" + std::to_string(suction_grasp);
+}
+std::string received_node(const std::string& arm, Id rr, Id grasp) {
+  return "received:" + arm + ":" + std::to_string(rr) + ":" + std::to_string(grasp);
+}
+
+// "1 goal", "2 goals".
+std::string count(std::size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
+// "a, b, c" of the first `most` ids, then "... (+n)".
+template <class Ids>
+std::string id_list(const Ids& ids, std::size_t most = 8) {
+  std::string out;
+  std::size_t n = 0;
+  for (const auto id : ids) {
+    if (n++ == most) {
+      out += ", ... (+" + std::to_string(ids.size() - most) + ")";
+      break;
+    }
+    out += (out.empty() ? "" : ", ") + std::to_string(id);
+  }
+  return out;
+}
+
+nlohmann::json edge_json(const std::string& from, const std::string& to, const std::string& kind,
+                         const nlohmann::json& way, const std::string& arm,
+                         const nlohmann::json& grasp_kind, const nlohmann::json& grasps,
+                         const std::string& offline, const Stored* regrasp, const Stored* transit) {
+  return {{"from", from},
+          {"to", to},
+          {"kind", kind},
+          {"way", way},
+          {"arm", arm},
+          {"grasp_kind", grasp_kind},
+          {"grasps", grasps},
+          {"offline", offline},
+          {"regrasp", stored_json(regrasp)},
+          {"transit", stored_json(transit)}};
+}
+
+struct Graph {
+  nlohmann::json json;
+  std::vector<Goal> goals;
+  std::vector<Way> ways;
+  std::map<Id, db::RobotHandoverRecord> robot_handovers;
+  RegraspIndex regrasp;
+};
+
+Graph build_graph(const db::Database& database, const db::PartRecord& part,
+                  const db::HandoverStageRecord& stage) {
+  const auto regrasp_nodes = database.regrasp_nodes(part.id);
+  const bool regrasp_stored = !regrasp_nodes.empty();
+  Graph g{{}, {}, {}, {}, {regrasp_nodes, database.regrasp_edges(part.id)}};
+  for (const auto& r : database.robot_handovers(part.id)) g.robot_handovers[r.id] = r;
+  for (const auto& c : database.handover_goals(part.id)) {
+    g.goals.push_back({c, database.shared_grasps(c.id), database.direct_grasps(c.id)});
+  }
+
+  std::map<WayKey, Way> ways;
+  std::map<std::string, std::set<Id>> picked;          // arm -> its direct grasps over every goal
+  std::set<std::tuple<std::string, Id, Id>> received;  // (receiving arm, rr, grasp)
+  int goals_direct = 0, goals_exchange = 0;
+  std::set<int> goals_connected;
+  for (const auto& goal : g.goals) {
+    const int rank = goal.candidate.rank;
+    goals_direct += goal.direct.empty() ? 0 : 1;
+    goals_exchange += goal.shared.empty() ? 0 : 1;
+    for (const auto& d : goal.direct) {
+      Way& w = ways[{"", d.arm}];
+      w.arm = d.arm;
+      w.ranks.insert(rank);
+      w.gripper_grasps.insert(d.robot_grasp_id);
+      picked[d.arm].insert(d.robot_grasp_id);
+    }
+    for (const auto& s : goal.shared) {
+      const auto& rr = g.robot_handovers.at(s.robot_handover_id);
+      Way& w = ways[{rr.arm, s.arm}];
+      w.suction_arm = rr.arm;
+      w.arm = s.arm;
+      w.ranks.insert(rank);
+      w.gripper_grasps.insert(s.robot_grasp_id);
+      w.suction_grasps.insert(rr.suction_grasp_id);
+      w.robot_handovers.insert(rr.id);
+      received.insert({s.arm, rr.id, s.robot_grasp_id});
+      if (g.regrasp.chain(rr, s.robot_grasp_id, goal.candidate.id)) {
+        w.connected.insert(rank);
+        goals_connected.insert(rank);
+      }
+    }
+  }
+  // Direct ways first: within a goal the online planner tries them first.
+  for (auto& [key, w] : ways) {
+    if (w.direct()) g.ways.push_back(w);
+  }
+  for (auto& [key, w] : ways) {
+    if (!w.direct()) g.ways.push_back(w);
+  }
+
+  nlohmann::json nodes = nlohmann::json::array();
+  nlohmann::json edges = nlohmann::json::array();
+  nodes.push_back({{"id", "table"},
+                   {"kind", "table"},
+                   {"arm", nullptr},
+                   {"label", part.name + " on the table at its initial pose"}});
+  for (const auto& [arm, grasps] : picked) {
+    nodes.push_back({{"id", "picked:" + arm},
+                     {"kind", "picked"},
+                     {"arm", arm},
+                     {"label", "in the " + arm + " gripper at the pick"},
+                     {"grasps", grasps}});
+    edges.push_back(edge_json("table", "picked:" + arm, "gripper_pick", "direct", arm, "gripper",
+                              grasps, "online", nullptr, nullptr));
+  }
+  std::set<std::pair<std::string, Id>> cups;
+  for (const auto& [id, rr] : g.robot_handovers) {
+    if (!cups.insert({rr.arm, rr.suction_grasp_id}).second) continue;
+    const std::string cup = cup_node(rr.arm, rr.suction_grasp_id);
+    const Stored* transit = find(g.regrasp.pick_transit, rr.suction_grasp_id);
+    nodes.push_back({{"id", cup},
+                     {"kind", "cup"},
+                     {"arm", rr.arm},
+                     {"label", "on the " + rr.arm + " suction cup, suction grasp " +
+                                   std::to_string(rr.suction_grasp_id)},
+                     {"suction_grasp", rr.suction_grasp_id}});
+    edges.push_back(edge_json("table", cup, "suction_pick", "exchange", rr.arm, "suction",
+                              {rr.suction_grasp_id}, transit ? "stored" : "not_stored", nullptr,
+                              transit));
+  }
+  for (const auto& [id, rr] : g.robot_handovers) {
+    const std::string node = "rr:" + std::to_string(id);
+    const Stored* transfer = find(g.regrasp.cup_transfer, id);
+    nodes.push_back({{"id", node},
+                     {"kind", "robot_handover"},
+                     {"arm", rr.arm},
+                     {"label", "at robot-robot pose " + std::to_string(id) + " on the " + rr.arm +
+                                   " suction cup"},
+                     {"robot_handover", id},
+                     {"suction_grasp", rr.suction_grasp_id}});
+    edges.push_back(edge_json(cup_node(rr.arm, rr.suction_grasp_id), node, "transfer", "exchange",
+                              rr.arm, "suction", {rr.suction_grasp_id},
+                              transfer ? "stored" : "not_stored", transfer, nullptr));
+  }
+  for (const auto& [arm, rr, grasp] : received) {
+    const std::string node = received_node(arm, rr, grasp);
+    const Stored* exchange = find(g.regrasp.exchange, RrGrasp{rr, grasp});
+    nodes.push_back({{"id", node},
+                     {"kind", "received"},
+                     {"arm", arm},
+                     {"label", "in the " + arm + " gripper at robot-robot pose " +
+                                   std::to_string(rr) + ", grasp " + std::to_string(grasp)},
+                     {"robot_handover", rr},
+                     {"grasp", grasp}});
+    edges.push_back(edge_json("rr:" + std::to_string(rr), node, "handover", "exchange", arm,
+                              "gripper", {grasp}, exchange ? "stored" : "not_stored", exchange,
+                              find(g.regrasp.way_in, RrGrasp{rr, grasp})));
+  }
+  for (const auto& goal : g.goals) {
+    const auto& c = goal.candidate;
+    std::map<std::string, std::set<Id>> direct;  // arm -> grasps
+    for (const auto& d : goal.direct) direct[d.arm].insert(d.robot_grasp_id);
+    std::set<std::string> arms;
+    for (const auto& [arm, grasps] : direct) arms.insert(arm);
+    for (const auto& s : goal.shared) arms.insert(s.arm);
+    for (const auto& arm : arms) {
+      nodes.push_back(
+          {{"id", goal_node(c.rank, arm)},
+           {"kind", "goal"},
+           {"arm", arm},
+           {"label", "at goal rank " + std::to_string(c.rank) + " in the " + arm + " gripper"},
+           {"rank", c.rank},
+           {"candidate", c.id},
+           {"distance", round_to(c.distance, 1e-5)},
+           {"quality", round_to(c.quality, 1e-4)}});
+    }
+    for (const auto& [arm, grasps] : direct) {
+      edges.push_back(edge_json("picked:" + arm, goal_node(c.rank, arm), "transfer", "direct", arm,
+                                "gripper", grasps, "online", nullptr, nullptr));
+    }
+    for (const auto& s : goal.shared) {
+      const Stored* transfer =
+          find(g.regrasp.to_goal, RrGraspGoal{s.robot_handover_id, s.robot_grasp_id, c.id});
+      edges.push_back(edge_json(received_node(s.arm, s.robot_handover_id, s.robot_grasp_id),
+                                goal_node(c.rank, s.arm), "transfer", "exchange", s.arm, "gripper",
+                                {s.robot_grasp_id}, transfer ? "stored" : "not_stored", transfer,
+                                nullptr));
+    }
+    for (const auto& arm : arms) {
+      edges.push_back(edge_json(goal_node(c.rank, arm), "human", "present", nullptr, arm, nullptr,
+                                nlohmann::json::array(), "none", nullptr, nullptr));
+    }
+  }
+  nodes.push_back(
+      {{"id", "human"}, {"kind", "human"}, {"arm", nullptr}, {"label", "taken by the human"}});
+
+  nlohmann::json ways_json = nlohmann::json::array();
+  for (const auto& w : g.ways) {
+    ways_json.push_back(
+        {{"way", w.direct() ? "direct" : "exchange"},
+         {"name", w.name()},
+         {"arm", w.arm},
+         {"suction_arm", w.direct() ? nlohmann::json(nullptr) : nlohmann::json(w.suction_arm)},
+         {"goals", w.ranks.size()},
+         {"best_rank", *w.ranks.begin()},
+         {"gripper_grasps", w.gripper_grasps},
+         {"suction_grasps", w.suction_grasps},
+         {"robot_handovers", w.robot_handovers},
+         {"goals_connected_offline",
+          w.direct() ? nlohmann::json(nullptr) : nlohmann::json(w.connected.size())}});
+  }
+  g.json = {{"part", part.name},
+            {"order", part.assembly_order},
+            {"failure", stage.failure},
+            {"regrasp_stored", regrasp_stored},
+            {"summary",
+             {{"goals", g.goals.size()},
+              {"goals_direct", goals_direct},
+              {"goals_exchange", goals_exchange},
+              {"goals_connected_offline", goals_connected.size()},
+              {"robot_handovers", g.robot_handovers.size()},
+              {"ways", ways_json}}},
+            {"nodes", nodes},
+            {"edges", edges}};
+  return g;
+}
+
+void print_text(const Graph& g, int shown_goals) {
+  const auto& j = g.json;
+  const auto& summary = j["summary"];
+  std::cout << "graph of " << j["part"].get<std::string>() << " (order " << j["order"]
+            << "): " << count(g.goals.size(), "goal") << ", " << summary["goals_exchange"]
+            << " by exchange, " << summary["goals_direct"] << " direct; "
+            << count(g.robot_handovers.size(), "robot-robot pose") << "\n";
+  if (!g.ways.empty()) {
+    std::cout << "  way                       goals  best rank  grasps\n";
+  }
+  for (const auto& w : g.ways) {
+    std::string grasps = std::to_string(w.gripper_grasps.size()) + " gripper";
+    if (!w.direct()) {
+      grasps += ", " + std::to_string(w.suction_grasps.size()) + " suction at " +
+                count(w.robot_handovers.size(), "robot-robot pose");
+    }
+    std::cout << "  " << std::left << std::setw(24) << w.name() << std::right << std::setw(7)
+              << w.ranks.size() << std::setw(11) << *w.ranks.begin() << "  " << grasps << "\n";
+  }
+  for (const auto& w : g.ways) {
+    if (w.direct()) {
+      std::cout << "  " << w.name()
+                << ": no stored path (the online planner plans it through the arm's roadmap)\n";
+    } else if (!j["regrasp_stored"].get<bool>()) {
+      std::cout << "  " << w.name() << ": the database holds no regrasp graph for this part\n";
+    } else {
+      std::cout << "  " << w.name() << ": " << count(w.connected.size(), "goal")
+                << " connected end to end in the regrasp graph"
+                << (w.connected.empty()
+                        ? ""
+                        : " (" + std::string(w.connected.size() == 1 ? "rank " : "ranks ") +
+                              id_list(w.connected, 5) + ")")
+                << "\n";
+    }
+  }
+  if (!g.goals.empty()) {
+    std::cout << "goals in rank order (" << std::min<std::size_t>(g.goals.size(), shown_goals)
+              << " of " << g.goals.size() << ")\n";
+  }
+  if (!g.goals.empty() && shown_goals > 0 && summary["goals_exchange"].get<int>() > 0) {
+    std::cout << "  (not stored: the regrasp graph has no such edge; the build examines the goals\n"
+                 "  in rank order and stops after a few are served)\n";
+  }
+  int shown = 0;
+  for (const auto& goal : g.goals) {
+    if (shown++ == shown_goals) {
+      std::cout << "  ... " << g.goals.size() - static_cast<std::size_t>(shown_goals)
+                << " more (--goals N, --json)\n";
+      break;
+    }
+    const auto& c = goal.candidate;
+    std::string hand = c.human_arm + " (" + std::to_string(c.human_grasp_id) + ")";
+    if (!c.second_arm.empty()) {
+      hand += " + " + c.second_arm + " (" + std::to_string(c.second_grasp_id) + ")";
+    }
+    std::cout << "  rank " << c.rank << "  distance " << std::fixed << std::setprecision(3)
+              << c.distance << " m  Q " << c.quality << "  human " << hand << "\n";
+    std::map<std::string, std::set<Id>> direct;  // arm -> grasps
+    for (const auto& d : goal.direct) direct[d.arm].insert(d.robot_grasp_id);
+    for (const auto& [arm, grasps] : direct) {
+      std::cout << "    direct by " << arm << ": " << count(grasps.size(), "gripper grasp") << " "
+                << id_list(grasps) << " (planned online)\n";
+    }
+    // Exchange ways, each by robot-robot pose: the suction arm's pick and transfer to it, the
+    // receiving arm's way in, and its best stored transfer to the goal over the grasps there.
+    std::map<WayKey, std::map<Id, std::vector<const db::SharedGraspRecord*>>> exchanges;
+    for (const auto& s : goal.shared) {
+      const auto& rr = g.robot_handovers.at(s.robot_handover_id);
+      exchanges[{rr.arm, s.arm}][rr.id].push_back(&s);
+    }
+    for (const auto& [key, by_rr] : exchanges) {
+      std::set<Id> grasps;
+      for (const auto& [rr, shared] : by_rr) {
+        for (const auto* s : shared) grasps.insert(s->robot_grasp_id);
+      }
+      std::cout << "    exchange " << key.first << " -> " << key.second << ": "
+                << count(grasps.size(), "gripper grasp") << " at "
+                << count(by_rr.size(), "robot-robot pose") << "\n"
+                << "        rr   cup  grasps  " << std::left << std::setw(22)
+                << key.first + " pick+transfer" << std::setw(20) << key.second + " way in"
+                << key.second + " transfer to goal" << std::right << "\n";
+      for (const auto& [id, shared] : by_rr) {
+        const auto& rr = g.robot_handovers.at(id);
+        const Stored* transit = find(g.regrasp.pick_transit, rr.suction_grasp_id);
+        const std::string to_rr = transit != nullptr && !transit->connected
+                                      ? "pick not reached"
+                                      : status(find(g.regrasp.cup_transfer, id));
+        // The receiving arm's way in, counted over the goal's grasps here, and its best stored
+        // transfer to the goal.
+        int ways_in = 0, ways_in_connected = 0;
+        const Stored* to_goal = nullptr;
+        Id to_goal_grasp = 0;
+        int tried = 0;
+        for (const auto* s : shared) {
+          const Stored* in = find(g.regrasp.way_in, RrGrasp{id, s->robot_grasp_id});
+          ways_in += in != nullptr ? 1 : 0;
+          ways_in_connected += connected(in) ? 1 : 0;
+          const Stored* t = find(g.regrasp.to_goal, RrGraspGoal{id, s->robot_grasp_id, c.id});
+          if (t == nullptr) continue;
+          ++tried;
+          if (to_goal == nullptr || (t->connected && !to_goal->connected) ||
+              (t->connected && t->cost < to_goal->cost)) {
+            to_goal = t;
+            to_goal_grasp = s->robot_grasp_id;
+          }
+        }
+        const std::string way_in = ways_in == 0 ? "not stored"
+                                                : std::to_string(ways_in_connected) + "/" +
+                                                      std::to_string(ways_in) + " connected";
+        std::string delivered = status(to_goal);
+        if (connected(to_goal)) {
+          delivered = std::to_string(to_goal_grasp) + ": " + delivered;
+        } else if (to_goal != nullptr) {
+          delivered += " (" + count(static_cast<std::size_t>(tried), "grasp") + ")";
+        }
+        std::cout << "      " << std::setw(4) << id << std::setw(6) << rr.suction_grasp_id
+                  << std::setw(8) << shared.size() << "  " << std::left << std::setw(22) << to_rr
+                  << std::setw(20) << way_in << delivered << std::right << "\n";
+      }
+    }
+  }
+  if (g.goals.empty()) {
+    std::cout << "no goal: " << j["failure"].get<std::string>() << "\n";
+  }
+}
+
+}  // namespace
+
+int inspect_graph(const db::Database& database, const std::string& part_name, int goals,
+                  bool json) {
+  if (part_name.empty()) {
+    throw core::InputError("command line", "--part", "the name of a part", "nothing");
+  }
+  if (goals < 0) {
+    throw core::InputError("command line", "--goals", "a number of goals >= 0",
+                           std::to_string(goals));
+  }
+  const auto& part = database.part(part_name);
+  const db::HandoverStageRecord* stage = database.handover_stage(part.id);
+  if (stage == nullptr) {
+    throw core::InputError(database.path(), "handover_stages",
+                           "handover goals for '" + part_name + "'",
+                           "none (a database from before schema 3: rebuild it with hila build)");
+  }
+  const Graph g = build_graph(database, part, *stage);
+  if (json) {
+    std::cout << g.json.dump(2) << "\n";
+    return 0;
+  }
+  print_text(g, goals);
+  return 0;
+}
+
+}  // namespace hila::tools
