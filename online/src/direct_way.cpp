@@ -32,16 +32,8 @@ std::string Run::direct_chain(const db::HandoverCandidateRecord& goal,
       stages[3] = &direct_leave(*arm, grasp, goal, direct);
     }
   };
-  plan_stages();
   // settle() reads a null as a chain stopped before it: without the tool stage, from the pick.
-  if (!settle(std::span<const Stage* const>(stages).subspan(sets_tool_down ? 0 : 1))) {
-    forget([](const Stage& st) { return st.rejected_late; });
-    const bool speculating = speculate_;
-    speculate_ = false;
-    std::fill(std::begin(stages), std::end(stages), nullptr);
-    plan_stages();
-    speculate_ = speculating;
-  }
+  plan_settled(stages, sets_tool_down ? 0 : 1, plan_stages);
   double clock = 0.0;
   for (std::size_t k = 0; k < std::size(stages); ++k) {
     const Stage* stage = stages[k];

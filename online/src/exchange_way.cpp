@@ -69,18 +69,7 @@ std::string Run::chain(const db::HandoverCandidateRecord& goal, const db::Shared
     if (stages[4] != nullptr && stages[4]->ok()) stages[5] = &present(rr, grasp, goal);
     if (stages[5] != nullptr && stages[5]->ok()) stages[6] = &leave(rr, grasp, goal);
   };
-  plan_stages();
-  if (!settle(stages)) {
-    // A stage planned past a step the validator then rejected, fallbacks and all, is planned
-    // again in order, validating as it goes: after a rejection it may take another branch or
-    // route. The stages after it stand (a memoised stage ends where its key says).
-    forget([](const Stage& st) { return st.rejected_late; });
-    const bool speculating = speculate_;
-    speculate_ = false;
-    std::fill(std::begin(stages), std::end(stages), nullptr);
-    plan_stages();
-    speculate_ = speculating;
-  }
+  plan_settled(stages, 0, plan_stages);
   double clock = 0.0;
   std::size_t previous_begin = 0;
   for (const Stage* stage : stages) {

@@ -368,6 +368,18 @@ std::string Run::recover(const Motion& frame, const MotionRequest& request,
   return "";
 }
 
+void Run::plan_settled(std::span<const Stage*> stages, std::size_t first,
+                       const std::function<void()>& plan_stages) {
+  plan_stages();
+  if (settle(std::span<const Stage* const>(stages).subspan(first))) return;
+  forget([](const Stage& st) { return st.rejected_late; });
+  const bool speculating = speculate_;
+  speculate_ = false;
+  std::fill(stages.begin(), stages.end(), nullptr);
+  plan_stages();
+  speculate_ = speculating;
+}
+
 bool Run::settle(std::span<const Stage* const> chain) {
   if (!queue_) return true;
   auto drop_failed = [&](Stage& st) {

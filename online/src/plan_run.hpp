@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -262,6 +263,12 @@ class Run {
   // attempts that failed further on are settled when a chain that plans through uses them, and
   // until then their jobs wait for the worker instead of holding up this chain.
   bool settle(std::span<const Stage* const> chain);
+  // Plans a way's chain (`plan_stages` fills `stages`) and settles it from stages[first] on. A
+  // stage planned past a step the validator then rejected, fallbacks and all, is planned again
+  // in order, validating as it goes: after a rejection it may take another branch or route.
+  // The stages after it stand (a memoised stage ends where its key says).
+  void plan_settled(std::span<const Stage*> stages, std::size_t first,
+                    const std::function<void()>& plan_stages);
 
   // The stage's queued reports are not wanted (an attempt given up, a stage that failed).
   void abandon(Stage& st);
