@@ -259,17 +259,18 @@ std::string settings_hash(const BuildSettings& s) {
   text.precision(17);
   text << "robot " << s.robot.samples << ' ' << s.robot.approach_rotations << ' '
        << s.robot.opening_margin << ' ' << s.robot.merge_distance << ' ' << s.robot.merge_angle_deg
-       << "\nsuction " << s.suction.rotations << ' ' << s.suction.min_area_fraction << "\nhuman "
-       << s.human.samples << ' ' << s.human.approach_rotations << ' ' << s.human.opening_margin
-       << ' ' << s.human.merge_distance << ' ' << s.human.merge_angle_deg << "\ncomfort "
+       << ' ' << s.robot.tip_clearance << ' ' << s.robot.tip_margin << "\nsuction "
+       << s.suction.rotations << ' ' << s.suction.min_area_fraction << "\nhuman " << s.human.samples
+       << ' ' << s.human.approach_rotations << ' ' << s.human.opening_margin << ' '
+       << s.human.merge_distance << ' ' << s.human.merge_angle_deg << "\ncomfort "
        << s.comfort.spacing << ' ' << s.comfort.orientations << ' ' << s.comfort.samples << '\n';
   const auto& h = s.handover;
   text << "handover " << h.candidates << ' ' << h.max_draws << ' ' << h.max_rotation_deg << ' '
        << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.two_hand_separation << ' '
        << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
        << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' ' << h.rr_per_grasp
-       << ' ' << h.human_ik_goals << ' ' << h.direct << ' ' << h.direct_stored << ' ' << h.pick_lift << ' ' << h.pick_resolution << ' '
-       << h.exchange_approach << ' ' << h.exchange_resolution;
+       << ' ' << h.human_ik_goals << ' ' << h.direct << ' ' << h.direct_stored << ' ' << h.pick_lift
+       << ' ' << h.pick_resolution << ' ' << h.exchange_approach << ' ' << h.exchange_resolution;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg

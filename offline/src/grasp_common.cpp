@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "hila/core/mesh.hpp"
 
 namespace hila::offline {
 
@@ -82,14 +85,29 @@ std::vector<TwoFingerGrasp> plan_two_finger_grasps(const core::TriangleMesh& mes
   const std::vector<ContactPair> pairs = sample_antipodal_pairs(surface, settings.antipodal);
   HandPartChecker checker(hand, mesh);
   const double half_extent = 0.5 * (mesh.max_corner() - mesh.min_corner()).maxCoeff();
+  const double reach = settings.max_tip_shift > 0.0 ? finger_reach(hand) : 0.0;
   std::vector<TwoFingerGrasp> candidates;
   for (const ContactPair& pair : pairs) {
     const double opening = std::min(pair.width + settings.opening_margin, settings.max_opening);
-    for (const core::Pose& frame : grasp_frames_about_axis(pair, settings.approach_rotations)) {
+    for (core::Pose frame : grasp_frames_about_axis(pair, settings.approach_rotations)) {
+      double shift = 0.0;
+      if (settings.max_tip_shift > 0.0) {
+        // The part's extent beyond the pair's centre along the approach.
+        const Eigen::Vector3d z = frame.linear().col(2);
+        double beyond = -std::numeric_limits<double>::infinity();
+        for (const Eigen::Vector3d& v : mesh.vertices)
+          beyond = std::max(beyond, (v - pair.centre).dot(z));
+        const double past = reach - beyond;  // > 0: the fingertips stand out past the part
+        if (past > 0.0) {
+          shift = std::min(past + settings.tip_clearance, settings.max_tip_shift);
+          frame.translation() -= shift * z;
+        }
+      }
       if (checker.collides(frame, opening)) continue;
       TwoFingerGrasp g;
       g.pair = pair;
       g.frame = frame;
+      g.tip_shift = shift;
       g.lever = axis_lever(com, pair.centre, pair.axis);
       g.quality = 0.5 * pair.alignment + 0.5 * (1.0 - std::min(1.0, g.lever / half_extent));
       candidates.push_back(g);
@@ -107,6 +125,43 @@ std::vector<TwoFingerGrasp> plan_two_finger_grasps(const core::TriangleMesh& mes
     kept.push_back(candidates[static_cast<std::size_t>(i)]);
   }
   return kept;
+}
+
+namespace {
+
+// The largest z of a shape posed by its origin.
+double top_z(const core::GeometrySpec& spec) {
+  const Eigen::Matrix3d& r = spec.origin.linear();
+  const double centre = spec.origin.translation().z();
+  switch (spec.type) {
+    case core::GeometrySpec::Type::Box:
+      return centre + 0.5 * r.row(2).cwiseAbs().dot(spec.box_size);
+    case core::GeometrySpec::Type::Cylinder:
+      // The axis's half-length plus the rim's radius across it.
+      return centre + 0.5 * spec.length * std::abs(r(2, 2)) +
+             spec.radius * std::sqrt(std::max(0.0, 1.0 - r(2, 2) * r(2, 2)));
+    case core::GeometrySpec::Type::Sphere:
+      return centre + spec.radius;
+    case core::GeometrySpec::Type::Mesh: {
+      const core::TriangleMesh mesh = core::load_mesh(spec.mesh_path, 1.0);
+      double top = -std::numeric_limits<double>::infinity();
+      for (const Eigen::Vector3d& v : mesh.vertices) {
+        top = std::max(top, (spec.origin * v.cwiseProduct(spec.mesh_scale)).z());
+      }
+      return top;
+    }
+  }
+  return centre;
+}
+
+}  // namespace
+
+double finger_reach(const HandGeometry& hand) {
+  double reach = -std::numeric_limits<double>::infinity();
+  for (const auto* group : {&hand.finger_pos, &hand.finger_neg}) {
+    for (const core::GeometrySpec& spec : *group) reach = std::max(reach, top_z(spec));
+  }
+  return reach;
 }
 
 double axis_lever(const Eigen::Vector3d& com, const Eigen::Vector3d& point_on_axis,

@@ -77,6 +77,8 @@ std::vector<db::RobotGraspRecord> plan_robot_grasps(const core::TriangleMesh& me
   two.max_opening = gripper.jaw_max;
   two.merge_distance = settings.merge_distance;
   two.merge_angle_deg = settings.merge_angle_deg;
+  two.max_tip_shift = std::max(0.0, 0.5 * gripper.pad.length - settings.tip_margin);
+  two.tip_clearance = settings.tip_clearance;
   const Eigen::Vector3d com = analysis.mass_properties.com;
   const double capacity = gripper_torque_capacity(cell);
   std::vector<db::RobotGraspRecord> grasps;

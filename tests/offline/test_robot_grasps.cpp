@@ -46,7 +46,10 @@ const Board& lateral() {
 
 // The gripper straight from the URDF (independent of offline::gripper_geometry): every link below
 // the left flange, posed for the grasp's TCP at the jaw opening the planner uses.
-bool gripper_collides_independently(const Board& board, const db::RobotGraspRecord& g) {
+// `support`: a box (world = part frame) the part rests on, checked too; size zero: none.
+bool gripper_collides_independently(const Board& board, const db::RobotGraspRecord& g,
+                                    const core::Pose& support = core::Pose::Identity(),
+                                    const Eigen::Vector3d& support_size = Eigen::Vector3d::Zero()) {
   const auto cell = test::reference_cell();
   const core::Arm& arm = cell->arm("left");
   const core::RobotModel& robot = cell->robot();
@@ -57,6 +60,11 @@ bool gripper_collides_independently(const Board& board, const db::RobotGraspReco
   const core::Pose part_from_world = g.tcp * links[robot.link_index(arm.spec.tip_link)].inverse();
   core::CollisionModel model;
   model.add_mesh_body("part", board.mesh, true);
+  if (support_size.minCoeff() > 0.0) {
+    core::GeometrySpec box;
+    box.box_size = support_size;
+    model.add_body("support", {box}, true, support);
+  }
   std::vector<int> bodies;
   std::vector<int> stack{robot.link_index(arm.spec.flange_link)};
   while (!stack.empty()) {
@@ -91,7 +99,8 @@ TEST(RobotGrasps, EveryGraspIsAntipodalInsideTheFrictionConeAndTheJawRange) {
       EXPECT_GE(g.normal_2.dot(axis), cos_cone - 1e-12);
       EXPECT_LE(g.jaw_width, gripper.jaw_max - offline::RobotGraspSettings{}.opening_margin);
       EXPECT_GE(g.jaw_width, gripper.jaw_min);
-      // The TCP sits between the contacts with its opening axis along the contact line.
+      // The TCP sits between the contacts with its opening axis along the contact line (the
+      // boards' fingertips never reach past them: no grasp is set back).
       EXPECT_LT((g.tcp.translation() - 0.5 * (g.contact_1 + g.contact_2)).norm(), 1e-9);
       EXPECT_GT(std::abs(g.tcp.linear().col(1).dot(axis)), 1 - 1e-9);
       EXPECT_TRUE(core::is_valid_pose(g.tcp, 1e-9));
@@ -205,4 +214,56 @@ TEST(RobotGrasps, APartWiderThanTheJawEverywhereHasNoGrasp) {
   settings.samples = 300;
   EXPECT_TRUE(
       offline::plan_robot_grasps(cube, analysis, 1.0, *test::reference_cell(), settings).empty());
+}
+
+TEST(RobotGrasps, FingerReachIsTheFingertipsDistanceAlongTheApproach) {
+  // The URDF's finger box ends 0.175 m past the palm, the palm 0.05 m past the flange (F/T
+  // sensor), the TCP 0.20 m past the flange: 0.025 m.
+  const auto hand = offline::gripper_geometry(*test::reference_cell(), "left");
+  EXPECT_NEAR(offline::finger_reach(hand), 0.025, 1e-12);
+}
+
+TEST(RobotGrasps, ASmallBlockOnTheTableIsTakenAtTheFingertips) {
+  // A 60 x 40 x 20 mm block resting on its 60 x 40 face: with the contact at the pads' centre
+  // the fingers reach 25 mm past it, through the table under it (10 mm below the contact).
+  Board block;
+  block.mesh = core::make_box_mesh({0.06, 0.04, 0.02});
+  block.mass = 0.05;
+  block.analysis = offline::analyze_part("block", block.mesh, block.mass);
+  offline::RobotGraspSettings settings;
+  block.grasps = offline::plan_robot_grasps(block.mesh, block.analysis, block.mass,
+                                            *test::reference_cell(), settings);
+  ASSERT_FALSE(block.grasps.empty());
+  const auto& pad = test::reference_cell()->spec().gripper.pad;
+  const double max_shift = 0.5 * pad.length - settings.tip_margin;
+  // The table: a slab whose top touches the block's bottom face (z = -0.01).
+  const core::Pose table = core::make_pose(Eigen::Vector3d(0, 0, -0.01 - 0.05));
+  const Eigen::Vector3d table_size(1.0, 1.0, 0.1 - 1e-4);
+  int from_above = 0;
+  int shifted = 0;
+  for (const auto& g : block.grasps) {
+    // The contact stays on the pads: on the approach axis, between the TCP and the fingertips.
+    const Eigen::Vector3d centre = 0.5 * (g.contact_1 + g.contact_2);
+    const Eigen::Vector3d z = g.tcp.linear().col(2);
+    const double shift = (centre - g.tcp.translation()).dot(z);
+    EXPECT_LT((centre - g.tcp.translation() - shift * z).norm(), 1e-9);
+    EXPECT_GE(shift, -1e-12);
+    EXPECT_LE(shift, max_shift + 1e-12);
+    shifted += shift > 1e-9 ? 1 : 0;
+    EXPECT_FALSE(gripper_collides_independently(block, g)) << "grasp " << g.id;
+    // Straight down onto the block: the fingers end above the table wherever the pads allow
+    // them to (the contact high enough on the block's side), and strike it elsewhere.
+    if (z.dot(-Eigen::Vector3d::UnitZ()) > 0.99) {
+      const double height = centre.z() + 0.01;  // of the contact above the table
+      const double tips = height - (0.025 - shift);  // of the fingertips above the table
+      EXPECT_EQ(gripper_collides_independently(block, g, table, table_size), tips < 0.0)
+          << "grasp " << g.id << " at " << height << " m, set back " << shift << " m";
+      if (0.025 + settings.tip_clearance - height <= max_shift) {
+        ++from_above;  // the pads allow the clearance: the grasp has it
+        EXPECT_NEAR(tips, settings.tip_clearance, 1e-9) << "grasp " << g.id;
+      }
+    }
+  }
+  EXPECT_GT(from_above, 0);
+  EXPECT_GT(shifted, 0);
 }

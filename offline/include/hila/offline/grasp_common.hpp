@@ -69,6 +69,7 @@ class HandPartChecker {
 struct TwoFingerGrasp {
   ContactPair pair;
   core::Pose frame = core::Pose::Identity();  // grasp frame in the part frame
+  double tip_shift = 0.0;  // m the frame is set back from the pair's centre along its approach
   double lever = 0.0;                         // CoM distance from the grasp axis
   double quality = 0.0;
 };
@@ -80,6 +81,13 @@ struct TwoFingerSettings {
   double max_opening = 0.085;
   double merge_distance = 0.01;
   double merge_angle_deg = 20.0;
+  // Fingertip grasps. Where the fingers, with the contact at the TCP, would reach past the part's
+  // far side along the approach, they would strike whatever the part rests on there (a 20 mm
+  // block on the table). Such a grasp is set back along its approach so the fingers end
+  // `tip_clearance` short of the part, by at most `max_tip_shift` (m; 0: never). The contact
+  // then lies that far from the TCP toward the fingertips.
+  double max_tip_shift = 0.0;
+  double tip_clearance = 0.002;  // m
 };
 
 // The grasp planner shared by the robot gripper and the human hand: antipodal pairs, frames about
@@ -89,6 +97,9 @@ std::vector<TwoFingerGrasp> plan_two_finger_grasps(const core::TriangleMesh& mes
                                                    const Eigen::Vector3d& com,
                                                    const HandGeometry& hand,
                                                    const TwoFingerSettings& settings);
+
+// How far the fingers (at opening 0) reach along the grasp frame's approach axis (z), m.
+double finger_reach(const HandGeometry& hand);
 
 // Distance of the centre of mass from the grasp axis line (the lever of the gravity torque).
 double axis_lever(const Eigen::Vector3d& com, const Eigen::Vector3d& point_on_axis,

@@ -16,6 +16,12 @@ struct RobotGraspSettings {
   double opening_margin = 0.005;  // m, the jaw opens to width + margin before closing
   double merge_distance = 0.01;   // m, near-duplicate TCP positions
   double merge_angle_deg = 20.0;  // and orientations
+  // Fingertip grasps (TwoFingerSettings::max_tip_shift): a grasp whose fingers would reach past
+  // the part is set back so they end `tip_clearance` short of it, while the contact stays at least
+  // `tip_margin` inside the pad's end (the TCP is the pads' centre, the pad `gripper.pad.length`
+  // long along the approach). A small part lying on the table is taken at the fingertips.
+  double tip_clearance = 0.002;  // m
+  double tip_margin = 0.003;     // m
   std::uint64_t seed = 1;
 };
 
