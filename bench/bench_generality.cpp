@@ -391,6 +391,47 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
   return r;
 }
 
+// Why a part was not delivered, in the two kinds: a physical impossibility in this cell
+// (over the payload; nothing the gripper or the cup can take where it lies, out of every arm's
+// reach there) or a limit of hila's planner (a way exists that hila does not try). Read from the
+// build's reason, which the database keeps as text, and the planner's status.
+struct Limit {
+  bool physical = false;
+  std::string what;
+};
+
+Limit limit_of(const PartResult& r) {
+  if (r.delivered) return {};
+  if (r.goals > 0 || r.build_failure.empty()) {
+    return {false, "hila: goals stored, none planned in the scene (" + r.status + ")"};
+  }
+  const auto has = [&](const char* text) {
+    return r.build_failure.find(text) != std::string::npos;
+  };
+  const bool no_gripper = has("no arm's gripper takes the part where it lies");
+  if (has("no arm's gripper lifts it")) return {true, "physical: over every arm's payload"};
+  if (no_gripper && has("over the payload")) {
+    return {true, "physical: over the payload on the cup, and no gripper takes it where it lies"};
+  }
+  if (no_gripper && has("no suction grasp")) {
+    return {true, "physical: no face for the cup, and no gripper takes it where it lies"};
+  }
+  if (no_gripper && has("cannot pick the part by suction")) {
+    return {false,
+            "hila: the tool's arm cannot pick it by suction, no gripper takes it where it lies "
+            "(the other arm would need the tool)"};
+  }
+  if (has("from where the part lies")) {
+    return {false,
+            "hila: a gripper picks it, but no comfortable goal with those grasps (an arm-to-arm "
+            "handover or a regrasp on the table would be needed)"};
+  }
+  if (has("shares a grasp with a robot-robot handover pose")) {
+    return {false, "hila: no comfortable goal shares a grasp with an exchange pose"};
+  }
+  return {false, "hila: " + reason_key(r.build_failure, 100)};
+}
+
 nlohmann::json part_json(const PartResult& r) {
   nlohmann::json j = {{"name", r.name},
                       {"order", r.order},
@@ -413,8 +454,11 @@ nlohmann::json part_json(const PartResult& r) {
     j["duration_s"] = r.duration;
     j["path_length_rad"] = r.path_length;
   } else {
+    const Limit limit = limit_of(r);
     j["cause"] = r.cause;
     j["top_outcome"] = r.top_outcome;
+    j["limit"] = limit.what;
+    j["physical"] = limit.physical;
   }
   return j;
 }
@@ -595,6 +639,8 @@ int run_products(const Options& opt) {
   int parts = 0, delivered = 0, products_all = 0, errors = 0;
   std::vector<double> plan_s, build_s, plan_all_s;
   std::map<std::string, int> causes;
+  std::map<std::string, int> limits;  // Limit::what of the undelivered parts
+  int physical = 0;
   std::map<std::string, std::pair<int, int>> by_kind;  // delivered, parts
   for (const auto& pr : results) {
     if (!pr.error.empty()) ++errors;
@@ -608,6 +654,9 @@ int run_products(const Options& opt) {
         plan_s.push_back(p.plan_s);
       } else {
         ++causes[p.cause];
+        const Limit limit = limit_of(p);
+        ++limits[limit.what];
+        physical += limit.physical;
       }
       auto& k = by_kind[p.kind.empty() ? "?" : p.kind];
       k.first += p.delivered;
@@ -660,7 +709,10 @@ int run_products(const Options& opt) {
     std::cout << "| " << kind << " | " << k.first << "/" << k.second << " |\n";
   }
 
-  std::cout << "\nWhy parts were not delivered (grouped; numbers as N):\n\n";
+  std::cout << "\nWhy parts were not delivered: " << physical << " of " << parts - delivered
+            << " physically impossible in this cell, the rest limits of hila's planner.\n\n";
+  print_causes(limits);
+  std::cout << "\nThe reasons in detail (grouped; numbers as N):\n\n";
   print_causes(causes);
 
   std::cout << "\nEvery undelivered part:\n\n| product | part | kind | status | cause |\n"
@@ -708,6 +760,8 @@ int run_products(const Options& opt) {
                       {"plan_s_p95_all", number(quantile(plan_all_s, 0.95))},
                       {"invalid", invalid},
                       {"errors", errors},
+                      {"physical", physical},
+                      {"limits", limits},
                       {"causes", causes}};
     out["products"] = nlohmann::json::array();
     for (const auto& pr : results) {
