@@ -523,6 +523,38 @@ TEST(Cli, AFailedWriteRemovesItsTemporaryFile) {
   EXPECT_TRUE(temporaries_in(dir).empty());
 }
 
+// The case: `plan -o` on a full disk reported the error but left plan.json.tmp.
+TEST(Cli, PlanOnAFullDiskLeavesNoTemporaryFile) {
+  const std::string dir = test::temp_dir("cli_plan_full_disk");
+  const std::string database = dir + "/c.hila";
+  const CommandRun build = run("build " + test::product_path() + " --cell " + test::cell_path() +
+                               kSmall + " --seed 1 --jobs 2 -o " + database);
+  ASSERT_LE(build.status, 1) << build.out;  // boards without goals are planned as failures
+  const std::string out = dir + "/out";
+  std::filesystem::create_directory(out);
+  const std::string plan = std::string(HILA_EXE) + " plan --db " + database + " --scene " +
+                           test::data_path("cabinet/scene.yaml") + " --all -o " + out +
+                           "/plan.json";
+  const CommandRun whole = run(plan.substr(std::string(HILA_EXE).size() + 1));
+  ASSERT_LE(whole.status, 1) << whole.out;
+  ASSERT_GT(test::read_file(out + "/plan.json").size(), 1024u);
+  std::filesystem::remove(out + "/plan.json");
+  // 1 KiB files, EFBIG instead of a kill: a write fails half way, as on a full disk.
+  const std::string command = "sh -c \"trap '' XFSZ; ulimit -f 1; " + plan + "\" 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string text;
+  std::array<char, 4096> buffer{};
+  std::size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) text.append(buffer.data(), n);
+  const int raw = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 2) << text;
+  EXPECT_NE(text.find("plan.json: (file): expected a writable path, got the write failed"),
+            std::string::npos)
+      << text;
+  EXPECT_TRUE(std::filesystem::is_empty(out));
+}
+
 TEST(Cli, CommandLineErrorsExitTwoOnOneLine) {
   const std::string dir = test::temp_dir("cli_command_line");
   expect_one_line_error(run("frobnicate"), "expected a subcommand (cell, human, mesh, product, "
