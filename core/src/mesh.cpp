@@ -59,6 +59,9 @@ TriangleMesh load_mesh(const std::string& path, double unit_scale) {
   if (!std::filesystem::exists(path)) {
     throw InputError(path, "(file)", "an existing mesh file", "no such file");
   }
+  if (std::filesystem::is_directory(path)) {
+    throw InputError(path, "(file)", "a mesh file", "a directory");
+  }
   Assimp::Importer importer;
   // Drop normals, colours and texture coordinates first so that vertices weld by position alone
   // (an STL repeats every corner once per face).

@@ -17,6 +17,37 @@ double unit_scale_from_name(const std::string& unit, const std::string& file,
   throw InputError(file, field, "one of m, cm, mm, in", "'" + unit + "'");
 }
 
+namespace {
+// The name quoted on one line: control characters as \n, \t or \xNN.
+std::string quoted_name(const std::string& name) {
+  static const char* const kHex = "0123456789abcdef";
+  std::string out = "'";
+  for (const unsigned char c : name) {
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c < 0x20 || c == 0x7f) {
+      out += std::string("\\x") + kHex[c >> 4] + kHex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "'";
+}
+
+// A part name labels tables, messages, plan files and database rows: it must be one printable
+// line.
+void check_part_name(const YamlNode& node, const std::string& name) {
+  if (name.empty()) node.fail("a non-empty part name", "''");
+  for (const unsigned char c : name) {
+    if (c < 0x20 || c == 0x7f) {
+      node.fail("a part name on one line, without control characters", quoted_name(name));
+    }
+  }
+}
+}  // namespace
+
 const PartSpec& ProductSpec::part(const std::string& part_name) const {
   for (const auto& p : parts) {
     if (p.name == part_name) return p;
@@ -45,6 +76,7 @@ ProductSpec load_product(const std::string& path) {
     p.expect_only({"name", "mesh", "mesh_unit", "mass", "target", "initial", "order"});
     PartSpec part;
     part.name = p.at("name").as_string();
+    check_part_name(p.at("name"), part.name);
     if (!names.insert(part.name).second) p.at("name").fail("a unique part name", "a duplicate");
     part.mesh_file = p.resolve_path(p.at("mesh").as_string());
     part.unit_scale =

@@ -109,6 +109,9 @@ RobotModel RobotModel::load_urdf_file(const std::string& path) {
   if (!std::filesystem::exists(path)) {
     throw InputError(path, "(file)", "an existing URDF file", "no such file");
   }
+  if (std::filesystem::is_directory(path)) {
+    throw InputError(path, "(file)", "a URDF file", "a directory");
+  }
   std::ifstream in(path);
   if (!in) throw InputError(path, "(file)", "a readable URDF file", "cannot open");
   std::stringstream buffer;
@@ -118,6 +121,15 @@ RobotModel RobotModel::load_urdf_file(const std::string& path) {
 
 RobotModel RobotModel::load_urdf_string(const std::string& xml, const std::string& source_name,
                                         const std::string& base_dir) {
+  // Text that is not XML at all (empty, a mesh, YAML): urdfdom would only say "Error document
+  // empty.".
+  std::size_t first = xml.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte order mark
+  first = xml.find_first_not_of(" \t\r\n", first);
+  if (first == std::string::npos || xml[first] != '<') {
+    throw InputError(source_name, "(file)", "a URDF (XML)",
+                     first == std::string::npos ? "an empty file"
+                                                : "text that is not XML (it does not begin with '<')");
+  }
   CaptureHandler capture;
   console_bridge::useOutputHandler(&capture);
   urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(xml);

@@ -26,6 +26,9 @@ YamlNode YamlNode::load_file(const std::string& path) {
   if (!std::filesystem::exists(path)) {
     throw InputError(path, "(file)", "an existing YAML file", "no such file");
   }
+  if (std::filesystem::is_directory(path)) {
+    throw InputError(path, "(file)", "a YAML file", "a directory");
+  }
   std::ifstream in(path);
   if (!in) throw InputError(path, "(file)", "a readable YAML file", "a file that cannot be opened");
   try {

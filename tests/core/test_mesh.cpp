@@ -139,6 +139,11 @@ TEST(Mesh, LoadMissingFileNamesThePath) {
   expect_input_error([&] { load_mesh(path, 1.0); }, {path, "no such file"});
 }
 
+TEST(Mesh, LoadADirectoryNamesThePath) {
+  const std::string dir = temp_dir("mesh_directory");
+  expect_input_error([&] { load_mesh(dir, 1.0); }, {dir, "expected a mesh file, got a directory"});
+}
+
 TEST(Mesh, LoadGarbageFileNamesThePath) {
   const std::string dir = temp_dir("mesh_garbage");
   std::mt19937_64 rng(99);

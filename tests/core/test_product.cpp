@@ -304,6 +304,25 @@ TEST(Product, DuplicatePartName) {
   expect_input_error([&] { load_product(path); }, {path, "parts[5].name", "unique"});
 }
 
+// A part name labels tables, messages and database rows: empty or multi-line names are refused
+// when the product is read, not by the build after minutes of work.
+TEST(Product, EmptyOrMultiLinePartName) {
+  const std::string empty = write_product(temp_dir("product_empty_name"),
+                                          replace_once(product_text(), "name: top", "name: ''"));
+  expect_input_error([&] { load_product(empty); },
+                     {empty, "parts[5].name", "expected a non-empty part name, got ''"});
+  const std::string newline =
+      write_product(temp_dir("product_newline_name"),
+                    replace_once(product_text(), "name: top", "name: \"to\\np\\t\""));
+  expect_input_error([&] { load_product(newline); },
+                     {newline, "parts[5].name", "without control characters, got 'to\\np\\t'"});
+}
+
+TEST(Product, ADirectoryIsNotAProductFile) {
+  const std::string dir = temp_dir("product_directory");
+  expect_input_error([&] { load_product(dir); }, {dir, "expected a YAML file, got a directory"});
+}
+
 TEST(Product, UnknownPartField) {
   const std::string text = replace_once(product_text(), "mass: 0.22", "masss: 0.22");
   const std::string path = write_product(temp_dir("product_typo"), text);

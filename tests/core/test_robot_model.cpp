@@ -163,7 +163,16 @@ TEST(RobotModel, TruncatedXmlThrows) {
   expect_input_error([&] { RobotModel::load_urdf_string(truncated, "in-memory.urdf"); },
                      {"in-memory.urdf", "a valid URDF document"});
   expect_input_error([&] { RobotModel::load_urdf_string("not xml at all", "junk.urdf"); },
-                     {"junk.urdf", "a valid URDF document"});
+                     {"junk.urdf", "expected a URDF (XML), got text that is not XML"});
+}
+
+TEST(RobotModel, AnEmptyFileOrADirectoryIsNotAUrdf) {
+  const std::string dir = temp_dir("robot_model_not_a_urdf");
+  const std::string empty = write_file(dir, "empty.urdf", " \n");
+  expect_input_error([&] { RobotModel::load_urdf_file(empty); },
+                     {empty, "expected a URDF (XML), got an empty file"});
+  expect_input_error([&] { RobotModel::load_urdf_file(dir); },
+                     {dir, "expected a URDF file, got a directory"});
 }
 
 TEST(RobotModel, JointToUnknownLinkThrows) {

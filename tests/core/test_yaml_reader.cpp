@@ -60,6 +60,11 @@ TEST(YamlReader, MissingFileNamesThePath) {
   expect_input_error([&] { YamlNode::load_file(path); }, {path, "no such file"});
 }
 
+TEST(YamlReader, ADirectoryIsNotAYamlFile) {
+  const std::string dir = temp_dir("yaml_reader_directory");
+  expect_input_error([&] { YamlNode::load_file(dir); }, {dir, "expected a YAML file, got a directory"});
+}
+
 TEST(YamlReader, MalformedYamlNamesFileAndLine) {
   const std::string dir = temp_dir("yaml_reader_malformed");
   // Line 3 opens a flow sequence that is never closed before a new block key.

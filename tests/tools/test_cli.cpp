@@ -390,3 +390,320 @@ TEST(Cli, PlanBadInputsGiveClearErrorsAndExitCodeTwo) {
   EXPECT_EQ(no_files.status, 2) << no_files.out;
   EXPECT_NE(no_files.out.find("files"), std::string::npos) << no_files.out;
 }
+
+// --- Bad input: outputs that are inputs, command-line errors, inputs refused before any work --
+
+namespace {
+
+// The build options that keep a build quick, should a refused build run after all.
+const std::string kSmall =
+    " --comfort-samples 1000 --handover-candidates 5 --roadmap-nodes 20";
+
+// The bundled cabinet and cell copied into `dir` (dir/cabinet, dir/cell: the scene's relative
+// paths still hold), so a command that wrongly overwrites an input damages only the copy.
+void copy_bundled_data(const std::string& dir) {
+  namespace fs = std::filesystem;
+  for (const char* folder : {"cabinet", "cell"}) {
+    fs::copy(test::data_path(folder), fs::path(dir) / folder, fs::copy_options::recursive);
+  }
+}
+
+// Every file directly in `dir` whose name contains ".tmp" (a temporary left behind).
+std::vector<std::string> temporaries_in(const std::string& dir) {
+  std::vector<std::string> found;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(".tmp") != std::string::npos) found.push_back(name);
+  }
+  return found;
+}
+
+// The message is one line: "hila: error: ...\n".
+void expect_one_line_error(const CommandRun& r, const std::string& fragment) {
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(r.out.rfind("hila: error: ", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.find('\n'), r.out.size() - 1) << r.out;
+  EXPECT_NE(r.out.find(fragment), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+TEST(Cli, BuildRefusesAnOutputThatIsAnInputBeforeAnyWork) {
+  const std::string dir = test::temp_dir("cli_output_is_input");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string cell = dir + "/cell/cell.yaml";
+  const std::string product_text = test::read_file(product);
+  const std::string build = "build " + product + " --cell " + cell + kSmall + " -o ";
+  struct Case {
+    std::string output;
+    std::string role;
+  };
+  std::filesystem::create_symlink(product, dir + "/link.hila");
+  std::filesystem::create_hard_link(dir + "/cabinet/shelf.stl", dir + "/hard.hila");
+  const std::vector<Case> cases = {
+      {product, "(the product file)"},
+      {dir + "/cabinet/../cabinet/product.yaml", "(the product file '" + product + "')"},
+      {dir + "/link.hila", "the product file"},
+      {dir + "/cabinet/lateral.stl", "the mesh of part 'lateral_right'"},
+      {dir + "/hard.hila", "the mesh of part 'base'"},
+      {cell, "(the cell file)"},
+      {dir + "/cell/dual_ur3.urdf", "the cell's robot URDF"},
+      {dir + "/cell/human.urdf", "the cell's human URDF"},
+  };
+  for (const Case& c : cases) {
+    const std::string before = test::read_file(c.output);
+    const CommandRun r = run(build + c.output);
+    expect_one_line_error(r, "-o: expected an output path that is not an input of the command, got '" +
+                                 c.output + "'");
+    EXPECT_NE(r.out.find(c.role), std::string::npos) << r.out;
+    EXPECT_EQ(test::read_file(c.output), before) << c.output;
+  }
+  EXPECT_EQ(test::read_file(product), product_text);
+  EXPECT_TRUE(temporaries_in(dir + "/cabinet").empty());
+}
+
+TEST(Cli, BuildRefusesAnUnusableOutputPathBeforeAnyWork) {
+  const std::string dir = test::temp_dir("cli_output_unusable");
+  const std::string build =
+      "build " + test::product_path() + " --cell " + test::cell_path() + kSmall + " -o ";
+  expect_one_line_error(run(build + "''"), "-o: expected an output file path, got ''");
+  expect_one_line_error(run(build + dir), "(a directory)");
+  const std::string long_name = dir + "/" + std::string(250, 'x') + ".hila";
+  expect_one_line_error(run(build + long_name), "the write adds a temporary suffix");
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+TEST(Cli, PlanRefusesAnOutputThatIsAnInputBeforeAnyWork) {
+  const std::string dir = test::temp_dir("cli_plan_output_is_input");
+  copy_bundled_data(dir);
+  // The check comes before the database is opened: any file stands in for it.
+  const std::string database = test::write_file(dir, "cabinet.hila", "a database\n");
+  const std::string scene = dir + "/cabinet/scene.yaml";
+  const std::string plan = "plan --db " + database + " --scene " + scene + " --all -o ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {database, "(the database)"},
+      {scene, "(the scene file)"},
+      {dir + "/cabinet/product.yaml", "the product file"},
+      {dir + "/cabinet/back_panel.stl", "the mesh of part"},
+      {dir + "/cell/cell.yaml", "the cell file"},
+      {dir + "/cell/suction_tool.urdf", "the cell's suction tool URDF"},
+  };
+  for (const auto& [output, role] : cases) {
+    const std::string before = test::read_file(output);
+    const CommandRun r = run(plan + output);
+    expect_one_line_error(r, "-o: expected an output path that is not an input of the command");
+    EXPECT_NE(r.out.find(role), std::string::npos) << r.out;
+    EXPECT_EQ(test::read_file(output), before) << output;
+  }
+  expect_one_line_error(run(plan + "''"), "-o: expected an output file path, got ''");
+}
+
+// A write that fails half way (here the file size limit, as a full disk would) leaves neither
+// the temporary file nor a partial output behind.
+TEST(Cli, AFailedWriteRemovesItsTemporaryFile) {
+  const std::string dir = test::temp_dir("cli_failed_write");
+  const std::string limit = "trap '' XFSZ; ulimit -f 1; ";  // 1 KiB files, EFBIG instead of a kill
+  const CommandRun human = run("human -o " + dir + "/h.urdf");  // the URDF is well over 1 KiB
+  ASSERT_EQ(human.status, 0) << human.out;
+  ASSERT_GT(test::read_file(dir + "/h.urdf").size(), 1024u);
+  std::filesystem::remove(dir + "/h.urdf");
+  const std::string command =
+      "sh -c \"" + limit + std::string(HILA_EXE) + " human -o " + dir + "/h.urdf\" 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 4096> buffer{};
+  std::size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) out.append(buffer.data(), n);
+  const int raw = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 2) << out;
+  EXPECT_NE(out.find("the write failed"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/h.urdf"));
+  EXPECT_TRUE(temporaries_in(dir).empty());
+}
+
+// The case: `plan -o` on a full disk reported the error but left plan.json.tmp.
+TEST(Cli, PlanOnAFullDiskLeavesNoTemporaryFile) {
+  const std::string dir = test::temp_dir("cli_plan_full_disk");
+  const std::string database = dir + "/c.hila";
+  const CommandRun build = run("build " + test::product_path() + " --cell " + test::cell_path() +
+                               kSmall + " --seed 1 --jobs 2 -o " + database);
+  ASSERT_LE(build.status, 1) << build.out;  // boards without goals are planned as failures
+  const std::string out = dir + "/out";
+  std::filesystem::create_directory(out);
+  const std::string plan = std::string(HILA_EXE) + " plan --db " + database + " --scene " +
+                           test::data_path("cabinet/scene.yaml") + " --all -o " + out +
+                           "/plan.json";
+  const CommandRun whole = run(plan.substr(std::string(HILA_EXE).size() + 1));
+  ASSERT_LE(whole.status, 1) << whole.out;
+  ASSERT_GT(test::read_file(out + "/plan.json").size(), 1024u);
+  std::filesystem::remove(out + "/plan.json");
+  // 1 KiB files, EFBIG instead of a kill: a write fails half way, as on a full disk.
+  const std::string command = "sh -c \"trap '' XFSZ; ulimit -f 1; " + plan + "\" 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string text;
+  std::array<char, 4096> buffer{};
+  std::size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) text.append(buffer.data(), n);
+  const int raw = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 2) << text;
+  EXPECT_NE(text.find("plan.json: (file): expected a writable path, got the write failed"),
+            std::string::npos)
+      << text;
+  EXPECT_TRUE(std::filesystem::is_empty(out));
+}
+
+TEST(Cli, CommandLineErrorsExitTwoOnOneLine) {
+  const std::string dir = test::temp_dir("cli_command_line");
+  expect_one_line_error(run("frobnicate"), "expected a subcommand (cell, human, mesh, product, "
+                                           "build, inspect, report, plan), got 'frobnicate'");
+  expect_one_line_error(run(""), "A subcommand is required");
+  expect_one_line_error(run("build"), "product is required (hila build --help");
+  const std::string build = "build " + test::product_path() + kSmall + " -o " + dir + "/x.hila";
+  expect_one_line_error(run(build + " --jobs 0"),
+                        "--jobs: expected an integer in [1, 1024], got 0");
+  expect_one_line_error(run(build + " --jobs two"),
+                        "--jobs: expected an integer in [1, 1024], got two");
+  expect_one_line_error(run("plan --db x.hila --scene s.yaml --all --no-such-option"),
+                        "--no-such-option");
+  EXPECT_EQ(run("--help").status, 0);
+  EXPECT_EQ(run("build --help").status, 0);
+}
+
+TEST(Cli, VersionPrintsTheProjectVersion) {
+  const CommandRun r = run("--version");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out, std::string("hila ") + HILA_VERSION + "\n");
+}
+
+TEST(Cli, NumericOptionsOutsideTheirRangeAreRefused) {
+  const std::string dir = test::temp_dir("cli_numeric_options");
+  // Quick builds but for the option under test, should a value be accepted after all.
+  auto build = [&](const std::string& option, const std::string& value) {
+    std::string command = "build " + test::product_path() + " -o " + dir + "/x.hila --jobs 2";
+    for (const char* small : {"--comfort-samples 1000", "--handover-candidates 5",
+                              "--roadmap-nodes 20"}) {
+      if (std::string(small).rfind(option, 0) != 0) command += std::string(" ") + small;
+    }
+    return run(command + " " + option + " " + value);
+  };
+  for (const char* seed : {"-1", "18446744073709551616", "1e3", "1.5"}) {
+    expect_one_line_error(build("--seed", seed),
+                          std::string("--seed: expected an integer in [0, 2^64), got ") + seed);
+  }
+  for (const char* threshold : {"nan", "inf", "-0.1", "1.5"}) {
+    expect_one_line_error(build("--comfort-threshold", threshold),
+                          std::string("--comfort-threshold: expected a number in [0, 1], got ") +
+                              threshold);
+  }
+  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
+           {"--comfort-samples", "0"},
+           {"--handover-candidates", "-5"},
+           {"--roadmap-nodes", "1e9"},
+           {"--comfort-samples", "99999999999"}}) {
+    expect_one_line_error(build(option, value),
+                          option + ": expected an integer in [1, ");
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+  const std::string plan = "plan --db x.hila --scene s.yaml --all --deadline ";
+  for (const char* deadline : {"inf", "nan", "0", "-1", "9.3e9", "86401"}) {
+    expect_one_line_error(run(plan + deadline),
+                          std::string("--deadline: expected seconds in (0, 86400], got ") +
+                              deadline);
+  }
+}
+
+TEST(Cli, MeshBoxRefusesAbsurdSizesAndAnOutputWithoutAFormat) {
+  const std::string dir = test::temp_dir("cli_mesh_bad");
+  for (const char* size : {"1e300 1 1", "1 nan 1", "1 1 inf", "1 1 1e-9"}) {
+    expect_one_line_error(run("mesh box --size " + std::string(size) + " -o " + dir + "/b.stl"),
+                          "--size: expected a length in [1e-06, 1000000], got ");
+  }
+  expect_one_line_error(run("mesh box --size 1 1 1 -o " + dir + "/m"),
+                        "extension names a mesh format (.stl, .obj, .ply), got '" + dir + "/m'");
+  expect_one_line_error(run("mesh box --size 1 1 1 -o ''"), "-o: expected an output file path");
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+  ASSERT_EQ(run("mesh box --size 10 20 30 --unit mm -o " + dir + "/b.obj").status, 0);
+  EXPECT_FALSE(test::read_file(dir + "/b.obj").empty());
+  EXPECT_TRUE(temporaries_in(dir).empty());
+}
+
+TEST(Cli, ADirectoryGivenAsAnInputFileIsBadInput) {
+  const std::string dir = test::temp_dir("cli_directory_input");
+  expect_one_line_error(run("product check " + dir + " --cell " + test::cell_path()),
+                        dir + ": (file): expected a YAML file, got a directory");
+  expect_one_line_error(run("product check " + test::product_path() + " --cell " + dir),
+                        dir + ": (file): expected a YAML file, got a directory");
+  expect_one_line_error(run("cell check " + dir), "expected a YAML file, got a directory");
+  expect_one_line_error(
+      run("build " + dir + " --cell " + test::cell_path() + kSmall + " -o " + dir + "/x.hila"),
+      "expected a YAML file, got a directory");
+  expect_one_line_error(run("build " + test::product_path() + " --cell " + dir + kSmall + " -o " +
+                            dir + "/x.hila"),
+                        "expected a YAML file, got a directory");
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+TEST(Cli, AnEmptyOrMultiLinePartNameIsRefusedByCheckAndBuild) {
+  const std::string dir = test::temp_dir("cli_part_name");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string text = test::read_file(product);
+  for (const char* name : {"''", "\"to\\np\""}) {
+    std::string changed = text;
+    changed.replace(changed.find("name: top"), 9, std::string("name: ") + name);
+    test::write_file(dir + "/cabinet", "product.yaml", changed);
+    const std::string field = "product.yaml: parts[5].name: expected a ";
+    expect_one_line_error(run("product check " + product + " --cell " + dir + "/cell/cell.yaml"),
+                          field);
+    expect_one_line_error(run("build " + product + " --cell " + dir + "/cell/cell.yaml" + kSmall +
+                              " -o " + dir + "/x.hila"),
+                          field);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+}
+
+// A mesh the build refuses (open, degenerate, ...) is refused by `product check` too, before the
+// build's work, and the message names the mesh file.
+TEST(Cli, AnOpenMeshIsRefusedNamingTheMeshFile) {
+  const std::string dir = test::temp_dir("cli_open_mesh");
+  copy_bundled_data(dir);
+  // A tetrahedron without its bottom face: 3 border edges.
+  const std::string open = test::write_file(dir + "/cabinet", "open.stl",
+                                            "solid open\n"
+                                            "facet normal 0 -1 0\nouter loop\n"
+                                            "vertex 0 0 0\nvertex 100 0 0\nvertex 0 0 100\n"
+                                            "endloop\nendfacet\n"
+                                            "facet normal -1 0 0\nouter loop\n"
+                                            "vertex 0 0 0\nvertex 0 0 100\nvertex 0 100 0\n"
+                                            "endloop\nendfacet\n"
+                                            "facet normal 1 1 1\nouter loop\n"
+                                            "vertex 100 0 0\nvertex 0 100 0\nvertex 0 0 100\n"
+                                            "endloop\nendfacet\n"
+                                            "endsolid open\n");
+  const std::string product = dir + "/cabinet/product.yaml";
+  std::string text = test::read_file(product);
+  text.replace(text.find("mesh: shelf.stl"), 15, "mesh: open.stl");
+  test::write_file(dir + "/cabinet", "product.yaml", text);
+  const std::string message =
+      open + ": mesh of part 'base' (" + product + "): expected a closed mesh, got 3 border edges";
+  expect_one_line_error(run("product check " + product + " --cell " + dir + "/cell/cell.yaml"),
+                        message);
+  expect_one_line_error(run("build " + product + " --cell " + dir + "/cell/cell.yaml" + kSmall +
+                            " -o " + dir + "/x.hila"),
+                        message);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+}
+
+TEST(Cli, AUrdfThatIsNotXmlIsNamed) {
+  const std::string dir = test::temp_dir("cli_urdf_not_xml");
+  copy_bundled_data(dir);
+  const std::string urdf = test::write_file(dir + "/cell", "human.urdf", "human: not a urdf\n");
+  expect_one_line_error(run("cell check " + dir + "/cell/cell.yaml"),
+                        urdf + ": (file): expected a URDF (XML), got text that is not XML");
+  expect_one_line_error(run("build " + test::product_path() + " --cell " + dir +
+                            "/cell/cell.yaml" + kSmall + " -o " + dir + "/x.hila"),
+                        urdf + ": (file): expected a URDF (XML)");
+}

@@ -10,10 +10,18 @@
 #include "hila/db/database.hpp"
 #include "hila/db/provenance.hpp"
 #include "hila/offline/build.hpp"
+#include "io_checks.hpp"
+#include "option_checks.hpp"
 
 namespace hila::tools {
 
 namespace {
+// Upper bounds of the build's counts: far above any useful value, low enough that a typo (an
+// extra digit, a negative number read as huge) is refused instead of exhausting memory or time.
+constexpr long long kMaxComfortSamples = 1'000'000'000;
+constexpr long long kMaxCandidatesOrNodes = 1'000'000;
+constexpr long long kMaxJobs = 1024;
+
 struct BuildOptions {
   std::string product_file;
   std::string output;
@@ -56,6 +64,11 @@ std::string why_outdated(const std::string& path, const std::string& cell_file,
 }
 
 int run_build(const BuildOptions& opt) {
+  std::vector<InputFile> inputs = product_input_files(opt.product_file);
+  for (auto&& file : cell_input_files(opt.cell_file)) inputs.push_back(file);
+  check_output_path("-o", opt.output, inputs);
+  // A mesh the build would refuse, refused before the comfort maps and roadmaps.
+  check_part_meshes(core::load_product(opt.product_file));
   offline::BuildSettings settings;
   settings.seed = opt.seed;
   settings.jobs = opt.jobs;
@@ -177,35 +190,36 @@ void add_build_command(CLI::App& app, Action& action) {
   build->add_option("-o,--output", opt->output, "database file to write (atomically)")->required();
   build->add_option("--cell", opt->cell_file, "cell YAML file")->capture_default_str();
   build->add_option("--seed", opt->seed, "random seed (same seed, same content)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(uint64_any());
   build
       ->add_option("--comfort-samples", opt->comfort_samples,
                    "arm postures sampled per human comfort map")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(int_in(1, kMaxComfortSamples));
   build
       ->add_option("--handover-candidates", opt->handover_candidates,
                    "Eq. 1 candidate poses per board")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(int_in(1, kMaxCandidatesOrNodes));
   build
       ->add_option("--comfort-threshold", opt->comfort_threshold,
                    "least human comfort Q of a handover goal (S)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(number_in(0.0, 1.0));
   build->add_option("--bodies", opt->bodies,
                     "human bodies every goal must suit, e.g. 1.50:female,1.722,1.88:male");
   build
       ->add_option("--roadmap-nodes", opt->roadmap_nodes,
                    "PRM milestones per robot arm roadmap (fewer: a faster, sparser build)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(int_in(1, kMaxCandidatesOrNodes));
   build->add_flag("--if-outdated", opt->if_outdated,
                   "keep the output when it was built by this hila from the same cell, product, "
                   "settings and seed; build it otherwise");
   build->add_option("--jobs", opt->jobs, "worker threads over parts")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(int_in(1, kMaxJobs));
   build->callback([opt, &action] { action = [opt] { return run_build(*opt); }; });
 }
 

@@ -8,10 +8,16 @@
 #include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/online/board_planner.hpp"
+#include "io_checks.hpp"
+#include "option_checks.hpp"
 
 namespace hila::tools {
 
 namespace {
+
+// The longest --deadline: a day per board (the steady clock's nanoseconds overflow past 292
+// years; anything near that is a typo).
+constexpr double kMaxDeadlineSeconds = 86400.0;
 
 struct PlanOptions {
   std::string database;
@@ -19,6 +25,7 @@ struct PlanOptions {
   std::string board;
   bool all = false;
   std::string output;
+  bool output_given = false;  // -o was on the command line (perhaps as '')
   bool json = false;
   double deadline_s = 30.0;
 };
@@ -110,33 +117,20 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
   return j;
 }
 
-// Written beside the target and renamed: a failed write leaves any previous plan whole.
-void write_atomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw core::InputError(path, "(file)", "a writable path", "cannot create it");
-    out << text;
-    if (!out.flush()) throw core::InputError(path, "(file)", "a writable path", "write failed");
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary, error);
-    throw core::InputError(path, "(file)", "a writable path", "cannot replace it");
-  }
-}
-
 int run_plan(const PlanOptions& opt) {
   if (opt.all == !opt.board.empty()) {
     throw core::InputError("hila plan", "--board/--all", "exactly one of --board NAME or --all",
                            opt.all ? "both" : "neither");
   }
-  if (!(opt.deadline_s > 0.0)) {
-    throw core::InputError("hila plan", "--deadline", "a positive number of seconds",
-                           std::to_string(opt.deadline_s));
-  }
+  std::vector<InputFile> inputs{{opt.database, "the database"}, {opt.scene, "the scene file"}};
+  if (opt.output_given) check_output_path("-o", opt.output, inputs);
   const online::SceneFiles files = online::read_scene_files(opt.scene);
+  if (opt.output_given) {
+    for (auto&& more : {cell_input_files(files.cell), product_input_files(files.product)}) {
+      inputs.insert(inputs.end(), more.begin(), more.end());
+    }
+    check_output_path("-o", opt.output, inputs);
+  }
   const auto model = online::PlannerModel::load(opt.database, files.cell, files.product);
   online::Scene scene = online::load_scene(opt.scene, model->cell(), model->product());
   std::vector<std::string> boards;
@@ -190,7 +184,7 @@ int run_plan(const PlanOptions& opt) {
     if (plan.solved()) scene.tool_in_hand = plan.tool_in_hand_after;
     for (const auto& arm : model->cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
   }
-  if (!opt.output.empty()) write_atomically(opt.output, out.dump(1) + "\n");
+  if (opt.output_given) write_file_atomically(opt.output, out.dump(1) + "\n");
   if (opt.json) std::cout << out.dump(1) << "\n";
   if (failed > 0) {
     std::cerr << "hila: " << failed << " board(s) not planned; the plan file says why\n";
@@ -209,10 +203,15 @@ void add_plan_command(CLI::App& app, Action& action) {
   cmd->add_option("--scene", opt->scene, "the scene file (docs/scene.md)")->required();
   cmd->add_option("--board", opt->board, "plan this board");
   cmd->add_flag("--all", opt->all, "plan every board still to be handled, in assembly order");
-  cmd->add_option("-o,--output", opt->output, "write the plan (JSON, docs/online.md)");
+  CLI::Option* output =
+      cmd->add_option("-o,--output", opt->output, "write the plan (JSON, docs/online.md)");
   cmd->add_flag("--json", opt->json, "print the plan as JSON instead of the table");
-  cmd->add_option("--deadline", opt->deadline_s, "seconds per board (default 30)");
-  cmd->callback([opt, &action] { action = [opt] { return run_plan(*opt); }; });
+  cmd->add_option("--deadline", opt->deadline_s, "seconds per board (default 30)")
+      ->check(number_in(0.0, kMaxDeadlineSeconds, true, "seconds"));
+  cmd->callback([opt, output, &action] {
+    opt->output_given = output->count() > 0;
+    action = [opt] { return run_plan(*opt); };
+  });
 }
 
 }  // namespace hila::tools

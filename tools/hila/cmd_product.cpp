@@ -7,8 +7,10 @@
 #include "commands.hpp"
 #include "hila/core/cell.hpp"
 #include "hila/core/collision.hpp"
+#include "hila/core/error.hpp"
 #include "hila/core/payload.hpp"
 #include "hila/core/product.hpp"
+#include "hila/offline/part_analysis.hpp"
 
 namespace hila::tools {
 
@@ -47,6 +49,7 @@ std::vector<std::string> colliding_parts(const core::Cell& cell, const core::Pro
 int run_product_check(const ProductCheckOptions& opt) {
   const auto cell = core::Cell::load(opt.cell_file);
   const core::ProductSpec product = core::load_product(opt.product_file);
+  check_part_meshes(product);
   const auto target_pairs = colliding_parts(*cell, product, true);
   const auto initial_pairs = colliding_parts(*cell, product, false);
   nlohmann::json report;
@@ -151,6 +154,22 @@ void add_product_command(CLI::App& app, Action& action) {
   check->add_option("--cell", opt->cell_file, "cell YAML file")->capture_default_str();
   check->add_flag("--json", opt->json, "print the report as JSON");
   check->callback([opt, &action] { action = [opt] { return run_product_check(*opt); }; });
+}
+
+void check_part_meshes(const core::ProductSpec& product) {
+  for (const core::PartSpec& part : product.parts) {
+    try {
+      offline::analyze_part(part.name, part.mesh, part.mass);
+    } catch (const core::InputError& e) {
+      if (e.field() != "mesh") throw;
+      // analyze_part names the part only: "<part>: mesh: expected ..., got ...".
+      std::string what = e.what();
+      const std::string prefix = e.file() + ": " + e.field() + ": ";
+      if (what.rfind(prefix, 0) == 0) what = what.substr(prefix.size());
+      throw core::InputError(part.mesh_file + ": mesh of part '" + part.name +
+                             "' (" + product.file + "): " + what);
+    }
+  }
 }
 
 namespace {

@@ -4,6 +4,8 @@
 #include <functional>
 #include <string>
 
+#include "hila/core/product.hpp"
+
 namespace hila::tools {
 
 // Each subcommand registers its options on `app` and returns the action to run when chosen.
@@ -20,6 +22,10 @@ void add_report_command(CLI::App& app, Action& action);
 void add_plan_command(CLI::App& app, Action& action);
 
 std::string default_cell_path();
+// Runs the build's mesh checks (closed, manifold, no degenerate faces, ...) on every part of the
+// product; a mesh the build would refuse throws core::InputError naming the mesh file, the
+// part and the product file. Quick (no sampling): the build and `product check` run it first.
+void check_part_meshes(const core::ProductSpec& product);
 std::string default_product_path();
 
 }  // namespace hila::tools

@@ -1,0 +1,44 @@
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace hila::tools {
+
+// A file a command reads, with how messages name it ("the product file").
+struct InputFile {
+  std::string path;
+  std::string role;
+};
+
+// The files behind a cell YAML: itself, its URDFs and every mesh those name. Collected for the
+// output check only: a file that cannot be read is skipped here (its loader reports it).
+std::vector<InputFile> cell_input_files(const std::string& cell_file);
+// The files behind a product YAML: itself and every part mesh. Skips unreadable files likewise.
+std::vector<InputFile> product_input_files(const std::string& product_file);
+
+// Throws core::InputError (exit 2) for an output path `option` (e.g. "-o") that cannot be written
+// safely, before any work: empty, a directory, a file name too long to take the temporary suffix
+// the write adds, or the same file as one of `inputs` (the same path, a symbolic link to it or a
+// hard link of it). The message names the option, the path and, for an input, its role.
+void check_output_path(const std::string& option, const std::string& output,
+                       const std::vector<InputFile>& inputs);
+
+// Bytes a temporary file name may add to the output's name (".tmp-PID-N" and SQLite's
+// "-journal"): a longer name cannot be written atomically.
+inline constexpr std::size_t kTemporarySuffixBytes = 32;
+
+// A temporary path beside `path`, unique to this process and call.
+std::string temporary_path_beside(const std::string& path);
+
+// Writes `path` through a temporary file beside it: `write` writes the temporary path (throwing
+// on failure), which is then renamed into place. On any failure (no space, no permission, an
+// exception from `write`) the temporary file is removed, a previous file at `path` is untouched,
+// and the exception propagates (core::InputError naming `path` for a failed rename).
+void write_atomically(const std::string& path,
+                      const std::function<void(const std::string& temporary)>& write);
+// write_atomically of a text; a failed write throws core::InputError naming `path` and the reason.
+void write_file_atomically(const std::string& path, const std::string& text);
+
+}  // namespace hila::tools
