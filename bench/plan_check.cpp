@@ -69,18 +69,20 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
   for (const auto& p : db.parts()) {
     if (p.name == plan.board) record = &p;
   }
-  std::optional<db::RobotGraspRecord> grasp;
+  std::optional<db::RobotGraspRecord> grasp, first_grasp;  // first: the regrasp's pick grasp
   std::optional<db::SuctionGraspRecord> cup;
+  const bool regrasp = plan.mode == online::DeliveryMode::kRegrasp;
   if (record != nullptr) {
     for (const auto& g : db.robot_grasps(record->id)) {
       if (g.id == plan.robot_grasp_id) grasp = g;
+      if (regrasp && g.id == plan.pick_grasp_id) first_grasp = g;
     }
     for (const auto& c : db.suction_grasps(record->id)) {
       if (c.id == plan.suction_grasp_id) cup = c;
     }
   }
   const bool exchange = plan.mode == online::DeliveryMode::kExchange;
-  if (!grasp || (exchange && !cup)) {
+  if (!grasp || (exchange && !cup) || (regrasp && !first_grasp)) {
     problem(plan.board, "the plan's robot or suction grasp is not in the database");
     return out;
   }
@@ -97,14 +99,26 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
   // The board in each hand, and the slip of the gripper's hold (the cup has no slip limit).
   const core::Pose board_in_cup_tcp =
       cup ? stage.cup_in_tcp * cup->cup.inverse() : core::Pose::Identity();
-  const core::Pose board_in_gripper_tcp = grasp->tcp.inverse();
+  // The gripper's grasp: the regrasp's pick grasp until the board is set down, then the plan's.
+  struct GripperHold {
+    core::Pose board_in_tcp;
+    Eigen::Vector3d lever_tcp;
+    double theta_c_deg = 90.0;
+    double jaw = 0.0;
+  };
   const Eigen::Vector3d opening = cell.spec().gripper.opening_axis.normalized();
-  const Eigen::Vector3d lever_part = core::lever_direction(
-      grasp->tcp.linear() * opening, 0.5 * (grasp->contact_1 + grasp->contact_2),
-      record->mass_properties.com);
-  const Eigen::Vector3d lever_tcp = grasp->tcp.linear().transpose() * lever_part;
-  const double holding_jaw =
-      std::min(cell.spec().gripper.jaw_max, grasp->jaw_width + settings.jaw_margin);
+  auto hold_of = [&](const db::RobotGraspRecord& g) {
+    GripperHold h;
+    h.board_in_tcp = g.tcp.inverse();
+    const Eigen::Vector3d lever_part = core::lever_direction(
+        g.tcp.linear() * opening, 0.5 * (g.contact_1 + g.contact_2), record->mass_properties.com);
+    h.lever_tcp = g.tcp.linear().transpose() * lever_part;
+    h.theta_c_deg = g.theta_c_deg;
+    h.jaw = std::min(cell.spec().gripper.jaw_max, g.jaw_width + settings.jaw_margin);
+    return h;
+  };
+  GripperHold hold = hold_of(regrasp ? *first_grasp : *grasp);
+  bool set_down = false;  // the regrasp's set-down happened
 
   // The cell at the scene's start.
   Eigen::VectorXd robot_q = cell.home_configuration();
@@ -114,14 +128,14 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
   }
   bool tool_in_hand = scene.tool_in_hand;
   bool on_cup = false, handed_over = false;
-  const core::Arm* in_gripper = nullptr;  // the arm whose gripper holds the board
+  const core::Arm* in_gripper = nullptr;              // the arm whose gripper holds the board
   core::Pose board_world = scene.initial_pose(part);  // while neither hand holds it
   auto tcp_of = [&](const core::Arm& arm) {
     return core::arm_base_in_world(cell, arm) * arm.chain.fk(cell.arm_joints(robot_q, arm));
   };
   auto board_now = [&]() {
     if (on_cup) return tcp_of(suction) * board_in_cup_tcp;
-    if (in_gripper) return tcp_of(*in_gripper) * board_in_gripper_tcp;
+    if (in_gripper) return tcp_of(*in_gripper) * hold.board_in_tcp;
     return board_world;
   };
 
@@ -176,11 +190,11 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     const bool holds_on_cup = arm == &suction && on_cup;
     motion.holds_board = holds_on_cup || arm == in_gripper;
     if (motion.holds_board) {
-      motion.board_in_tcp = holds_on_cup ? board_in_cup_tcp : board_in_gripper_tcp;
+      motion.board_in_tcp = holds_on_cup ? board_in_cup_tcp : hold.board_in_tcp;
       if (!holds_on_cup) {
         motion.slip_axis_tcp = opening;
-        motion.slip_lever_tcp = lever_tcp;
-        motion.theta_c_deg = grasp->theta_c_deg;
+        motion.slip_lever_tcp = hold.lever_tcp;
+        motion.theta_c_deg = hold.theta_c_deg;
       }
     } else {
       motion.board_world = board_now();
@@ -188,8 +202,10 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     motion.tool_in_hand = tool_in_hand;
     motion.tool_world = scene.tool;
     motion.start_in_contact = lifting;
+    // The tool's foot, or a board set down for a regrasp, meets the table at the last sample.
     motion.end_in_contact =
-        std::find(events.begin(), events.end(), "tool_released") != events.end();
+        std::find(events.begin(), events.end(), "tool_released") != events.end() ||
+        std::find(events.begin(), events.end(), "set_down") != events.end();
     const online::ValidationReport report =
         online::validate_motion(world, data, motion, settings.validator);
     out.samples += report.samples;
@@ -221,6 +237,17 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         if (!off.empty()) problem(where, "sets the tool down " + off + " its place");
         tool_in_hand = false;
         cell.set_jaw(robot_q, suction, cell.spec().gripper.jaw_max);
+      } else if (e == "set_down") {
+        if (!regrasp || set_down || in_gripper != arm || on_cup) {
+          problem(where, "sets down a board it does not hold, or not for a regrasp");
+        }
+        const std::string at = pose_error(board_now(), plan.set_down);
+        if (!at.empty()) problem(where, "sets the board down " + at + " the plan's set-down pose");
+        board_world = board_now();
+        in_gripper = nullptr;
+        set_down = true;
+        hold = hold_of(*grasp);  // the next close takes it with the delivering grasp
+        cell.set_jaw(robot_q, *arm, cell.spec().gripper.jaw_max);
       } else if (e == "suction_on") {
         if (arm != &suction || !tool_in_hand || on_cup || in_gripper != nullptr || handed_over) {
           problem(where, "suction on without the tool or with the board already taken");
@@ -230,7 +257,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         on_cup = true;
         lifting = true;
       } else if (e == "gripper_close") {
-        const std::string off = pose_error(tcp_of(*arm) * board_in_gripper_tcp, board_now());
+        const std::string off = pose_error(tcp_of(*arm) * hold.board_in_tcp, board_now());
         if (!off.empty()) problem(where, "the gripper closes " + off + " the board");
         if (on_cup) {  // the exchange: from the suction arm's cup to the other arm's gripper
           if (arm == &suction) problem(where, "the suction arm closes on the board on its cup");
@@ -238,13 +265,15 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
           if (!at.empty()) problem(where, "the exchange is " + at + " the plan's robot-robot pose");
         } else {  // a direct pick where the board lies
           if (exchange || in_gripper != nullptr || handed_over) {
-            problem(where, "closes on a board that is not standing where it was detected");
+            problem(where,
+                    "closes on a board that is not standing where it was detected or set "
+                    "down");
           }
           if (arm == &suction && tool_in_hand) problem(where, "closes a gripper holding the tool");
           lifting = true;
         }
         in_gripper = arm;
-        cell.set_jaw(robot_q, *arm, holding_jaw);
+        cell.set_jaw(robot_q, *arm, hold.jaw);
       } else if (e == "wait_for_human") {
         if (in_gripper != arm || on_cup) problem(where, "waits for the human without the board");
         const std::string at = pose_error(board_now(), plan.human_handover);

@@ -599,6 +599,27 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.inclination_pick_deg = s.next_double();
         r.inclination_rh_deg = s.next_double();
       });
+  db.table_regrasps_ = load_rows<TableRegraspRecord>(
+      *connection, "table_regrasps",
+      "candidate_id, pick_grasp_id, robot_grasp_id, arm, " + pose_columns("placement") +
+          ", joints_pick, joints_place, joints_repick, joints_rh, inclination_pick_deg, "
+          "inclination_place_deg, inclination_repick_deg, inclination_rh_deg",
+      fix, [&](detail::Statement& s, std::int64_t id, TableRegraspRecord& r) {
+        r.id = id;
+        r.candidate_id = s.next_int64();
+        r.pick_grasp_id = s.next_int64();
+        r.robot_grasp_id = s.next_int64();
+        r.arm = s.next_text();
+        r.placement = read_pose(s, path, "table_regrasps", "placement", id, fix);
+        r.joints_pick = read_joints(s, path, "table_regrasps", "joints_pick", id, fix);
+        r.joints_place = read_joints(s, path, "table_regrasps", "joints_place", id, fix);
+        r.joints_repick = read_joints(s, path, "table_regrasps", "joints_repick", id, fix);
+        r.joints_rh = read_joints(s, path, "table_regrasps", "joints_rh", id, fix);
+        r.inclination_pick_deg = s.next_double();
+        r.inclination_place_deg = s.next_double();
+        r.inclination_repick_deg = s.next_double();
+        r.inclination_rh_deg = s.next_double();
+      });
   db.ergonomics_ = load_rows<ErgonomicsRecord>(
       *connection, "ergonomics",
       "part_id, method, reachable, torso_flexion_deg, shoulder_elevated, reach, "
@@ -773,6 +794,13 @@ std::vector<DirectGraspRecord> Database::direct_grasps(std::int64_t candidate_id
   std::vector<DirectGraspRecord> selected;
   std::copy_if(direct_grasps_.begin(), direct_grasps_.end(), std::back_inserter(selected),
                [&](const DirectGraspRecord& g) { return g.candidate_id == candidate_id; });
+  return selected;
+}
+
+std::vector<TableRegraspRecord> Database::table_regrasps(std::int64_t candidate_id) const {
+  std::vector<TableRegraspRecord> selected;
+  std::copy_if(table_regrasps_.begin(), table_regrasps_.end(), std::back_inserter(selected),
+               [&](const TableRegraspRecord& g) { return g.candidate_id == candidate_id; });
   return selected;
 }
 

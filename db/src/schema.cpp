@@ -7,7 +7,7 @@ namespace hila::db {
 
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 5;
+  return 6;
 }
 
 namespace detail {
@@ -259,12 +259,38 @@ CREATE TABLE direct_grasps (
 CREATE INDEX direct_grasps_candidate_id ON direct_grasps(candidate_id);
 )sql";
 
+// The table_regrasps table as schema version 6 defines it (with its index): regrasps on the table
+// by one arm's gripper (records::TableRegraspRecord). Created by schema_sql() and by the 5 -> 6
+// step from this text. The placement is a pose; the joints are joint vectors as in the version 3
+// tables.
+constexpr const char* kCreateTableRegraspsV6 = R"sql(
+CREATE TABLE table_regrasps (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  pick_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  arm TEXT NOT NULL,
+  placement_x REAL NOT NULL, placement_y REAL NOT NULL, placement_z REAL NOT NULL,
+  placement_qw REAL NOT NULL, placement_qx REAL NOT NULL, placement_qy REAL NOT NULL,
+  placement_qz REAL NOT NULL,
+  joints_pick BLOB NOT NULL,
+  joints_place BLOB NOT NULL,
+  joints_repick BLOB NOT NULL,
+  joints_rh BLOB NOT NULL,
+  inclination_pick_deg REAL NOT NULL,
+  inclination_place_deg REAL NOT NULL,
+  inclination_repick_deg REAL NOT NULL,
+  inclination_rh_deg REAL NOT NULL
+);
+CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);
+)sql";
+
 }  // namespace
 
 // Written out in full (not generated) so this file is the readable reference of the schema (the
 // comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
 // kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones, the
-// direct_grasps table kCreateDirectGraspsV5).
+// direct_grasps table kCreateDirectGraspsV5, the table_regrasps table kCreateTableRegraspsV6).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
@@ -345,7 +371,8 @@ CREATE TABLE human_grasps (
 );
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql" + std::string(kCreateComfortMapsV2) +
-                                 create_tables_v3() + create_tables_v4() + kCreateDirectGraspsV5;
+                                 create_tables_v3() + create_tables_v4() + kCreateDirectGraspsV5 +
+                                 kCreateTableRegraspsV6;
   return sql;
 }
 
@@ -366,6 +393,8 @@ const std::vector<MigrationStep>& migration_steps() {
       // 4 -> 5: direct grasps (a new table, empty in a migrated file until it is rebuilt; the old
       // tables are unchanged).
       {4, kCreateDirectGraspsV5},
+      // 5 -> 6: regrasps on the table (a new table, empty in a migrated file until it is rebuilt).
+      {5, kCreateTableRegraspsV6},
   };
   return steps;
 }

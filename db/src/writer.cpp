@@ -144,8 +144,8 @@ struct DatabaseWriter::Impl {
   // Prepared once, reused for every row; destroyed before the connection closes.
   std::optional<detail::Statement> insert_meta, insert_part, insert_placement, insert_robot,
       insert_suction, insert_human, insert_comfort, insert_stage, insert_robot_handover,
-      insert_candidate, insert_shared, insert_direct, insert_ergonomics, insert_roadmap,
-      insert_filter, insert_regrasp_node, insert_regrasp_edge, select_robot_grasp,
+      insert_candidate, insert_shared, insert_direct, insert_regrasp, insert_ergonomics,
+      insert_roadmap, insert_filter, insert_regrasp_node, insert_regrasp_edge, select_robot_grasp,
       select_suction_grasp;
   std::map<std::int64_t, RoadmapShape> roadmaps;  // by id
   bool meta_written = false;
@@ -192,6 +192,7 @@ struct DatabaseWriter::Impl {
     insert_candidate.reset();
     insert_shared.reset();
     insert_direct.reset();
+    insert_regrasp.reset();
     insert_ergonomics.reset();
     insert_roadmap.reset();
     insert_filter.reset();
@@ -316,6 +317,15 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
                                        "candidate_id, robot_grasp_id, arm, joints_pick, joints_rh, "
                                        "inclination_pick_deg, inclination_rh_deg"),
                             m.context("direct_grasps"));
+    m.insert_regrasp.emplace(
+        *m.connection,
+        insert_sql("table_regrasps",
+                   "candidate_id, pick_grasp_id, robot_grasp_id, arm, " +
+                       pose_columns("placement") +
+                       ", joints_pick, joints_place, joints_repick, joints_rh, "
+                       "inclination_pick_deg, inclination_place_deg, inclination_repick_deg, "
+                       "inclination_rh_deg"),
+        m.context("table_regrasps"));
     m.insert_ergonomics.emplace(
         *m.connection,
         insert_sql("ergonomics",
@@ -686,6 +696,52 @@ void DatabaseWriter::add_direct_grasps(const std::vector<DirectGraspRecord>& gra
       bind_joints(s, g.joints_pick);
       bind_joints(s, g.joints_rh);
       s.bind_next(g.inclination_pick_deg);
+      s.bind_next(g.inclination_rh_deg);
+      s.run();
+    }
+  });
+}
+
+void DatabaseWriter::add_table_regrasps(const std::vector<TableRegraspRecord>& regrasps) {
+  Impl& m = *impl_;
+  m.guarded("add_table_regrasps", [&] {
+    FiniteCheck check("add_table_regrasps", "table_regrasps");
+    for (std::size_t i = 0; i < regrasps.size(); ++i) {
+      const auto& g = regrasps[i];
+      const std::string record =
+          record_label(i, regrasps.size(), "candidate id " + std::to_string(g.candidate_id));
+      if (g.arm.empty()) {
+        refuse("add_table_regrasps", "table_regrasps.arm", record,
+               "TableRegraspRecord::arm is empty, expected an arm name");
+      }
+      check.set_record(record);
+      check.pose("placement", g.placement);
+      check.joints("joints_pick", g.joints_pick);
+      check.joints("joints_place", g.joints_place);
+      check.joints("joints_repick", g.joints_repick);
+      check.joints("joints_rh", g.joints_rh);
+      check.value("inclination_pick_deg", g.inclination_pick_deg);
+      check.value("inclination_place_deg", g.inclination_place_deg);
+      check.value("inclination_repick_deg", g.inclination_repick_deg);
+      check.value("inclination_rh_deg", g.inclination_rh_deg);
+    }
+    detail::Statement& s = *m.insert_regrasp;
+    for (const auto& g : regrasps) {
+      s.set_context(m.context("table_regrasps (candidate id " + std::to_string(g.candidate_id) +
+                              ", robot grasp id " + std::to_string(g.robot_grasp_id) + ", arm '" +
+                              g.arm + "')"));
+      s.bind_next(g.candidate_id);
+      s.bind_next(g.pick_grasp_id);
+      s.bind_next(g.robot_grasp_id);
+      s.bind_next(g.arm);
+      bind_pose(s, g.placement);
+      bind_joints(s, g.joints_pick);
+      bind_joints(s, g.joints_place);
+      bind_joints(s, g.joints_repick);
+      bind_joints(s, g.joints_rh);
+      s.bind_next(g.inclination_pick_deg);
+      s.bind_next(g.inclination_place_deg);
+      s.bind_next(g.inclination_repick_deg);
       s.bind_next(g.inclination_rh_deg);
       s.run();
     }

@@ -187,6 +187,13 @@ HandoverIds write_handover(db::DatabaseWriter& writer, std::int64_t part_id,
     d.robot_grasp_id = id_of(robot_ids, d.robot_grasp_id);
   }
   writer.add_direct_grasps(direct);
+  std::vector<db::TableRegraspRecord> regrasps = h.regrasps;
+  for (auto& r : regrasps) {
+    r.candidate_id = id_of(candidate_ids, r.candidate_id);
+    r.pick_grasp_id = id_of(robot_ids, r.pick_grasp_id);
+    r.robot_grasp_id = id_of(robot_ids, r.robot_grasp_id);
+  }
+  writer.add_table_regrasps(regrasps);
   return {rr_ids, candidate_ids};
 }
 
@@ -270,7 +277,9 @@ std::string settings_hash(const BuildSettings& s) {
        << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
        << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' ' << h.rr_per_grasp
        << ' ' << h.human_ik_goals << ' ' << h.direct << ' ' << h.direct_stored << ' ' << h.pick_lift
-       << ' ' << h.pick_resolution << ' ' << h.exchange_approach << ' ' << h.exchange_resolution;
+       << ' ' << h.pick_resolution << ' ' << h.exchange_approach << ' ' << h.exchange_resolution
+       << ' ' << h.table_regrasp.enabled << ' ' << h.table_regrasp.placements << ' '
+       << h.table_regrasp.yaws << ' ' << h.table_regrasp.support_tolerance;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
@@ -364,7 +373,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   const HumanComfort comfort(*cell, maps, settings.human_bodies);
   run_tasks(settings.jobs, n, [&](std::size_t i) {
     PartResult& r = results[i];
-    BoardGrasps grasps{r.robot, r.suction, r.human, r.record.mass_properties.com};
+    BoardGrasps grasps{r.robot, r.suction, r.human, r.record.mass_properties.com, r.placements};
     HandoverSettings handover = settings.handover;
     handover.pick_resolution = settings.roadmap.resolution;
     handover.seed = part_seed(settings.seed, product.parts[i].name, 4);

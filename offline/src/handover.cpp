@@ -1,9 +1,11 @@
 #include "hila/offline/handover.hpp"
 
 #include <algorithm>
-#include <map>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <optional>
 #include <random>
 
 #include "hila/core/collision.hpp"
@@ -473,8 +475,19 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     const core::Arm* arm = nullptr;
     core::Pose base_inv = core::Pose::Identity();
     bool tool_on_table = false;
-    std::vector<int> bodies;  // the arm's and the board's: checked at the robot-human pose
+    std::vector<int> bodies;       // the arm's and the board's: checked at the robot-human pose
     std::vector<Receiving> picks;  // the grasps it picks the part with, grasp order
+    std::unique_ptr<ArmWorkspace> workspace;  // the part standing, for picks and set-downs
+    GripperPickSettings pick_settings;
+    // Regrasps on the table, found when a goal first needs them: where the part is set down
+    // with a pick grasp and which grasps take it again there.
+    struct SetDown {
+      core::Pose board;
+      Receiving pick;                  // a pick grasp at the part's initial pose
+      Receiving place;                 // the same grasp, its IK at the set-down pose
+      std::vector<Receiving> repicks;  // the grasps that take it again there
+    };
+    std::optional<std::vector<SetDown>> set_downs;
   };
   std::vector<DirectArm> direct_arms;
   std::string direct_checks;  // per arm that picks nothing: how far its grasps got
@@ -488,10 +501,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       if (&cell.arms()[k] == a) d.bodies = scene.cell.arm_bodies[k];
     }
     d.bodies.push_back(scene.board);
-    ArmWorkspace pick(cell, a->spec.name, suction_arm.spec.name, &part.mesh, finished,
-                      core::parts_after(product, index),
-                      d.tool_on_table ? &product.suction_tool_pose : nullptr);
-    GripperPickSettings ps;
+    d.workspace = std::make_unique<ArmWorkspace>(
+        cell, a->spec.name, suction_arm.spec.name, &part.mesh, finished,
+        core::parts_after(product, index), d.tool_on_table ? &product.suction_tool_pose : nullptr);
+    ArmWorkspace& pick = *d.workspace;
+    GripperPickSettings& ps = d.pick_settings;
     ps.approach = settings.exchange_approach;
     ps.approach_resolution = settings.exchange_resolution;
     ps.lift = settings.pick_lift;
@@ -532,6 +546,43 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     if (!direct_checks.empty()) direct_checks += "; ";
     direct_checks += "the " + a->spec.name + " arm: " + (counts.empty() ? "no grasp" : counts);
   }
+  // Regrasps on the table. Arm d's set-downs, found once when a goal first needs them: the poses
+  // where one of its pick grasps sets the part down (plan_gripper_pick's way in and lift, run
+  // backwards) and the other grasps take it again (plan_gripper_pick), each within θc there.
+  const std::vector<core::Pose> set_down_poses =
+      settings.direct ? table_set_down_poses(cell, part.mesh, grasps.com, part.initial,
+                                             grasps.placements, settings.table_regrasp)
+                      : std::vector<core::Pose>{};
+  auto set_downs_of = [&](DirectArm& d) -> const std::vector<DirectArm::SetDown>& {
+    if (d.set_downs) return *d.set_downs;
+    d.set_downs.emplace();
+    auto taken = [&](const core::Pose& board, int g, Receiving& out) {
+      const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
+      const double slip = slip_at(board, g);
+      if (slip > grasp.theta_c_deg) return false;
+      const GripperPick p = plan_gripper_pick(*d.workspace, board, grasp, d.pick_settings);
+      if (!p.ok()) return false;
+      out = {g, p.grasp, slip};
+      return true;
+    };
+    for (const core::Pose& board : set_down_poses) {
+      DirectArm::SetDown down;
+      down.board = board;
+      for (const Receiving& at_pick : d.picks) {
+        if (!taken(board, at_pick.grasp, down.place)) continue;
+        down.pick = at_pick;
+        break;
+      }
+      if (down.place.grasp < 0) continue;
+      for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+        Receiving again;
+        if (g != down.place.grasp && taken(board, g, again)) down.repicks.push_back(again);
+      }
+      if (!down.repicks.empty()) d.set_downs->push_back(std::move(down));
+    }
+    return *d.set_downs;
+  };
+
   std::string direct_failure;
   if (!settings.direct) {
     direct_failure = "direct picks are off";
@@ -708,8 +759,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                                  "of the shared-workspace poses"
                            : "no robot-robot handover pose: the " + receiving_arm.spec.name +
                                  " arm reaches no grasp within its slip limit at the " +
-                                 std::to_string(examined) + " poses the " +
-                                 suction_arm.spec.name + " arm can hold";
+                                 std::to_string(examined) + " poses the " + suction_arm.spec.name +
+                                 " arm can hold";
     if (trapping > 0) {
       exchange_failure += " (" + std::to_string(trapping) +
                           " more held poses left out: the board there would stand where the " +
@@ -820,7 +871,54 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         data.set_body_pose(scene.board, c.board);
       }
       reset_state();
-      if (shared == 0 && direct == 0) continue;
+      int regrasps = 0;
+      if (shared == 0 && direct == 0 && settings.table_regrasp.enabled) {
+        for (DirectArm& d : direct_arms) {
+          const auto& downs = set_downs_of(d);
+          if (downs.empty()) continue;
+          if (d.tool_on_table) {
+            core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                                 product.suction_tool_pose);
+          }
+          int stored = 0;
+          for (const auto& down : downs) {
+            for (const Receiving& again : down.repicks) {
+              Receiving at_rh;
+              if (!reach_with(*d.arm, d.base_inv, c.board, again.grasp, d.bodies, false, at_rh)) {
+                continue;
+              }
+              db::TableRegraspRecord r;
+              r.candidate_id = ci;
+              r.pick_grasp_id = down.pick.grasp;
+              r.robot_grasp_id = again.grasp;
+              r.arm = d.arm->spec.name;
+              r.placement = down.board;
+              r.joints_pick = down.pick.joints;
+              r.joints_place = down.place.joints;
+              r.joints_repick = again.joints;
+              r.joints_rh = at_rh.joints;
+              r.inclination_pick_deg = down.pick.slip_deg;
+              r.inclination_place_deg = down.place.slip_deg;
+              r.inclination_repick_deg = again.slip_deg;
+              r.inclination_rh_deg = at_rh.slip_deg;
+              result.regrasps.push_back(r);
+              ++regrasps;
+              if (++stored >= settings.direct_stored) break;
+            }
+            if (stored >= settings.direct_stored) break;
+          }
+          restore_arm(*d.arm);
+          reset_state();
+          place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
+          if (h.second_grasp >= 0) {
+            const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+            place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
+          }
+          data.set_body_pose(scene.board, c.board);
+        }
+        reset_state();
+      }
+      if (shared == 0 && direct == 0 && regrasps == 0) continue;
       // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
       // are coarse, so a bin's Q may come from a neighbouring hand orientation.
       if (verified < settings.human_ik_goals) {
@@ -843,6 +941,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
               std::remove_if(result.direct.begin(), result.direct.end(),
                              [&](const db::DirectGraspRecord& r) { return r.candidate_id == ci; }),
               result.direct.end());
+          result.regrasps.erase(
+              std::remove_if(result.regrasps.begin(), result.regrasps.end(),
+                             [&](const db::TableRegraspRecord& r) { return r.candidate_id == ci; }),
+              result.regrasps.end());
           continue;
         }
         ++verified;
@@ -877,16 +979,22 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   if (!no_candidate_reason().empty()) return finish(no_candidate_reason());
   if (stage.goals == 0) {
     std::string why = "no comfortable candidate (|S| = " + std::to_string(stage.comfortable) + ")";
-    why += exchange_failure.empty() ? " shares a grasp with a robot-robot handover pose (" +
-                                          std::to_string(stage.robot_handovers) +
-                                          " robot-robot poses)"
-                                    : " is reached through an exchange (" + exchange_failure + ")";
+    why += exchange_failure.empty()
+               ? " shares a grasp with a robot-robot handover pose (" +
+                     std::to_string(stage.robot_handovers) + " robot-robot poses)"
+               : " is reached through an exchange (" + exchange_failure + ")";
     if (!direct_arms.empty()) {
       std::string arms;
       for (const DirectArm& d : direct_arms) {
         arms += (arms.empty() ? "" : " or ") + d.arm->spec.name;
       }
       why += " or by the " + arms + " arm's gripper from where the part lies";
+      if (settings.table_regrasp.enabled) {
+        why += set_down_poses.empty()
+                   ? " (no regrasp on the table: the part does not lie on it)"
+                   : " (nor after a regrasp on the table, at " +
+                         std::to_string(set_down_poses.size()) + " set-down poses)";
+      }
     } else {
       why += "; " + direct_failure;
     }
@@ -900,6 +1008,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                    });
   std::stable_sort(result.direct.begin(), result.direct.end(),
                    [&](const db::DirectGraspRecord& a, const db::DirectGraspRecord& b) {
+                     return result.candidates[static_cast<std::size_t>(a.candidate_id)].rank <
+                            result.candidates[static_cast<std::size_t>(b.candidate_id)].rank;
+                   });
+  std::stable_sort(result.regrasps.begin(), result.regrasps.end(),
+                   [&](const db::TableRegraspRecord& a, const db::TableRegraspRecord& b) {
                      return result.candidates[static_cast<std::size_t>(a.candidate_id)].rank <
                             result.candidates[static_cast<std::size_t>(b.candidate_id)].rank;
                    });

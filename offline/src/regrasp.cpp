@@ -697,9 +697,9 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       result.first_served_rank = handover.candidates[static_cast<std::size_t>(c)].rank;
     }
   }
-  // Goals reached by a direct pick have no exchange chain here: the online planner plans them
-  // through the picking arm's roadmap.
-  if (result.goals_served == 0 && handover.direct.empty()) {
+  // Goals reached by a direct pick or a regrasp on the table have no exchange chain here: the
+  // online planner plans them through the picking arm's roadmap.
+  if (result.goals_served == 0 && handover.direct.empty() && handover.regrasps.empty()) {
     return finish("none of the first " + std::to_string(result.goals_considered) +
                   " goals connects home -> pick -> robot-robot -> robot-human in the roadmaps (" +
                   std::to_string(result.shared_grasps) +

@@ -25,6 +25,8 @@ const char* to_string(DeliveryMode mode) {
       return "exchange";
     case DeliveryMode::kDirect:
       return "direct";
+    case DeliveryMode::kRegrasp:
+      return "regrasp";
   }
   return "?";
 }
@@ -241,6 +243,30 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.suction_grasp_id = 0;
     return true;
   };
+  // One regrasp chain of a goal; true when it is planned (result filled in).
+  auto try_regrasp = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
+                         const db::TableRegraspRecord& r) {
+    GoalAttempt attempt;
+    attempt.rank = goal.rank;
+    attempt.candidate_id = goal.id;
+    attempt.mode = DeliveryMode::kRegrasp;
+    attempt.arm = r.arm;
+    attempt.robot_grasp_id = r.robot_grasp_id;
+    std::vector<PlanStep> steps;
+    ArmsState end;
+    const std::string failure = run.regrasp_chain(goal, r, steps, end);
+    attempt.outcome = failure.empty() ? "planned" : round + failure;
+    result.attempts.push_back(attempt);
+    if (!failure.empty()) return false;
+    planned(goal, r.robot_grasp_id, steps, end);
+    result.mode = DeliveryMode::kRegrasp;
+    result.picking_arm = r.arm;
+    result.delivering_arm = r.arm;
+    result.suction_grasp_id = 0;
+    result.pick_grasp_id = r.pick_grasp_id;
+    result.set_down = r.placement;
+    return true;
+  };
   // One exchange chain of a goal under the round's budgets; true when it is planned (result
   // filled in).
   auto try_shared = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
@@ -284,6 +310,15 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
           if (std::chrono::steady_clock::now() >= deadline) return false;
           if (direct_within_payload.count(d.arm) == 0) continue;
           if (try_direct(round, goal, d)) return true;
+        }
+      }
+      // Then a regrasp on the table: five stages, all by one arm.
+      if (const auto regrasps = records->table_regrasps.find(goal.id);
+          regrasps != records->table_regrasps.end()) {
+        for (const auto& r : regrasps->second) {
+          if (std::chrono::steady_clock::now() >= deadline) return false;
+          if (direct_within_payload.count(r.arm) == 0) continue;
+          if (try_regrasp(round, goal, r)) return true;
         }
       }
       if (!exchange_within_payload) continue;

@@ -34,8 +34,13 @@ std::string Run::direct_chain(const db::HandoverCandidateRecord& goal,
   };
   // settle() reads a null as a chain stopped before it: without the tool stage, from the pick.
   plan_settled(stages, sets_tool_down ? 0 : 1, plan_stages);
+  return join_stages(stages, steps, end);
+}
+
+std::string Run::join_stages(std::span<const Stage* const> stages, std::vector<PlanStep>& steps,
+                             ArmsState& end) {
   double clock = 0.0;
-  for (std::size_t k = 0; k < std::size(stages); ++k) {
+  for (std::size_t k = 0; k < stages.size(); ++k) {
     const Stage* stage = stages[k];
     if (stage == nullptr && k == 0) continue;  // the tool stays where it is
     if (stage == nullptr) break;
@@ -120,20 +125,27 @@ const Stage& Run::gripper_pick(const core::Arm& arm, const db::RobotGraspRecord&
   if (found != gripper_picks_.end()) return found->second;
   Stage& st = gripper_picks_[key];
   st.end = &arm == &suction_ && start_.tool_in_hand ? tool_down().end : start_;
+  take(st, arm, grasp, board_initial_, direct.joints_pick, false);
+  return st;
+}
+
+void Run::take(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& grasp,
+               const core::Pose& board, const Eigen::VectorXd& preferred, bool again) {
+  const std::string what = again ? "regrasp_pick" : "gripper_pick";
   if (&arm == &suction_ && st.end.tool_in_hand) {
-    st.failure = "gripper_pick: the " + arm.spec.name + " arm holds the suction tool";
-    return st;
+    st.failure = what + ": the " + arm.spec.name + " arm holds the suction tool";
+    return;
   }
   ArmMotionPlanner& planner = planner_of(arm);
-  const core::Pose tcp = board_initial_ * grasp.tcp;
+  const core::Pose tcp = board * grasp.tcp;
   const core::Pose lifted = shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift));
   MotionRequest standing;
-  standing.board_world = board_initial_;
+  standing.board_world = board;
   MotionRequest carry;
   carry.held = in_gripper(grasp);
   const Eigen::VectorXd now = arm_q(st, arm);
   std::optional<Eigen::VectorXd> at, before, up;
-  for (const auto& q : solutions(cell_, arm, tcp, now, &direct.joints_pick)) {
+  for (const auto& q : solutions(cell_, arm, tcp, now, &preferred)) {
     if (!first_valid(st, planner, standing, {q})) continue;
     const auto pre = pre_grasp(st, arm, standing, q);
     const auto l = solutions(cell_, arm, lifted, q);
@@ -147,30 +159,33 @@ const Stage& Run::gripper_pick(const core::Arm& arm, const db::RobotGraspRecord&
     break;
   }
   if (!at) {
-    st.failure =
-        "gripper_pick: no IK branch with a way in, a valid grasp and lift at the detected board "
-        "pose";
-    return st;
+    st.failure = what + ": no IK branch with a way in, a valid grasp and lift at the " +
+                 (again ? "set-down" : "detected") + " board pose";
+    return;
   }
   MotionRequest r = standing;
   r.start = now;
   r.goal = *before;
-  if (auto e = step(st, planner, arm, r, "gripper_approach", "", ""); !e.empty()) {
+  if (auto e = step(st, planner, arm, r, again ? "regrasp_approach" : "gripper_approach", "", "");
+      !e.empty()) {
     st.failure = e;
-    return st;
+    return;
   }
   r.start = *before;
   r.goal = *at;
-  if (auto e = step(st, planner, arm, r, "gripper_grasp", "", "gripper_close"); !e.empty()) {
+  if (auto e =
+          step(st, planner, arm, r, again ? "regrasp_grasp" : "gripper_grasp", "", "gripper_close");
+      !e.empty()) {
     st.failure = e;
-    return st;
+    return;
   }
   cell_.set_jaw(st.end.robot_q, arm, jaw_for(grasp));
   carry.start = *at;
   carry.goal = *up;
-  carry.start_in_contact = true;  // the board still rests where it was detected
-  if (auto e = step(st, planner, arm, carry, "lift", "", ""); !e.empty()) st.failure = e;
-  return st;
+  carry.start_in_contact = true;  // the board still rests where it was detected or set down
+  if (auto e = step(st, planner, arm, carry, again ? "regrasp_lift" : "lift", "", ""); !e.empty()) {
+    st.failure = e;
+  }
 }
 
 const Stage& Run::direct_present(const core::Arm& arm, const db::RobotGraspRecord& grasp,
@@ -181,15 +196,21 @@ const Stage& Run::direct_present(const core::Arm& arm, const db::RobotGraspRecor
   if (found != direct_presents_.end()) return found->second;
   Stage& st = direct_presents_[key];
   st.end = gripper_pick(arm, grasp, direct).end;
+  present_held(st, arm, grasp, goal, direct.joints_rh);
+  return st;
+}
+
+void Run::present_held(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                       const db::HandoverCandidateRecord& goal, const Eigen::VectorXd& preferred) {
   ArmMotionPlanner& planner = planner_of(arm);
   MotionRequest present;
   present.held = in_gripper(grasp);
   const Eigen::VectorXd up = arm_q(st, arm);
-  const auto rh_q = first_valid(
-      st, planner, present, solutions(cell_, arm, goal.board * grasp.tcp, up, &direct.joints_rh));
+  const auto rh_q = first_valid(st, planner, present,
+                                solutions(cell_, arm, goal.board * grasp.tcp, up, &preferred));
   if (!rh_q) {
     st.failure = kNoHumanPoseIk;
-    return st;
+    return;
   }
   present.start = up;
   present.goal = *rh_q;
@@ -198,7 +219,6 @@ const Stage& Run::direct_present(const core::Arm& arm, const db::RobotGraspRecor
       !e.empty()) {
     st.failure = e;
   }
-  return st;
 }
 
 const Stage& Run::direct_leave(const core::Arm& arm, const db::RobotGraspRecord& grasp,

@@ -158,6 +158,14 @@ class Run {
                            const db::DirectGraspRecord& direct, std::vector<PlanStep>& steps,
                            ArmsState& end);
 
+  // --- The regrasp way: the gripper picks the board, sets it down on the table on another
+  // resting pose, takes it again with the grasp that serves the goal and delivers it
+  // (regrasp_way.cpp)
+
+  std::string regrasp_chain(const db::HandoverCandidateRecord& goal,
+                            const db::TableRegraspRecord& regrasp, std::vector<PlanStep>& steps,
+                            ArmsState& end);
+
  private:
   // --- Construction, the memoised stages and the board's records (plan_run.cpp) --------------
 
@@ -177,6 +185,10 @@ class Run {
     visit(gripper_picks_);
     visit(direct_presents_);
     visit(direct_leaves_);
+    visit(set_downs_);
+    visit(repicks_);
+    visit(regrasp_presents_);
+    visit(regrasp_leaves_);
   }
 
   // Drops the memoised stages `which` picks, to be planned again when next asked for.
@@ -402,6 +414,37 @@ class Run {
                             const db::HandoverCandidateRecord& goal,
                             const db::DirectGraspRecord& direct);
 
+  // What a gripper pick does, into `st` from its end state: the open gripper from a pre-grasp to
+  // the grasp of the board standing at `board`, closed, and the lift straight up; the IK branch
+  // `preferred` first. `again`: the board was set down for a regrasp (the steps' names say so).
+  void take(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& grasp,
+            const core::Pose& board, const Eigen::VectorXd& preferred, bool again);
+
+  // The slip-constrained transfer to the robot-human pose, into `st` from its end state.
+  void present_held(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                    const db::HandoverCandidateRecord& goal, const Eigen::VectorXd& preferred);
+
+  // Concatenates the chain's stages, each starting where the previous ended (a null first stage:
+  // none, a null later stage: the chain stops there); the first failure, else "".
+  static std::string join_stages(std::span<const Stage* const> stages, std::vector<PlanStep>& steps,
+                                 ArmsState& end);
+
+  // --- The regrasp way's stages after the pick (regrasp_way.cpp) ---------------------------
+
+  // From the lift: above the set-down pose (within the pick grasp's slip limit), straight down
+  // until the board rests on the table (`set_down`: the last sample touches by design), the
+  // gripper opens, back along its approach.
+  const Stage& set_down(const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                        const db::TableRegraspRecord& regrasp, const Stage& picked);
+  // The gripper takes the board again where it was set down (take(), `again`).
+  const Stage& repick(const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                      const db::TableRegraspRecord& regrasp, const Stage& set);
+  const Stage& regrasp_present(const core::Arm& arm, const db::RobotGraspRecord& grasp,
+                               const db::HandoverCandidateRecord& goal,
+                               const db::TableRegraspRecord& regrasp, const Stage& taken);
+  const Stage& regrasp_leave(const core::Arm& arm, const db::HandoverCandidateRecord& goal,
+                             const db::TableRegraspRecord& regrasp, const Stage& presented);
+
   // --- The run's state -----------------------------------------------------------------------
 
   const PlannerModel& model_;
@@ -456,6 +499,12 @@ class Run {
   std::map<std::pair<std::string, std::int64_t>, Stage> gripper_picks_;
   std::map<std::tuple<std::string, std::int64_t, std::int64_t>, Stage> direct_presents_;
   std::map<std::tuple<std::string, std::int64_t, std::int64_t>, Stage> direct_leaves_;
+  // The regrasp way's stages after the pick, by table regrasp record (one per goal, arm, grasps
+  // and set-down pose).
+  std::map<std::int64_t, Stage> set_downs_;
+  std::map<std::int64_t, Stage> repicks_;
+  std::map<std::int64_t, Stage> regrasp_presents_;
+  std::map<std::int64_t, Stage> regrasp_leaves_;
 };
 
 }  // namespace hila::online::detail

@@ -87,9 +87,14 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
     j["mode"] = {{"way", online::to_string(plan.mode)},
                  {"pick",
                   {{"arm", plan.picking_arm},
-                   {"by", plan.mode == online::DeliveryMode::kDirect ? "gripper" : "suction"}}},
+                   {"by", plan.mode == online::DeliveryMode::kExchange ? "suction" : "gripper"}}},
                  {"exchanges", exchanges},
                  {"delivered_by", plan.delivering_arm}};
+    if (plan.mode == online::DeliveryMode::kRegrasp) {
+      j["mode"]["set_down"] = {{"board", pose_to_json(plan.set_down)},
+                               {"pick_grasp", plan.pick_grasp_id},
+                               {"grasp_again", plan.robot_grasp_id}};
+    }
     j["goal_rank"] = plan.goal_rank;
     j["candidate"] = plan.candidate_id;
     j["robot_grasp"] = plan.robot_grasp_id;

@@ -76,6 +76,7 @@ class DatabaseWriter {
   // candidate_id and robot_grasp_id are taken from each record and must name written records;
   // arm must be non-empty (schema version 5).
   void add_direct_grasps(const std::vector<DirectGraspRecord>& grasps);
+  void add_table_regrasps(const std::vector<TableRegraspRecord>& regrasps);
   // method must be "hila", "table" or "alone", at most one row per part and method (DatabaseError:
   // CHECK / UNIQUE constraint failed).
   void add_ergonomics(std::int64_t part_id, const std::vector<ErgonomicsRecord>& rows);
@@ -171,8 +172,9 @@ class Database {
   std::vector<HandoverCandidateRecord> handover_candidates(std::int64_t part_id) const;  // id order
   // The part's candidates with status "goal", by rank ascending (then id).
   std::vector<HandoverCandidateRecord> handover_goals(std::int64_t part_id) const;
-  std::vector<SharedGraspRecord> shared_grasps(std::int64_t candidate_id) const;  // id order
-  std::vector<DirectGraspRecord> direct_grasps(std::int64_t candidate_id) const;  // id order
+  std::vector<SharedGraspRecord> shared_grasps(std::int64_t candidate_id) const;    // id order
+  std::vector<DirectGraspRecord> direct_grasps(std::int64_t candidate_id) const;    // id order
+  std::vector<TableRegraspRecord> table_regrasps(std::int64_t candidate_id) const;  // id order
   std::vector<ErgonomicsRecord> ergonomics(std::int64_t part_id) const;  // id (write) order
 
   // Roadmaps and the regrasp graph (schema version 4). The arm's roadmap, or nullptr when the
@@ -199,6 +201,7 @@ class Database {
   std::vector<HandoverCandidateRecord> handover_candidates_;
   std::vector<SharedGraspRecord> shared_grasps_;
   std::vector<DirectGraspRecord> direct_grasps_;
+  std::vector<TableRegraspRecord> table_regrasps_;
   std::vector<ErgonomicsRecord> ergonomics_;
   std::vector<RoadmapRecord> roadmaps_;
   std::vector<RoadmapFilterRecord> roadmap_filters_;  // id order: roadmap_filter() bisects

@@ -9,6 +9,7 @@
 #include "hila/core/product.hpp"
 #include "hila/db/records.hpp"
 #include "hila/offline/human_comfort.hpp"
+#include "hila/offline/table_regrasp.hpp"
 
 namespace hila::offline {
 
@@ -60,6 +61,10 @@ struct HandoverSettings {
   // direct_stored robot grasps per goal and arm are stored.
   bool direct = true;
   int direct_stored = 4;
+  // Regrasps on the table, for a comfortable candidate no exchange and no direct grasp serves: the
+  // arm that picks the part sets it down where it lay on another resting pose and takes it again
+  // with a grasp that holds it at the goal (up to direct_stored per goal and arm).
+  TableRegraspSettings table_regrasp;
   std::uint64_t seed = 3;
 };
 
@@ -72,6 +77,7 @@ struct HandoverResult {
   std::vector<db::HandoverCandidateRecord> candidates;  // in sample order
   std::vector<db::SharedGraspRecord> shared;            // for the goals, by rank
   std::vector<db::DirectGraspRecord> direct;            // for the goals, by rank
+  std::vector<db::TableRegraspRecord> regrasps;         // for the goals, by rank
   double seconds = 0.0;
 };
 
@@ -80,6 +86,7 @@ struct BoardGrasps {
   std::vector<db::SuctionGraspRecord> suction;
   std::vector<db::HumanGraspRecord> human;
   Eigen::Vector3d com = Eigen::Vector3d::Zero();  // part frame
+  std::vector<db::PlacementRecord> placements;    // resting poses, most stable first
 };
 
 // Handover goals of product.parts[index] at its assembly stage (the parts before it finished at

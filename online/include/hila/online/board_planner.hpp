@@ -73,7 +73,11 @@ struct PlanStep {
 // How the board reaches the human. kExchange: the suction arm picks it with the tool, hands it
 // to the other arm's gripper at a robot-robot pose, and that arm delivers it. kDirect: one arm's
 // gripper picks it where it lies and delivers it (no tool, no exchange).
-enum class DeliveryMode { kExchange, kDirect };
+// kExchange: the suction arm picks the board with the tool and hands it to the other arm's
+// gripper. kDirect: one arm's gripper picks it where it lies. kRegrasp: one arm's gripper picks
+// it, sets it down on the table on another resting pose and takes it again with another grasp.
+// The delivering arm's gripper then takes it to the human.
+enum class DeliveryMode { kExchange, kDirect, kRegrasp };
 const char* to_string(DeliveryMode mode);
 
 // A handover goal tried by one way, and why it was left.
@@ -124,6 +128,10 @@ struct BoardPlan {
   std::string delivering_arm;
   std::int64_t robot_grasp_id = 0;
   std::int64_t suction_grasp_id = 0;  // 0 for a direct pick
+  // kRegrasp only: the grasp the board is picked and set down with, and where it is set down
+  // (world); robot_grasp_id is the grasp it is taken again and delivered with.
+  std::int64_t pick_grasp_id = 0;
+  core::Pose set_down = core::Pose::Identity();
   double theta_c_deg = 90.0;
   double quality = 0.0;  // the comfort Q of the scene's human at the goal (paper Eq. 4)
   // Stored goals the scene's human reaches only uncomfortably (tried after the comfortable ones)

@@ -24,6 +24,7 @@ struct BoardRecords {
   std::vector<db::HandoverCandidateRecord> goals;  // Eq. 8 order: by rank (then id)
   std::map<std::int64_t, std::vector<db::SharedGraspRecord>> shared_grasps;  // by goal, id order
   std::map<std::int64_t, std::vector<db::DirectGraspRecord>> direct_grasps;  // by goal, id order
+  std::map<std::int64_t, std::vector<db::TableRegraspRecord>> table_regrasps;  // by goal, id order
   std::map<std::int64_t, db::RobotGraspRecord> robot_grasps;
   std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps;
   std::map<std::int64_t, db::HumanGraspRecord> human_grasps;
