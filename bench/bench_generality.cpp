@@ -802,12 +802,34 @@ struct StackPose {
   std::vector<PartResult> boards;
 };
 
+// Which board of the stack the suction tool, standing at its place on the table, touches in this
+// scene, "" when none or when the suction arm holds it.
+std::string tool_collision(const online::PlannerModel& model, const online::Scene& scene,
+                           const std::string& board) {
+  if (scene.tool_in_hand) return "";
+  const online::World world(model.cell(), model.product(), scene, board);
+  core::CollisionData data = world.make_data();
+  std::vector<int> boards = world.stage().stacked;
+  boards.push_back(world.stage().board);
+  for (const int b : boards) {
+    std::vector<int> bodies = world.stage().tool_bodies;
+    bodies.push_back(b);
+    core::CollisionPair pair;
+    if (core::in_collision_among(world.stage().cell.model, data, bodies, &pair)) {
+      return core::describe_pair(world.stage().cell.model, pair);
+    }
+  }
+  return "";
+}
+
 // Whether a board touches something at its stage with the stack at the scene's detected poses
-// (the robot at home, the tool, the finished boards); the first contact, or "".
+// (the robot at home, the tool, the finished boards), or the tool at its place touches the stack;
+// the first contact, or "".
 std::string stack_touches(const online::PlannerModel& model, online::Scene scene) {
   for (const auto& part : model.product().parts) {
     if (scene.is_finished(part.name)) continue;
-    const std::string hit = start_collision(model, scene, part.name);
+    std::string hit = start_collision(model, scene, part.name);
+    if (hit.empty()) hit = tool_collision(model, scene, part.name);
     if (!hit.empty()) return part.name + ": " + hit;
     scene = scene.with_finished(model.product(), part.name);
     scene.tool_in_hand = true;

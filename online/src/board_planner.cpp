@@ -289,7 +289,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     result.mode = DeliveryMode::kExchange;
     result.picking_arm = run.suction_arm().spec.name;
     result.delivering_arm = run.receiving_arm().spec.name;
-    result.suction_grasp_id = rr.suction_grasp_id;
+    result.suction_grasp_id = run.suction_grasp_of(rr);
     result.robot_handover = rr.board;
     return true;
   };

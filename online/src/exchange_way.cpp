@@ -14,6 +14,15 @@
 
 namespace hila::online::detail {
 
+namespace {
+
+// Two suction grasps hold the board at the same point (m) of the same face (the cosine of the
+// angle between their axes): the cup is round, so they differ by a turn about its axis.
+constexpr double kSameCupPoint = 1e-6;
+constexpr double kSameCupAxis = 1.0 - 1e-9;
+
+}  // namespace
+
 bool Run::connected_offline(const db::HandoverCandidateRecord& goal,
                             const db::SharedGraspRecord& shared) const {
   for (const auto& e : edges_) {
@@ -45,6 +54,11 @@ bool Run::receive_failed_at_same_pose(const db::SharedGraspRecord& shared) const
   return false;
 }
 
+std::int64_t Run::suction_grasp_of(const db::RobotHandoverRecord& rr) const {
+  const auto found = transfers_.find(rr.id);
+  return found == transfers_.end() ? rr.suction_grasp_id : found->second.cup;
+}
+
 std::string Run::chain(const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared,
                        std::vector<PlanStep>& steps, ArmsState& end) {
   const auto rr_it = handovers_.find(shared.robot_handover_id);
@@ -57,8 +71,12 @@ std::string Run::chain(const db::HandoverCandidateRecord& goal, const db::Shared
   const Stage* stages[7] = {};
   const auto plan_stages = [&] {
     stages[0] = &tool();
-    if (stages[0]->ok()) stages[1] = &pick(rr.suction_grasp_id);
-    if (stages[1] != nullptr && stages[1]->ok()) stages[2] = &transfer(rr);
+    if (stages[0]->ok()) {
+      // The transfer chooses the suction grasp (its stand-ins) and plans the pick it follows.
+      const Stage& moved = transfer(rr);
+      stages[1] = &pick(moved.cup);
+      if (stages[1]->ok()) stages[2] = &moved;
+    }
     // The exchange and release are planned per grasp: not for one whose goal the receiving
     // arm cannot reach (the present stage's own first check, made first).
     if (stages[2] != nullptr && stages[2]->ok() &&
@@ -177,8 +195,12 @@ const Stage& Run::pick(std::int64_t cup_id) {
       "transit", suction_, [&](const auto& n) { return n.kind == "pick" && n.grasp_id == cup_id; },
       [](const auto&) { return true; });
   const Eigen::VectorXd* preferred = transits.empty() ? nullptr : &transits.front()->path.back();
-  std::optional<Eigen::VectorXd> at, up, before;
   const Eigen::VectorXd suction_now = arm_q(st, suction_);
+  // Each branch's pre-pick, pick and lift.
+  struct Branch {
+    Eigen::VectorXd before, at, up;
+  };
+  std::vector<Branch> branches;
   for (const auto& q : solutions(cell_, suction_, pick_tcp, preferred ? *preferred : suction_now)) {
     if (!first_valid(st, suction_planner_, standing, {q})) continue;
     const auto p = solutions(cell_, suction_, pre_pick, q);
@@ -187,53 +209,139 @@ const Stage& Run::pick(std::int64_t cup_id) {
         !first_valid(st, suction_planner_, carry, {l.front()})) {
       continue;
     }
-    at = q;
-    before = p.front();
-    up = l.front();
-    break;
+    branches.push_back({p.front(), q, l.front()});
   }
-  if (!at) {
+  if (branches.empty()) {
     st.failure =
         "suction_pick: no IK branch with a valid approach, pick and lift at the detected board "
         "pose";
     return st;
   }
-  MotionRequest r = standing;
-  r.start = suction_now;
-  r.goal = *before;
-  r.hints = paths_of(transits);
-  if (auto e = step(st, suction_planner_, suction_, r, "suction_approach", "", ""); !e.empty()) {
-    st.failure = e;
-    return st;
+  const Stage start = st;
+  std::string first_failure;
+  for (std::size_t b = 0; b < branches.size(); ++b) {
+    const Branch& branch = branches[b];
+    Stage attempt = start;
+    MotionRequest r = standing;
+    r.start = suction_now;
+    r.goal = branch.before;
+    // The stored transits end at the build's branch: they lead only to a branch near it.
+    if (b == 0) r.hints = paths_of(transits);
+    std::string e = step(attempt, suction_planner_, suction_, r, "suction_approach", "", "");
+    if (e.empty()) {
+      r.hints.clear();
+      r.start = branch.before;
+      r.goal = branch.at;
+      e = step(attempt, suction_planner_, suction_, r, "suction_pick", "", "suction_on");
+    }
+    if (e.empty()) {
+      MotionRequest up = carry;
+      up.start = branch.at;
+      up.goal = branch.up;
+      up.start_in_contact = true;  // the board still rests where it was detected
+      e = step(attempt, suction_planner_, suction_, up, "lift", "", "");
+    }
+    if (e.empty()) {
+      st = std::move(attempt);
+      return st;
+    }
+    abandon(attempt);
+    if (first_failure.empty()) first_failure = e;
+    if (attempt.deadline_passed) {
+      st.failure = e;
+      st.deadline_passed = true;
+      return st;
+    }
   }
-  r.hints.clear();
-  r.start = *before;
-  r.goal = *at;
-  if (auto e = step(st, suction_planner_, suction_, r, "suction_pick", "", "suction_on");
-      !e.empty()) {
-    st.failure = e;
-    return st;
-  }
-  carry.start = *at;
-  carry.goal = *up;
-  carry.start_in_contact = true;  // the board still rests where it was detected
-  if (auto e = step(st, suction_planner_, suction_, carry, "lift", "", ""); !e.empty()) {
-    st.failure = e;
-  }
+  st.failure = first_failure;
   return st;
+}
+
+std::vector<std::int64_t> Run::stand_in_cups(const db::SuctionGraspRecord& cup) const {
+  // Rotations between cup frames are those between the TCPs holding them (the same
+  // cup-in-TCP on the right).
+  const Eigen::Matrix3d nominal = (part_.initial * cup.cup).linear();
+  std::vector<std::pair<double, std::int64_t>> turned;
+  for (const auto& [id, other] : suction_grasps_) {
+    if (id == cup.id ||
+        (other.cup.translation() - cup.cup.translation()).norm() > kSameCupPoint ||
+        other.cup.linear().col(2).dot(cup.cup.linear().col(2)) < kSameCupAxis) {
+      continue;
+    }
+    const Eigen::Matrix3d here = (board_initial_ * other.cup).linear();
+    turned.emplace_back(Eigen::AngleAxisd(nominal.transpose() * here).angle(), id);
+  }
+  std::sort(turned.begin(), turned.end());
+  std::vector<std::int64_t> out{cup.id};
+  for (const auto& [angle, id] : turned) out.push_back(id);
+  return out;
 }
 
 const Stage& Run::transfer(const db::RobotHandoverRecord& rr) {
-  const auto found = transfers_.find(rr.id);
-  if (found != transfers_.end()) return found->second;
+  if (const auto found = transfers_.find(rr.id); found != transfers_.end()) {
+    const Stage& planned = found->second;
+    if (!planned.ok()) return planned;
+    // A pick planned again after the validator rejected it late may end elsewhere (another
+    // branch): the transfer must leave from there.
+    const Stage& picked = pick(planned.cup);
+    if (picked.ok() && !planned.paths.empty() &&
+        planned.paths.front().front() == arm_q(picked, suction_)) {
+      return planned;
+    }
+    abandon(transfers_.at(rr.id));
+    transfers_.erase(rr.id);
+  }
+  forget_after_transfer(rr.id);
   Stage& st = transfers_[rr.id];
-  st.end = pick(rr.suction_grasp_id).end;
-  st.failure = transfer_steps(st, rr);
+  st.cup = rr.suction_grasp_id;
+  std::string first_failure;
+  for (const std::int64_t cup_id : stand_in_cups(suction_grasps_.at(rr.suction_grasp_id))) {
+    const Stage& picked = pick(cup_id);
+    std::string e = picked.failure;
+    bool deadline_passed = picked.deadline_passed;
+    if (picked.ok()) {
+      Stage attempt;
+      attempt.end = picked.end;
+      attempt.cup = cup_id;
+      e = transfer_steps(attempt, rr, cup_id);
+      if (e.empty()) {
+        st = std::move(attempt);
+        return st;
+      }
+      abandon(attempt);
+      deadline_passed = attempt.deadline_passed;
+    }
+    if (first_failure.empty()) first_failure = e;
+    if (deadline_passed) {
+      st.deadline_passed = true;
+      break;
+    }
+  }
+  st.failure = first_failure;
   return st;
 }
 
-std::string Run::transfer_steps(Stage& st, const db::RobotHandoverRecord& rr) {
-  const db::SuctionGraspRecord& cup = suction_grasps_.at(rr.suction_grasp_id);
+void Run::forget_after_transfer(std::int64_t rr_id) {
+  const auto drop = [&](auto& stages, auto rr_of) {
+    for (auto it = stages.begin(); it != stages.end();) {
+      if (rr_of(it->first) != rr_id) {
+        ++it;
+        continue;
+      }
+      abandon(it->second);
+      it = stages.erase(it);
+    }
+  };
+  const auto first = [](const auto& key) { return std::get<0>(key); };
+  drop(receives_, first);
+  drop(releases_, first);
+  drop(presents_, first);
+  drop(leaves_, first);
+}
+
+std::string Run::transfer_steps(Stage& st, const db::RobotHandoverRecord& rr,
+                                std::int64_t cup_id) {
+  const db::SuctionGraspRecord& cup = suction_grasps_.at(cup_id);
   const core::Pose rr_tcp = rr.board * cup.cup * world_.stage().cup_in_tcp.inverse();
   const auto stored = stored_edges(
       "transfer", suction_,
@@ -242,9 +350,12 @@ std::string Run::transfer_steps(Stage& st, const db::RobotHandoverRecord& rr) {
   MotionRequest carry;
   carry.held = on_cup(cup);
   const Eigen::VectorXd up = arm_q(st, suction_);
-  const auto rr_q = first_valid(st, suction_planner_, carry,
-                                solutions(cell_, suction_, rr_tcp, up,
-                                          stored.empty() ? nullptr : &stored.front()->path.back()));
+  std::vector<Eigen::VectorXd> ends = solutions(
+      cell_, suction_, rr_tcp, up, stored.empty() ? nullptr : &stored.front()->path.back());
+  if (cup_id != rr.suction_grasp_id) {
+    for (auto& q : ends) q = in_roadmap_box(suction_, q);
+  }
+  const auto rr_q = first_valid(st, suction_planner_, carry, ends);
   if (!rr_q) return "transfer_to_robot_handover: no valid IK at the robot-robot pose";
   carry.start = up;
   carry.goal = *rr_q;
@@ -314,7 +425,7 @@ const Stage& Run::receive(const db::RobotHandoverRecord& rr, const db::RobotGras
     return false;
   };
   const auto waiting = [&] {
-    const Stage& lifted = pick(rr.suction_grasp_id);
+    const Stage& lifted = pick(transfer(rr).cup);
     for (std::size_t b = 0; b < branches.size() && lifted.ok(); ++b) {
       Stage attempt;
       attempt.end = lifted.end;
@@ -339,7 +450,8 @@ std::string Run::preposition(Stage& st, const db::RobotHandoverRecord& rr,
   at_exchange.board_world = rr.board;
   const std::optional<Eigen::VectorXd> pre_q = pre_grasp(st, at_exchange, grasp_q);
   if (!pre_q) return "receiving_approach: no pre-grasp to wait at";
-  const db::SuctionGraspRecord& cup = suction_grasps_.at(rr.suction_grasp_id);
+  const std::int64_t cup_id = transfer(rr).cup;
+  const db::SuctionGraspRecord& cup = suction_grasps_.at(cup_id);
   const core::Pose up_tcp =
       core::arm_base_in_world(cell_, suction_) * suction_.chain.fk(arm_q(st, suction_));
   MotionRequest wait;
@@ -350,7 +462,7 @@ std::string Run::preposition(Stage& st, const db::RobotHandoverRecord& rr,
       !e.empty()) {
     return e;
   }
-  if (auto e = transfer_steps(st, rr); !e.empty()) return e;
+  if (auto e = transfer_steps(st, rr, cup_id); !e.empty()) return e;
   at_exchange.start = *pre_q;
   at_exchange.goal = grasp_q;
   return step(st, receiving_planner_, receiving_, at_exchange, "receiving_grasp", "",
@@ -409,7 +521,7 @@ const Stage& Run::release(const db::RobotHandoverRecord& rr, const db::RobotGras
   if (found != releases_.end()) return found->second;
   Stage& st = releases_[key];
   st.end = receive(rr, grasp).end;
-  const db::SuctionGraspRecord& cup = suction_grasps_.at(rr.suction_grasp_id);
+  const db::SuctionGraspRecord& cup = suction_grasps_.at(transfer(rr).cup);
   const Eigen::VectorXd rr_q = arm_q(st, suction_);
   const core::Pose rr_tcp = rr.board * cup.cup * world_.stage().cup_in_tcp.inverse();
   const Eigen::Vector3d cup_axis = (rr.board * cup.cup).linear().col(2);

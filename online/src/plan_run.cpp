@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hila/core/bridge.hpp"
+#include "hila/core/joint_box.hpp"
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
@@ -69,6 +71,18 @@ core::Pose shifted(const core::Pose& pose, const Eigen::Vector3d& by) {
   core::Pose p = pose;
   p.translation() += by;
   return p;
+}
+
+Eigen::VectorXd in_roadmap_box(const core::Arm& arm, Eigen::VectorXd q) {
+  const core::JointBox box = core::joint_box(arm, core::BridgeSettings{}.joint_range);
+  const Eigen::VectorXd lower = arm.chain.lower_limits();
+  const Eigen::VectorXd upper = arm.chain.upper_limits();
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    const double turns = std::round((0.5 * (box.lower[i] + box.upper[i]) - q[i]) / (2.0 * M_PI));
+    const double turned = q[i] + 2.0 * M_PI * turns;
+    if (turned >= lower[i] && turned <= upper[i]) q[i] = turned;
+  }
+  return q;
 }
 
 Run::Run(const PlannerModel& model, const BoardPlanSettings& settings, const Scene& scene,

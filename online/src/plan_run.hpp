@@ -41,6 +41,13 @@ std::vector<Eigen::VectorXd> solutions(const core::Cell& cell, const core::Arm& 
 // `pose` moved by `by` (m, in the world frame).
 core::Pose shifted(const core::Pose& pose, const Eigen::Vector3d& by);
 
+// `q` with each joint turned by whole turns into the box the roadmaps and bridges sample
+// (core::joint_box, home +- pi) where the joint's limits allow it: the same configuration, with
+// roadmap nodes near it. An IK solution wrapped towards a seed far from home (the robot-robot
+// pose with a stand-in suction grasp, its wrist turned from the lift's) may lie a whole turn
+// outside, where the nearest nodes are radians away.
+Eigen::VectorXd in_roadmap_box(const core::Arm& arm, Eigen::VectorXd q);
+
 // Where the robot is between stages.
 struct ArmsState {
   Eigen::VectorXd robot_q;  // the whole robot, jaws included
@@ -90,6 +97,9 @@ struct Stage {
   // (MotionStatus::kTimeout); receive() tries no other branch after it. Typed so that no
   // decision reads the reason, which is for the attempt's outcome.
   bool deadline_passed = false;
+  // A transfer stage's: the suction grasp (database id) whose pick it follows and with which
+  // the suction arm holds the board at the robot-robot pose (Run::transfer).
+  std::int64_t cup = 0;
   bool ok() const { return failure.empty(); }
 };
 
@@ -145,6 +155,10 @@ class Run {
   // at its board pose, under another robot-robot pose of the same board pose (another suction
   // grasp holding the board there).
   bool receive_failed_at_same_pose(const db::SharedGraspRecord& shared) const;
+
+  // The suction grasp the exchange at `rr` picks and holds the board with (its transfer's; the
+  // database's for a robot-robot pose not planned).
+  std::int64_t suction_grasp_of(const db::RobotHandoverRecord& rr) const;
 
   // The whole chain for one goal and shared grasp: the memoised stages in order.
   std::string chain(const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared,
@@ -341,15 +355,31 @@ class Run {
 
   HeldBoard on_cup(const db::SuctionGraspRecord& cup) const;
 
-  // 1. Suction pick at the detected pose: approach along the cup's axis, pick, lift. A branch
-  // whose approach and lift stay in it (their nearest solutions) and are valid.
+  // 1. Suction pick at the detected pose: approach along the cup's axis, pick, lift. Every IK
+  // branch whose approach and lift stay in it (their nearest solutions) and whose three ends are
+  // valid, in order, until one's motions plan: near the robot's body the first branch's pre-pick
+  // may attach to no roadmap node while another's does.
   const Stage& pick(std::int64_t cup_id);
 
-  // 2. To the robot-robot pose through the suction grasp's filtered roadmap.
+  // The suction grasps that can stand in for `cup` at a robot-robot pose: the cup is symmetric
+  // about its axis, so a grasp at the same point of the same face, turned about the axis, holds
+  // the board at the same pose with the suction arm's TCP turned about the cup's axis. `cup`
+  // first (the database's chain, its stored paths), then the others by how little their pick at
+  // the detected pose turns the TCP from `cup`'s pick at the board's nominal pose: where the
+  // stack is turned, the one whose arm posture at the pick is the one the build planned.
+  std::vector<std::int64_t> stand_in_cups(const db::SuctionGraspRecord& cup) const;
+
+  // 2. The pick (by stand_in_cups(), the first whose pick and transfer plan) and the transfer to
+  // the robot-robot pose through the suction grasp's filtered roadmap. Stage::cup says which.
   const Stage& transfer(const db::RobotHandoverRecord& rr);
 
-  // The suction arm, holding the board after the lift, to the robot-robot pose.
-  std::string transfer_steps(Stage& st, const db::RobotHandoverRecord& rr);
+  // Drops the memoised stages after the transfer to robot-robot pose `rr_id` (the exchange, the
+  // release, the presentation and the leave there): they start where that transfer ended, and
+  // it is being planned anew (after a late rejection, perhaps with another suction grasp).
+  void forget_after_transfer(std::int64_t rr_id);
+
+  // The suction arm, holding the board on `cup_id` after the lift, to the robot-robot pose.
+  std::string transfer_steps(Stage& st, const db::RobotHandoverRecord& rr, std::int64_t cup_id);
 
   // 3. The receiving arm's approach and grasp, the board held by the suction arm. The approach
   // backs off along the gripper's axis as far as the scene lets it (the exchange may be close
