@@ -43,6 +43,9 @@ struct SamplePart {
   // Schema version 5. id, candidate_id and robot_grasp_id are the ones write_sample's writer
   // assigns.
   std::vector<DirectGraspRecord> direct_grasps;  // of this part's candidates
+  // Schema version 6. id, candidate_id, pick_grasp_id and robot_grasp_id are the ones
+  // write_sample's writer assigns.
+  std::vector<TableRegraspRecord> table_regrasps;  // of this part's candidates
 };
 
 struct Sample {
@@ -474,10 +477,64 @@ inline void add_direct_grasps(Sample& s, std::uint64_t seed) {
   p.direct_grasps[5].joints_rh[2] = -0.0;
 }
 
+// Table regrasps of part 1's three goals (part 2 has none), written with the candidates
+// interleaved (5, 2, 4, 2, 5), so that one candidate's regrasps are not consecutive ids: both arms,
+// a non-ASCII arm name, a regrasp that sets down and takes again with the same grasp, one without
+// stored place and repick solutions (empty
+// joints_place and joints_repick), -0.0 and a subnormal in joint blobs, a subnormal placement
+// coordinate, a placement turned exactly half about the vertical, inclinations of exactly 0 and
+// just below 90 degrees, and four inclinations that differ in every record (so that no column can
+// stand in for another). From an RNG of its own, so that every other record of the sample keeps
+// the values it had before the table.
+inline void add_table_regrasps(Sample& s, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  SamplePart& p = s.parts[0];
+  std::vector<std::int64_t> goals;  // candidate ids in id order
+  for (const auto& c : p.handover_candidates) {
+    if (c.status == "goal") goals.push_back(c.id);
+  }
+  const std::size_t goal_of[] = {2, 0, 1, 0, 2};
+  const auto grasps = static_cast<std::int64_t>(p.robot_grasps.size());
+  std::int64_t id = 0;
+  for (std::size_t i = 0; i < std::size(goal_of); ++i) {
+    const auto k = static_cast<std::int64_t>(i);
+    TableRegraspRecord r;
+    r.id = ++id;
+    r.candidate_id = goals.at(goal_of[i]);
+    r.pick_grasp_id = 1 + (2 * k + 1) % grasps;
+    r.robot_grasp_id = 1 + (3 * k) % grasps;
+    r.arm = i == 3 ? "left ✋" : i % 2 == 0 ? "left" : "right";
+    r.placement = test::random_pose(rng, 0.6);
+    r.joints_pick = random_joints(rng, 6);
+    if (i != 2) {
+      r.joints_place = random_joints(rng, 6);
+      r.joints_repick = random_joints(rng, 6);
+    }
+    r.joints_rh = random_joints(rng, 6);
+    const double base = 17.5 * static_cast<double>(i) + 1e-13;
+    r.inclination_pick_deg = i == 0 ? 0.0 : base + 0.25;
+    r.inclination_place_deg = base + 1.5;
+    r.inclination_repick_deg = i == 4 ? 89.999999999999986 : base + 2.75;
+    r.inclination_rh_deg = base + 4.0;
+    p.table_regrasps.push_back(r);
+  }
+  p.table_regrasps[1].robot_grasp_id = p.table_regrasps[1].pick_grasp_id;  // the same grasp
+  p.table_regrasps[0].joints_place[3] = -0.0;
+  p.table_regrasps[0].joints_repick[0] = std::numeric_limits<double>::denorm_min();
+  p.table_regrasps[4].joints_rh[5] = -0.0;
+  p.table_regrasps[4].joints_pick[2] = -std::numeric_limits<double>::denorm_min();
+  p.table_regrasps[2].placement.translation().y() = std::numeric_limits<double>::denorm_min();
+  core::Pose half_turn = core::Pose::Identity();
+  half_turn.linear() = Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal();
+  half_turn.translation() = Eigen::Vector3d(0.5, -0.25, 0.0625);
+  p.table_regrasps[1].placement = half_turn;
+}
+
 // Two parts with different record counts (part 2 has no suction grasps), values that are
 // negative, tiny, huge, subnormal and infinite, a non-ASCII part name, handover records (see
 // add_handover_records), two comfort maps, roadmaps with the regrasp graph (see
-// add_roadmap_records) and direct grasps (see add_direct_grasps).
+// add_roadmap_records), direct grasps (see add_direct_grasps) and table regrasps (see
+// add_table_regrasps).
 inline Sample make_sample(std::uint64_t seed = 7) {
   std::mt19937_64 rng(seed);
   Sample s;
@@ -559,16 +616,17 @@ inline Sample make_sample(std::uint64_t seed = 7) {
   s.comfort_maps.push_back(make_comfort_map("left", seed + 2, {2, 5, 3}, 7, 0.5));
   add_roadmap_records(s, rng);
   add_direct_grasps(s, seed + 3);
+  add_table_regrasps(s, seed + 4);
   return s;
 }
 
 // Writes `sample` to `path` through DatabaseWriter and returns the part ids in order: first each
-// part with its placements and grasps, then each part's handover, direct grasp and ergonomics
-// records (so they may refer to grasps of any part), then the comfort maps, the roadmaps and each
-// part's roadmap filters, regrasp nodes and regrasp edges. The candidate, robot handover, roadmap,
-// filter and node ids the records refer to are translated from the sample's ids to the ones the
-// writer returns (the same unless a test reorders the sample's parts); grasp ids are written as
-// given.
+// part with its placements and grasps, then each part's handover, direct grasp, table regrasp and
+// ergonomics records (so they may refer to grasps of any part), then the comfort maps, the roadmaps
+// and each part's roadmap filters, regrasp nodes and regrasp edges. The candidate, robot handover,
+// roadmap, filter and node ids the records refer to are translated from the sample's ids to the
+// ones the writer returns (the same unless a test reorders the sample's parts); grasp ids are
+// written as given.
 inline std::vector<std::int64_t> write_sample(const std::string& path, const Sample& sample) {
   DatabaseWriter writer(path);
   writer.write_meta(sample.meta);
@@ -611,6 +669,9 @@ inline std::vector<std::int64_t> write_sample(const std::string& path, const Sam
     std::vector<DirectGraspRecord> direct = p.direct_grasps;
     for (auto& g : direct) g.candidate_id = translate(candidate_ids, g.candidate_id);
     writer.add_direct_grasps(direct);
+    std::vector<TableRegraspRecord> regrasps = p.table_regrasps;
+    for (auto& r : regrasps) r.candidate_id = translate(candidate_ids, r.candidate_id);
+    writer.add_table_regrasps(regrasps);
     writer.add_ergonomics(ids[k], p.ergonomics);
   }
   for (const auto& map : sample.comfort_maps) writer.add_comfort_map(map);

@@ -217,6 +217,51 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
       [](Sample& s) { std::swap(s.parts[0].direct_grasps[0], s.parts[0].direct_grasps[2]); });
   add("a direct grasp less", [](Sample& s) { s.parts[0].direct_grasps.pop_back(); });
   add("no direct grasps", [](Sample& s) { s.parts[0].direct_grasps.clear(); });
+  // Schema version 6: table regrasps.
+  add("table regrasp place inclination ulp", [](Sample& s) {
+    double& a = s.parts[0].table_regrasps[2].inclination_place_deg;
+    a = std::nextafter(a, 90.0);
+  });
+  add("table regrasp repick inclination ulp", [](Sample& s) {
+    double& a = s.parts[0].table_regrasps[4].inclination_repick_deg;
+    a = std::nextafter(a, 0.0);
+  });
+  add("table regrasp inclinations swapped", [](Sample& s) {
+    auto& r = s.parts[0].table_regrasps[1];
+    std::swap(r.inclination_pick_deg, r.inclination_rh_deg);
+  });
+  add("table regrasp pick grasp",
+      [](Sample& s) { s.parts[0].table_regrasps[0].pick_grasp_id = 5; });
+  add("table regrasp robot grasp",
+      [](Sample& s) { s.parts[0].table_regrasps[3].robot_grasp_id = 1; });
+  add("table regrasp grasps swapped", [](Sample& s) {
+    auto& r = s.parts[0].table_regrasps[2];
+    std::swap(r.pick_grasp_id, r.robot_grasp_id);
+  });
+  add("table regrasp candidate", [](Sample& s) { s.parts[0].table_regrasps[2].candidate_id = 5; });
+  add("table regrasp arm", [](Sample& s) { s.parts[0].table_regrasps[0].arm = "right"; });
+  add("table regrasp placement position ulp", [](Sample& s) {
+    double& x = s.parts[0].table_regrasps[3].placement.translation().x();
+    x = std::nextafter(x, 10.0);
+  });
+  add("table regrasp placement turned", [](Sample& s) {
+    auto& placement = s.parts[0].table_regrasps[1].placement;
+    placement.linear() = Eigen::Matrix3d::Identity();
+  });
+  add("table regrasp joints swapped", [](Sample& s) {
+    auto& r = s.parts[0].table_regrasps[0];
+    std::swap(r.joints_place, r.joints_repick);
+  });
+  add("table regrasp place joint -0.0 to +0.0",
+      [](Sample& s) { s.parts[0].table_regrasps[0].joints_place[3] = 0.0; });
+  add("table regrasp repick joint ulp", [](Sample& s) {
+    double& q = s.parts[0].table_regrasps[3].joints_repick[2];
+    q = std::nextafter(q, 10.0);
+  });
+  add("table regrasps reordered",
+      [](Sample& s) { std::swap(s.parts[0].table_regrasps[0], s.parts[0].table_regrasps[2]); });
+  add("a table regrasp less", [](Sample& s) { s.parts[0].table_regrasps.pop_back(); });
+  add("no table regrasps", [](Sample& s) { s.parts[0].table_regrasps.clear(); });
   for (const auto& [name, sample] : variants) {
     const std::string path = dir + "/variant.db";
     write_sample(path, sample);

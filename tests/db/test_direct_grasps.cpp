@@ -65,7 +65,7 @@ TEST(DirectGrasps, EveryFieldRoundTripsPerCandidateInIdOrder) {
   const Sample sample = make_sample();
   write_sample(path, sample);
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 5);
+  EXPECT_EQ(db.meta().schema_version, 6);
 
   const auto& written = sample.parts[0].direct_grasps;
   ASSERT_EQ(written.size(), 7u);
@@ -233,7 +233,7 @@ TEST(DirectGrasps, DamagedJointBlobIsADatabaseError) {
                      {"direct_grasps.joints_rh (id 6)", "got a value that is not finite"});
 }
 
-TEST(DirectGrasps, AVersion5FileWithoutTheTableIsRefused) {
+TEST(DirectGrasps, ACurrentFileWithoutTheTableIsRefused) {
   // The reader reads the table: a current file that lacks it (damaged by hand) cannot open.
   const std::string path = temp_dir("db_direct_missing") + "/p.db";
   write_sample(path, make_sample());

@@ -17,12 +17,13 @@ namespace fs = std::filesystem;
 namespace {
 
 // A "version 0" database: what schema 1 would look like if robot_grasps had no theta_c_deg yet
-// (and, as in schema 1, there were no comfort maps, handover, ergonomics, roadmap, regrasp or
-// direct grasp tables).
+// (and, as in schema 1, there were no comfort maps, handover, ergonomics, roadmap, regrasp,
+// direct grasp or table regrasp tables).
 std::string write_v0(const std::string& dir) {
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
   execute_script(path,
+                 "DROP TABLE table_regrasps;"
                  "DROP TABLE direct_grasps;"
                  "DROP TABLE regrasp_edges;"
                  "DROP TABLE regrasp_nodes;"
@@ -313,6 +314,22 @@ CREATE TABLE regrasp_edges (
 CREATE INDEX regrasp_edges_part_id ON regrasp_edges(part_id);
 )sql";
 
+// What schema version 5 added to version 4, exactly as hila (schema 5) wrote it, frozen here like
+// kSchemaV1.
+const char* const kSchemaV5Additions = R"sql(
+CREATE TABLE direct_grasps (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  arm TEXT NOT NULL,
+  joints_pick BLOB NOT NULL,
+  joints_rh BLOB NOT NULL,
+  inclination_pick_deg REAL NOT NULL,
+  inclination_rh_deg REAL NOT NULL
+);
+CREATE INDEX direct_grasps_candidate_id ON direct_grasps(candidate_id);
+)sql";
+
 // Meta and one part with a placement and one grasp of each kind, as rows of the version 1 tables
 // (meta without schema_version). Values are exact in binary so the writer would store the same
 // bits.
@@ -395,13 +412,32 @@ std::string write_v4(const std::string& dir) {
   return path;
 }
 
+// One direct grasp of the goal of kV3Rows (joints_pick (0.5, 1.0) and joints_rh (-2.0), as in the
+// kV3Rows blobs), as a row of the version 5 table; the version set to 5.
+const char* const kV5Rows = R"sql(
+UPDATE meta SET value = '5' WHERE key = 'schema_version';
+INSERT INTO direct_grasps VALUES (1, 1, 1, 'right', x'000000000000e03f000000000000f03f',
+  x'00000000000000c0', 22.5, 67.5);
+)sql";
+
+// A version 5 file made by hand: kV1Rows, kV3Rows, kV4Rows and kV5Rows.
+std::string write_v5(const std::string& dir) {
+  const std::string path = dir + "/v5.db";
+  execute_script(path, std::string(kSchemaV1) + kSchemaV2Additions + kSchemaV3Additions +
+                           kSchemaV4Additions + kSchemaV5Additions + kV1Rows + kV3Rows + kV4Rows +
+                           kV5Rows);
+  return path;
+}
+
 // The same content written by this hila's DatabaseWriter (no handover or ergonomics records, an
 // empty meta.human_bodies), with the comfort map of write_v2 when `with_comfort_map`, with the
-// version 3 records (and meta.human_bodies) of write_v3 when `with_handover_records`, and with the
-// version 4 records of write_v4 when `with_roadmap_records` (which needs the version 3 ones).
+// version 3 records (and meta.human_bodies) of write_v3 when `with_handover_records`, with the
+// version 4 records of write_v4 when `with_roadmap_records` (which needs the version 3 ones), and
+// with the version 5 record of write_v5 when `with_direct_grasp_records` (which needs the version 3
+// ones).
 void write_reference_content(const std::string& path, bool with_comfort_map,
-                             bool with_handover_records = false,
-                             bool with_roadmap_records = false) {
+                             bool with_handover_records = false, bool with_roadmap_records = false,
+                             bool with_direct_grasp_records = false) {
   Meta meta;
   meta.hila_version = "0.1.0";
   meta.product_name = "cabinet";
@@ -534,6 +570,17 @@ void write_reference_content(const std::string& path, bool with_comfort_map,
     node.solutions = {Eigen::Vector2d(0.5, 1.0)};
     writer.add_regrasp_nodes({node});
   }
+  if (with_direct_grasp_records) {
+    DirectGraspRecord direct;
+    direct.candidate_id = 1;
+    direct.robot_grasp_id = 1;
+    direct.arm = "right";
+    direct.joints_pick = Eigen::Vector2d(0.5, 1.0);
+    direct.joints_rh = Eigen::VectorXd::Constant(1, -2.0);
+    direct.inclination_pick_deg = 22.5;
+    direct.inclination_rh_deg = 67.5;
+    writer.add_direct_grasps({direct});
+  }
   writer.commit();
 }
 
@@ -582,6 +629,11 @@ void expect_no_direct_grasps(const Database& db) {
   EXPECT_TRUE(db.direct_grasps(1).empty());
 }
 
+// A migrated file has the version 6 table, empty.
+void expect_no_table_regrasps(const Database& db) {
+  EXPECT_TRUE(db.table_regrasps(1).empty());
+}
+
 }  // namespace
 
 TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
@@ -593,10 +645,10 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v1 = content_digest(path);  // an old file still has a digest
 
-  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5
+  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 5);
+  EXPECT_EQ(db.meta().schema_version, 6);
   EXPECT_EQ(db.meta().product_name, "cabinet");
   EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
@@ -607,6 +659,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
   expect_no_handover_records(db);
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
+  expect_no_table_regrasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v1.db"}) << "no temporary copy left";
 
   // The migrated file holds exactly what this hila writes for the same records: same tables,
@@ -629,16 +682,16 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 5), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
        "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_THROW(Database::open(path), DatabaseError);
   const std::string digest_v2 = content_digest(path);
 
-  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5
+  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 5);
+  EXPECT_EQ(db.meta().schema_version, 6);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   expect_v1_records(db);
   ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
@@ -648,6 +701,7 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_no_handover_records(db);
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
+  expect_no_table_regrasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v2.db"}) << "no temporary copy left";
 
   // Same content as this hila writes: the new tables (empty) and meta.human_bodies ("") included.
@@ -668,15 +722,15 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 5), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
        "written by schema version 3 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v3 = content_digest(path);
 
-  migrate_in_place(path);  // 3 -> 4 -> 5
+  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 5);
+  EXPECT_EQ(db.meta().schema_version, 6);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -697,9 +751,10 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(db.shared_grasps(1)[0].inclination_rh_deg, 45.0);
   ASSERT_EQ(db.ergonomics(1).size(), 1u);
   EXPECT_EQ(db.ergonomics(1)[0].torso_flexion_deg, 17.25);
-  // The version 4 and 5 tables exist, empty.
+  // The version 4, 5 and 6 tables exist, empty.
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
+  expect_no_table_regrasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v3.db"}) << "no temporary copy left";
 
   // Same content as this hila writes for the same records: the new tables (empty) included.
@@ -745,22 +800,22 @@ TEST(Migration, Version3FileThatAlreadyHasTheNewTablesFailsCleanly) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
-TEST(Migration, Version4FileIsUpgradedToVersion5) {
+TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   const std::string dir = temp_dir("db_migration_v4");
   const std::string path = write_v4(dir);
   // Unmigrated, the file is refused as outdated, with the way out.
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 5), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
        "written by schema version 4 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v4 = content_digest(path);
 
-  migrate_in_place(path);  // 4 -> 5 only
+  migrate_in_place(path);  // 4 -> 5 -> 6
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 5);
+  EXPECT_EQ(db.meta().schema_version, 6);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -776,11 +831,12 @@ TEST(Migration, Version4FileIsUpgradedToVersion5) {
   EXPECT_EQ(db.regrasp_nodes(1)[0].candidate_id, 1);
   ASSERT_EQ(db.regrasp_nodes(1)[0].solutions.size(), 1u);
   EXPECT_EQ(db.regrasp_nodes(1)[0].solutions[0], Eigen::Vector2d(0.5, 1.0));
-  // The version 5 table exists, empty.
+  // The version 5 and 6 tables exist, empty.
   expect_no_direct_grasps(db);
+  expect_no_table_regrasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v4.db"}) << "no temporary copy left";
 
-  // Same content as this hila writes for the same records: the new table (empty) included.
+  // Same content as this hila writes for the same records: the new tables (empty) included.
   const std::string fresh = dir + "/fresh.db";
   write_reference_content(fresh, true, true, true);
   EXPECT_EQ(content_digest(path), content_digest(fresh));
@@ -825,6 +881,125 @@ TEST(Migration, Version4FileThatAlreadyHasTheNewTableFailsCleanly) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
+TEST(Migration, Version5FileIsUpgradedToVersion6) {
+  const std::string dir = temp_dir("db_migration_v5");
+  const std::string path = write_v5(dir);
+  // Unmigrated, the file is refused as outdated, with the way out.
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
+       "written by schema version 5 (an older hila); rebuild with: hila build product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  const std::string digest_v5 = content_digest(path);
+
+  migrate_in_place(path);  // 5 -> 6 only
+
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 6);
+  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+  EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
+  expect_v1_records(db);
+  ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
+  EXPECT_EQ(db.comfort_map("right").coverage, 0.375);
+  // The version 3 and 4 records are kept.
+  ASSERT_NE(db.handover_stage(1), nullptr);
+  EXPECT_EQ(db.handover_stage(1)->draws, 812);
+  ASSERT_EQ(db.robot_handovers(1).size(), 1u);
+  EXPECT_EQ(db.robot_handovers(1)[0].joints, Eigen::Vector2d(0.5, 1.0));
+  ASSERT_EQ(db.handover_goals(1).size(), 1u);
+  EXPECT_EQ(db.handover_goals(1)[0].human_joints, Eigen::VectorXd::Constant(1, -2.0));
+  ASSERT_EQ(db.shared_grasps(1).size(), 1u);
+  EXPECT_EQ(db.shared_grasps(1)[0].joints_rr, Eigen::Vector2d(0.5, 1.0));
+  ASSERT_EQ(db.ergonomics(1).size(), 1u);
+  EXPECT_EQ(db.ergonomics(1)[0].torso_flexion_deg, 17.25);
+  ASSERT_NE(db.roadmap("left"), nullptr);
+  EXPECT_EQ(db.roadmap("left")->resolution, 0.0625);
+  ASSERT_EQ(db.regrasp_nodes(1).size(), 1u);
+  ASSERT_EQ(db.regrasp_nodes(1)[0].solutions.size(), 1u);
+  EXPECT_EQ(db.regrasp_nodes(1)[0].solutions[0], Eigen::Vector2d(0.5, 1.0));
+  // The version 5 record is kept, every field.
+  const auto direct = db.direct_grasps(1);
+  ASSERT_EQ(direct.size(), 1u);
+  EXPECT_EQ(direct[0].id, 1);
+  EXPECT_EQ(direct[0].candidate_id, 1);
+  EXPECT_EQ(direct[0].robot_grasp_id, 1);
+  EXPECT_EQ(direct[0].arm, "right");
+  ASSERT_EQ(direct[0].joints_pick.size(), 2);
+  EXPECT_EQ(direct[0].joints_pick, Eigen::Vector2d(0.5, 1.0));
+  ASSERT_EQ(direct[0].joints_rh.size(), 1);
+  EXPECT_EQ(direct[0].joints_rh[0], -2.0);
+  EXPECT_EQ(direct[0].inclination_pick_deg, 22.5);
+  EXPECT_EQ(direct[0].inclination_rh_deg, 67.5);
+  // The version 6 table exists, empty.
+  expect_no_table_regrasps(db);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"v5.db"}) << "no temporary copy left";
+
+  // Same content as this hila writes for the same records: the new table (empty) included.
+  const std::string fresh = dir + "/fresh.db";
+  write_reference_content(fresh, true, true, true, true);
+  EXPECT_EQ(content_digest(path), content_digest(fresh));
+  EXPECT_NE(content_digest(path), digest_v5);
+  // Without the direct grasp the content differs: the comparison sees the version 5 rows.
+  const std::string without = dir + "/without.db";
+  write_reference_content(without, true, true, true, false);
+  EXPECT_NE(content_digest(path), content_digest(without));
+
+  // The migrated file takes table regrasps like a fresh one (the table and its foreign keys are
+  // there): a row by SQL, read back, then one whose pick grasp does not exist.
+  execute_script(path,
+                 "INSERT INTO table_regrasps VALUES (1, 1, 1, 1, 'left', 0.5, -0.25, 0.75, "
+                 "0.0, 0.0, 0.0, 1.0, x'000000000000e03f', x'', x'00000000000000c0', "
+                 "x'000000000000e03f000000000000f03f', 10.5, 20.5, 30.5, 40.5);");
+  const auto regrasps = Database::open(path).table_regrasps(1);
+  ASSERT_EQ(regrasps.size(), 1u);
+  EXPECT_EQ(regrasps[0].id, 1);
+  EXPECT_EQ(regrasps[0].pick_grasp_id, 1);
+  EXPECT_EQ(regrasps[0].robot_grasp_id, 1);
+  EXPECT_EQ(regrasps[0].arm, "left");
+  EXPECT_EQ(regrasps[0].placement.translation(), Eigen::Vector3d(0.5, -0.25, 0.75));
+  EXPECT_EQ(regrasps[0].placement.linear(),
+            Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal().toDenseMatrix())
+      << "a half turn about z";
+  ASSERT_EQ(regrasps[0].joints_pick.size(), 1);
+  EXPECT_EQ(regrasps[0].joints_pick[0], 0.5);
+  EXPECT_EQ(regrasps[0].joints_place.size(), 0);
+  ASSERT_EQ(regrasps[0].joints_repick.size(), 1);
+  EXPECT_EQ(regrasps[0].joints_repick[0], -2.0);
+  ASSERT_EQ(regrasps[0].joints_rh.size(), 2);
+  EXPECT_EQ(regrasps[0].joints_rh, Eigen::Vector2d(0.5, 1.0));
+  EXPECT_EQ(regrasps[0].inclination_pick_deg, 10.5);
+  EXPECT_EQ(regrasps[0].inclination_place_deg, 20.5);
+  EXPECT_EQ(regrasps[0].inclination_repick_deg, 30.5);
+  EXPECT_EQ(regrasps[0].inclination_rh_deg, 40.5);
+  EXPECT_EQ(Database::open(path).direct_grasps(1).size(), 1u) << "a table of its own";
+  expect_input_error(
+      [&] {
+        execute_script(path,
+                       "INSERT INTO table_regrasps VALUES (2, 1, 2, 1, 'left', 0.0, 0.0, 0.0, "
+                       "1.0, 0.0, 0.0, 0.0, x'', x'', x'', x'', 0.0, 0.0, 0.0, 0.0);");
+      },
+      {"FOREIGN KEY constraint failed"});
+
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after) << "migrating a current file is a no-op";
+}
+
+TEST(Migration, Version5FileThatAlreadyHasTheNewTableFailsCleanly) {
+  // Version 6 content with the version number set back: the 5 -> 6 step's CREATE TABLE fails and
+  // the file is left as it was.
+  const std::string dir = temp_dir("db_migration_v5_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '5' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 5 -> 6", "table table_regrasps already exists"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
+}
+
 TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
   // A hand-made version 2 file that already has the key: the step does not overwrite it.
   const std::string dir = temp_dir("db_migration_v2_bodies");
@@ -856,7 +1031,7 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   migrate_with_steps(path, steps_from_v0(), current_schema_version());
 
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 5);
+  EXPECT_EQ(db.meta().schema_version, 6);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -870,34 +1045,37 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   expect_no_handover_records(db);
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
+  expect_no_table_regrasps(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"}) << "no temporary copy left";
 }
 
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 5 -> 6 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4 and
-  // 4 -> 5 create; listed first to prove ordering.
-  std::vector<MigrationStep> steps = {{5,
-                                       "INSERT INTO notes (text) VALUES ('from step 5');"
+  // Step 6 -> 7 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
+  // 4 -> 5 and 5 -> 6 create; listed first to prove ordering.
+  std::vector<MigrationStep> steps = {{6,
+                                       "INSERT INTO notes (text) VALUES ('from step 6');"
                                        "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
                                        "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
                                        "INSERT INTO notes (text) SELECT arm FROM roadmaps;"
-                                       "INSERT INTO notes (text) SELECT arm FROM direct_grasps;"}};
+                                       "INSERT INTO notes (text) SELECT arm FROM direct_grasps;"
+                                       "INSERT INTO notes (text) SELECT arm FROM table_regrasps;"}};
   steps.push_back(migration_steps().at(1));
+  steps.push_back(migration_steps().at(4));
   steps.push_back(migration_steps().at(3));
   steps.push_back(migration_steps().at(2));
   steps.push_back(migration_steps().at(0));
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 6));
-  migrate_with_steps(path, steps, 6);
-  // The file is now version 6: this hila (5) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 6"});
-  // Migrating to 6 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 7));
+  migrate_with_steps(path, steps, 7);
+  // The file is now version 7: this hila (6) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 7"});
+  // Migrating to 7 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 6);
+  migrate_with_steps(path, steps, 7);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -927,6 +1105,10 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
   EXPECT_FALSE(can_migrate(
       {migration_steps().at(0), migration_steps().at(1), migration_steps().at(2)}, 1, 5))
       << "1 -> 2 -> 3 -> 4 does not reach 5";
+  EXPECT_FALSE(can_migrate({migration_steps().at(0), migration_steps().at(1),
+                            migration_steps().at(2), migration_steps().at(3)},
+                           1, 6))
+      << "1 -> 2 -> 3 -> 4 -> 5 does not reach 6";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },

@@ -33,17 +33,19 @@ std::vector<std::string> create_statements(const std::string& sql) {
 
 }  // namespace
 
-TEST(Schema, VersionIsFiveWithStepsFromOneToFour) {
-  EXPECT_EQ(current_schema_version(), 5);
-  ASSERT_EQ(migration_steps().size(), 4u);
+TEST(Schema, VersionIsSixWithStepsFromOneToFive) {
+  EXPECT_EQ(current_schema_version(), 6);
+  ASSERT_EQ(migration_steps().size(), 5u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
   EXPECT_EQ(migration_steps()[1].from_version, 2);
   EXPECT_EQ(migration_steps()[2].from_version, 3);
   EXPECT_EQ(migration_steps()[3].from_version, 4);
+  EXPECT_EQ(migration_steps()[4].from_version, 5);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 3, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 4, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 5, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
   // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
@@ -83,6 +85,17 @@ TEST(Schema, VersionIsFiveWithStepsFromOneToFour) {
     EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
   }
   EXPECT_EQ(migration_steps()[3].sql.find("INSERT"), std::string::npos);
+  // 5 -> 6: the table_regrasps table and its index, as a fresh database has them, and nothing
+  // else.
+  const auto created_v6 = create_statements(migration_steps()[4].sql);
+  ASSERT_EQ(created_v6.size(), 2u) << "1 table, 1 index";
+  EXPECT_EQ(created_v6[0].rfind("CREATE TABLE table_regrasps (", 0), 0u) << created_v6[0];
+  EXPECT_EQ(created_v6[1],
+            "CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);");
+  for (const auto& statement : created_v6) {
+    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  EXPECT_EQ(migration_steps()[4].sql.find("INSERT"), std::string::npos);
 }
 
 TEST(Schema, ColumnListHelpers) {
@@ -91,7 +104,7 @@ TEST(Schema, ColumnListHelpers) {
 }
 
 TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
-  ASSERT_EQ(kTables.size(), 17u);
+  ASSERT_EQ(kTables.size(), 18u);
   EXPECT_STREQ(kTables[0].name, "meta");
   EXPECT_STREQ(kTables[1].name, "parts");
   EXPECT_STREQ(kTables[6].name, "comfort_maps");
@@ -110,6 +123,8 @@ TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
   // Appended last, so the digest of an older file hashes its tables as it always did.
   EXPECT_STREQ(kTables[16].name, "direct_grasps");
   EXPECT_EQ(kTables[16].since_version, 5);
+  EXPECT_STREQ(kTables[17].name, "table_regrasps");
+  EXPECT_EQ(kTables[17].since_version, 6);
   for (const auto& table : kTables) {
     EXPECT_NE(schema_sql().find(std::string("CREATE TABLE ") + table.name + " ("),
               std::string::npos)
@@ -235,6 +250,34 @@ TEST(Schema, DirectGraspColumnsAreDeclared) {
             ");");
 }
 
+TEST(Schema, TableRegraspColumnsAreDeclared) {
+  // The table's own text, so a column of another table cannot stand in for one of these.
+  const std::string& sql = schema_sql();
+  const std::size_t start = sql.find("CREATE TABLE table_regrasps (");
+  ASSERT_NE(start, std::string::npos);
+  const std::string table = sql.substr(start, sql.find(");", start) + 2 - start);
+  EXPECT_EQ(table,
+            "CREATE TABLE table_regrasps (\n"
+            "  id INTEGER PRIMARY KEY,\n"
+            "  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),\n"
+            "  pick_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),\n"
+            "  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),\n"
+            "  arm TEXT NOT NULL,\n"
+            "  placement_x REAL NOT NULL, placement_y REAL NOT NULL, placement_z REAL NOT NULL,\n"
+            "  placement_qw REAL NOT NULL, placement_qx REAL NOT NULL, placement_qy REAL NOT "
+            "NULL,\n"
+            "  placement_qz REAL NOT NULL,\n"
+            "  joints_pick BLOB NOT NULL,\n"
+            "  joints_place BLOB NOT NULL,\n"
+            "  joints_repick BLOB NOT NULL,\n"
+            "  joints_rh BLOB NOT NULL,\n"
+            "  inclination_pick_deg REAL NOT NULL,\n"
+            "  inclination_place_deg REAL NOT NULL,\n"
+            "  inclination_repick_deg REAL NOT NULL,\n"
+            "  inclination_rh_deg REAL NOT NULL\n"
+            ");");
+}
+
 TEST(Schema, ComfortMapColumnsAreDeclaredNotNull) {
   const std::string& sql = schema_sql();
   for (const std::string column :
@@ -251,7 +294,7 @@ TEST(Schema, ComfortMapColumnsAreDeclaredNotNull) {
 TEST(Schema, EveryPoseAndVectorColumnIsDeclared) {
   const std::string& sql = schema_sql();
   for (const std::string prefix :
-       {"target", "initial", "part_in_plane", "tcp", "cup", "hand", "board"}) {
+       {"target", "initial", "part_in_plane", "tcp", "cup", "hand", "board", "placement"}) {
     for (const std::string suffix : {"_x ", "_y ", "_z ", "_qw ", "_qx ", "_qy ", "_qz "}) {
       EXPECT_NE(sql.find(prefix + suffix + "REAL NOT NULL"), std::string::npos) << prefix << suffix;
     }
@@ -277,7 +320,7 @@ TEST(Schema, SqlRunsOnAnEmptyFileAndCreatesThePartIdIndexes) {
         },
         {path, "already exists"});
   }
-  for (const std::string table : {"shared_grasps", "direct_grasps"}) {
+  for (const std::string table : {"shared_grasps", "direct_grasps", "table_regrasps"}) {
     expect_input_error(
         [&] {
           execute_script(path,
