@@ -728,6 +728,7 @@ void DatabaseWriter::add_table_regrasps(const std::vector<TableRegraspRecord>& r
     detail::Statement& s = *m.insert_regrasp;
     for (const auto& g : regrasps) {
       s.set_context(m.context("table_regrasps (candidate id " + std::to_string(g.candidate_id) +
+                              ", pick grasp id " + std::to_string(g.pick_grasp_id) +
                               ", robot grasp id " + std::to_string(g.robot_grasp_id) + ", arm '" +
                               g.arm + "')"));
       s.bind_next(g.candidate_id);

@@ -76,6 +76,8 @@ class DatabaseWriter {
   // candidate_id and robot_grasp_id are taken from each record and must name written records;
   // arm must be non-empty (schema version 5).
   void add_direct_grasps(const std::vector<DirectGraspRecord>& grasps);
+  // candidate_id, pick_grasp_id and robot_grasp_id are taken from each record and must name
+  // written records; arm must be non-empty, the placement and joints finite (schema version 6).
   void add_table_regrasps(const std::vector<TableRegraspRecord>& regrasps);
   // method must be "hila", "table" or "alone", at most one row per part and method (DatabaseError:
   // CHECK / UNIQUE constraint failed).
