@@ -286,21 +286,25 @@ TEST(TableRegrasps, UnknownReferencesAreDatabaseErrors) {
   ASSERT_EQ(r.pick_grasp_id, 1);
   ASSERT_EQ(r.robot_grasp_id, 2);
   r.candidate_id = 10;  // part 1's six candidates are written, part 2's are not
-  refused("unknown candidate", r,
-          {target, "table_regrasps (candidate id 10, robot grasp id 2, arm 'left')",
-           "FOREIGN KEY constraint failed"});
+  refused(
+      "unknown candidate", r,
+      {target, "table_regrasps (candidate id 10, pick grasp id 1, robot grasp id 2, arm 'left')",
+       "FOREIGN KEY constraint failed"});
   r.candidate_id = 4;
   r.pick_grasp_id = 10;  // the sample has 5 + 4
   refused("unknown pick grasp", r,
-          {target, "table_regrasps (candidate id 4,", "FOREIGN KEY constraint failed"});
+          {target, "table_regrasps (candidate id 4, pick grasp id 10, robot grasp id 2",
+           "FOREIGN KEY constraint failed"});
   r.pick_grasp_id = 0;
   refused("pick grasp id 0", r,
-          {target, "table_regrasps (candidate id 4,", "FOREIGN KEY constraint failed"});
+          {target, "table_regrasps (candidate id 4, pick grasp id 0,",
+           "FOREIGN KEY constraint failed"});
   r.pick_grasp_id = 1;
   r.robot_grasp_id = 10;
-  refused("unknown robot grasp", r,
-          {target, "table_regrasps (candidate id 4, robot grasp id 10, arm 'left')",
-           "FOREIGN KEY constraint failed"});
+  refused(
+      "unknown robot grasp", r,
+      {target, "table_regrasps (candidate id 4, pick grasp id 1, robot grasp id 10, arm 'left')",
+       "FOREIGN KEY constraint failed"});
   // The same record with known references is written.
   r.robot_grasp_id = 9;
   Fixture f(target);
