@@ -803,13 +803,18 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     for (const int ci : comfortable) {
       auto& c = result.candidates[static_cast<std::size_t>(ci)];
       const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
-      data.set_body_pose(scene.board, c.board);
-      const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
-      place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
-      if (h.second_grasp >= 0) {
-        const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-        place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
-      }
+      // The board at the candidate with the human's hands at their grasps (again after an arm's
+      // checks reset the scene).
+      const auto at_candidate = [&] {
+        data.set_body_pose(scene.board, c.board);
+        const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
+        place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
+        if (h.second_grasp >= 0) {
+          const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+          place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
+        }
+      };
+      at_candidate();
       int shared = 0;
       for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
         const auto& poses = rr_of_grasp[static_cast<std::size_t>(g)];
@@ -863,12 +868,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         }
         restore_arm(*d.arm);
         reset_state();
-        place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
-        if (h.second_grasp >= 0) {
-          const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-          place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
-        }
-        data.set_body_pose(scene.board, c.board);
+        at_candidate();
       }
       reset_state();
       int regrasps = 0;
@@ -909,12 +909,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
           }
           restore_arm(*d.arm);
           reset_state();
-          place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
-          if (h.second_grasp >= 0) {
-            const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-            place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
-          }
-          data.set_body_pose(scene.board, c.board);
+          at_candidate();
         }
         reset_state();
       }
