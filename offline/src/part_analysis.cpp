@@ -9,12 +9,14 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <deque>
 #include <limits>
 #include <numeric>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include "cgal_types.hpp"
@@ -399,9 +401,21 @@ core::TriangleMesh convex_hull(const core::TriangleMesh& mesh) {
   }
   SurfaceMesh hull;
   CGAL::convex_hull_3(points.begin(), points.end(), hull);
+  // convex_hull_3 returns the same triangles from call to call, but in an order that varies
+  // between calls (and threads). Areas and normals summed over a facet's triangles depend on
+  // that order in their last bits, and equal-stability placements were sorted by them, so the
+  // hull is put in a canonical order: vertices lexicographically, each triangle starting at its
+  // smallest index (orientation kept), triangles sorted.
+  std::vector<SurfaceMesh::Vertex_index> vertices(hull.vertices().begin(), hull.vertices().end());
+  const auto coordinates_less = [&](SurfaceMesh::Vertex_index a, SurfaceMesh::Vertex_index b) {
+    const Point3& p = hull.point(a);
+    const Point3& q = hull.point(b);
+    return std::make_tuple(p.x(), p.y(), p.z()) < std::make_tuple(q.x(), q.y(), q.z());
+  };
+  std::sort(vertices.begin(), vertices.end(), coordinates_less);
   core::TriangleMesh out;
   std::vector<int> index(hull.num_vertices(), -1);
-  for (const auto v : hull.vertices()) {
+  for (const auto v : vertices) {
     index[static_cast<std::size_t>(v)] = static_cast<int>(out.vertices.size());
     out.vertices.push_back(to_eigen(hull.point(v)));
   }
@@ -412,9 +426,13 @@ core::TriangleMesh convex_hull(const core::TriangleMesh& mesh) {
     }
     // convex_hull_3 triangulates its output; fan-triangulate defensively all the same.
     for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
-      out.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+      std::array<int, 3> triangle{polygon[0], polygon[k], polygon[k + 1]};
+      std::rotate(triangle.begin(), std::min_element(triangle.begin(), triangle.end()),
+                  triangle.end());
+      out.triangles.push_back(triangle);
     }
   }
+  std::sort(out.triangles.begin(), out.triangles.end());
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <thread>
 
 #include "hila/core/error.hpp"
 #include "hila/core/mesh.hpp"
@@ -260,6 +261,58 @@ TEST(PartAnalysis, ResultIsDeterministic) {
   for (std::size_t i = 0; i < a.placements.size(); ++i) {
     EXPECT_EQ(a.placements[i].stability, b.placements[i].stability);
     EXPECT_TRUE(a.placements[i].part_in_plane.isApprox(b.placements[i].part_in_plane, 0.0));
+  }
+}
+
+// A closed prism with a regular `sides`-gon cross-section (a dowel-like part): its two caps are
+// equal, so its two most stable placements tie exactly and only a canonical order separates them.
+core::TriangleMesh regular_prism(int sides, double radius, double length) {
+  core::TriangleMesh mesh;
+  for (int end = 0; end < 2; ++end) {
+    for (int k = 0; k < sides; ++k) {
+      const double angle = 2.0 * M_PI * k / sides;
+      mesh.vertices.emplace_back(radius * std::cos(angle), radius * std::sin(angle),
+                                 (end == 0 ? -0.5 : 0.5) * length);
+    }
+  }
+  const int bottom_centre = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.emplace_back(0.0, 0.0, -0.5 * length);
+  mesh.vertices.emplace_back(0.0, 0.0, 0.5 * length);
+  for (int k = 0; k < sides; ++k) {
+    const int a = k;
+    const int b = (k + 1) % sides;
+    mesh.triangles.push_back({a, b, b + sides});
+    mesh.triangles.push_back({a, b + sides, a + sides});
+    mesh.triangles.push_back({bottom_centre, b, a});
+    mesh.triangles.push_back({bottom_centre + 1, a + sides, b + sides});
+  }
+  return mesh;
+}
+
+TEST(PartAnalysis, HullAndPlacementsOfADowelAreTheSameOnEveryCallAndThread) {
+  // CGAL's convex_hull_3 returns its triangles in an order that varies between calls; the tied
+  // caps of a dowel were then sorted differently by a build with --jobs 2.
+  const auto mesh = regular_prism(24, 0.01, 0.3);
+  const auto reference = analyze_part("dowel", mesh, 0.1);
+  ASSERT_GE(reference.placements.size(), 2u);
+  EXPECT_EQ(reference.placements[0].stability, reference.placements[1].stability);
+  for (int run = 0; run < 6; ++run) {
+    PartAnalysis other;
+    if (run % 2 == 0) {
+      other = analyze_part("dowel", mesh, 0.1);
+    } else {
+      std::thread worker([&] { other = analyze_part("dowel", mesh, 0.1); });
+      worker.join();
+    }
+    ASSERT_EQ(other.convex_hull.vertices, reference.convex_hull.vertices) << "run " << run;
+    ASSERT_EQ(other.convex_hull.triangles, reference.convex_hull.triangles) << "run " << run;
+    ASSERT_EQ(other.placements.size(), reference.placements.size());
+    for (std::size_t i = 0; i < other.placements.size(); ++i) {
+      EXPECT_EQ(other.placements[i].stability, reference.placements[i].stability);
+      EXPECT_TRUE(other.placements[i].part_in_plane.isApprox(reference.placements[i].part_in_plane,
+                                                             0.0))
+          << "run " << run << " placement " << i;
+    }
   }
 }
 
