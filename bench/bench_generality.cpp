@@ -290,6 +290,7 @@ struct PartResult {
   std::string way;              // "exchange" or "direct" (delivered parts)
   std::string delivering_arm;
   bool tool_in_hand_after = true;  // the suction arm holds the tool after the part
+  std::string tool_arm = online::kDefaultSuctionArm;  // the arm holding it then
 };
 
 std::string most_frequent_outcome(const online::BoardPlan& plan) {
@@ -356,8 +357,10 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
     r.way = online::to_string(plan.mode);
     r.delivering_arm = plan.delivering_arm;
     r.tool_in_hand_after = plan.tool_in_hand_after;
+    r.tool_arm = plan.suction_arm;
   } else {
     r.tool_in_hand_after = scene.tool_in_hand;
+    r.tool_arm = scene.tool_arm;
   }
   r.status = online::to_string(plan.status);
   r.reason = plan.reason;
@@ -478,9 +481,11 @@ std::vector<PartResult> plan_all(online::BoardPlanner& planner, const online::Pl
               << (r.start_collision.empty() ? "" : "  [start touches " + r.start_collision + "]")
               << std::endl;
     const bool tool_in_hand = r.tool_in_hand_after;
+    const std::string tool_arm = r.tool_arm;
     results.push_back(std::move(r));
     scene = scene.with_finished(model.product(), part.name);
     scene.tool_in_hand = tool_in_hand;
+    scene.tool_arm = tool_arm;
     for (const auto& arm : model.cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
   }
   return results;

@@ -90,7 +90,9 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     problem(plan.board, "the plan's theta_c is not its grasp's");
   }
 
-  const online::World world(cell, product, scene, plan.board);
+  const online::World world(
+      cell, product, scene, plan.board,
+      plan.suction_arm.empty() ? online::kDefaultSuctionArm : plan.suction_arm);
   core::CollisionData data = world.make_data();
   const core::StageScene& stage = world.stage();
   const core::Arm& suction = cell.arms()[static_cast<std::size_t>(stage.suction_arm)];
@@ -126,7 +128,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     const auto it = scene.robot.find(arm.spec.name);
     if (it != scene.robot.end()) cell.set_arm(robot_q, arm, it->second);
   }
-  bool tool_in_hand = scene.tool_in_hand;
+  bool tool_in_hand = scene.tool_in_hand && scene.tool_arm == suction.spec.name;
   bool on_cup = false, handed_over = false;
   const core::Arm* in_gripper = nullptr;              // the arm whose gripper holds the board
   core::Pose board_world = scene.initial_pose(part);  // while neither hand holds it

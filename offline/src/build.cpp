@@ -70,6 +70,7 @@ struct PartResult {
   std::vector<db::SuctionGraspRecord> suction;
   std::vector<db::HumanGraspRecord> human;
   PartBuildSummary summary;
+  bool roles_swapped = false;  // the receiving arm picks by suction (swap_roles)
 };
 
 PartResult build_part(const core::ProductSpec& product, std::size_t index, const core::Cell& cell,
@@ -279,7 +280,7 @@ std::string settings_hash(const BuildSettings& s) {
        << ' ' << h.human_ik_goals << ' ' << h.direct << ' ' << h.direct_stored << ' ' << h.pick_lift
        << ' ' << h.pick_resolution << ' ' << h.exchange_approach << ' ' << h.exchange_resolution
        << ' ' << h.table_regrasp.enabled << ' ' << h.table_regrasp.placements << ' '
-       << h.table_regrasp.yaws << ' ' << h.table_regrasp.support_tolerance;
+       << h.table_regrasp.yaws << ' ' << h.table_regrasp.support_tolerance << ' ' << h.swap_roles;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
@@ -294,6 +295,36 @@ std::string settings_hash(const BuildSettings& s) {
        << g.alternative_checks << '\n';
   return db::sha256_hex(text.str());
 }
+
+namespace {
+
+// For a part without goals in the default roles: its goals with the arms' roles swapped. Kept
+// (and `handover` swapped with them) when there are some and the new suction arm reaches the
+// tool on its stand; otherwise the default roles' reason gains what the swap would have needed.
+void swap_roles(const core::Cell& cell, const core::ProductSpec& product, std::size_t i,
+                const BoardGrasps& grasps, const HumanComfort& comfort, HandoverSettings& handover,
+                PartResult& r) {
+  HandoverSettings swapped = handover;
+  std::swap(swapped.suction_arm, swapped.receiving_arm);
+  HandoverResult other = plan_handover_goals(cell, product, i, grasps, comfort, swapped);
+  if (other.stage.goals == 0) return;
+  if (!reaches_tool_stand(cell, product, i, swapped.suction_arm)) {
+    const Eigen::Vector3d at = product.suction_tool_pose.translation();
+    r.handover.stage.failure +=
+        "; with the " + swapped.suction_arm + " arm picking by suction it would have " +
+        std::to_string(other.stage.goals) + " goals, but the " + swapped.suction_arm +
+        " arm does not reach the suction tool on " + "its stand at (" +
+        core::format_number(at.x()) + ", " + core::format_number(at.y()) + ", " +
+        core::format_number(at.z()) + ") m: stand the tool where both arms reach it";
+    return;
+  }
+  other.seconds += r.handover.seconds;
+  r.handover = std::move(other);
+  r.roles_swapped = true;
+  handover = swapped;
+}
+
+}  // namespace
 
 BuildSummary build_database(const std::string& product_path, const std::string& cell_path,
                             const std::string& output_path, const BuildSettings& settings,
@@ -378,6 +409,8 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     handover.pick_resolution = settings.roadmap.resolution;
     handover.seed = part_seed(settings.seed, product.parts[i].name, 4);
     r.handover = plan_handover_goals(*cell, product, i, grasps, comfort, handover);
+    if (r.handover.stage.goals == 0 && handover.swap_roles)
+      swap_roles(*cell, product, i, grasps, comfort, handover, r);
     ErgonomicsInputs in;
     in.target = r.record.target;
     in.initial = r.record.initial;
@@ -418,15 +451,17 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
       }
     }
     RegraspSettings regrasp = settings.regrasp;
-    regrasp.suction_arm = settings.handover.suction_arm;
-    regrasp.receiving_arm = settings.handover.receiving_arm;
+    regrasp.suction_arm = handover.suction_arm;
+    regrasp.receiving_arm = handover.receiving_arm;
+    s.suction_arm = handover.suction_arm;
     regrasp.lift = settings.handover.pick_lift;
     regrasp.approach = settings.handover.exchange_approach;
     regrasp.approach_resolution = settings.handover.exchange_resolution;
     regrasp.held_resolution = settings.handover.exchange_resolution;
     regrasp.seed = part_seed(settings.seed, product.parts[i].name, 7);
     r.regrasp =
-        plan_regrasp(*cell, product, i, grasps, r.handover, roadmaps[0], roadmaps[1], regrasp);
+        plan_regrasp(*cell, product, i, grasps, r.handover, roadmaps[r.roles_swapped ? 1 : 0],
+                     roadmaps[r.roles_swapped ? 0 : 1], regrasp);
     const auto& g = r.regrasp;
     s.regrasp_filters = static_cast<int>(g.filters.size());
     s.regrasp_nodes = static_cast<int>(g.nodes.size());
@@ -471,7 +506,10 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     const auto human_ids = writer.add_human_grasps(id, r.human);
     const HandoverIds handover_ids =
         write_handover(writer, id, r.handover, robot_ids, suction_ids, human_ids);
-    write_regrasp(writer, id, r.regrasp, roadmap_ids, robot_ids, suction_ids, handover_ids);
+    // The regrasp graph numbers the roadmaps by role: 0 the suction arm's, 1 the receiving arm's.
+    const std::vector<std::int64_t> by_role =
+        r.roles_swapped ? std::vector<std::int64_t>{roadmap_ids[1], roadmap_ids[0]} : roadmap_ids;
+    write_regrasp(writer, id, r.regrasp, by_role, robot_ids, suction_ids, handover_ids);
     writer.add_ergonomics(id, r.ergonomics);
     summary.parts.push_back(r.summary);
   }

@@ -1014,4 +1014,19 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   return finish("");
 }
 
+bool reaches_tool_stand(const core::Cell& cell, const core::ProductSpec& product, std::size_t index,
+                        const std::string& arm) {
+  const core::Arm& a = cell.arm(arm);
+  const core::Pose& stand = product.suction_tool_pose;
+  ArmWorkspace workspace(cell, arm, arm, nullptr, core::parts_before(product, index),
+                         core::parts_after(product, index), &stand);
+  const core::Pose tcp = stand * cell.spec().suction.handle_in_tcp.inverse();
+  core::UrIkSolutions ik;
+  const int n = a.ur_ik->solve(core::arm_base_in_world(cell, a).inverse() * tcp, a.spec.home, ik);
+  for (int k = 0; k < n; ++k) {
+    if (workspace.arm_valid(ik.q[static_cast<std::size_t>(k)])) return true;
+  }
+  return false;
+}
+
 }  // namespace hila::offline

@@ -85,6 +85,17 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (records == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
+  // The tool stays in the hand that used it last; the board's suction arm must be that one.
+  const std::string suction_arm =
+      records->suction_arm.empty() ? kDefaultSuctionArm : records->suction_arm;
+  result.suction_arm = suction_arm;
+  if (scene.tool_in_hand && scene.tool_arm != suction_arm) {
+    return finish(BoardPlanStatus::kNoGoal,
+                  "the suction tool is in the " + scene.tool_arm + " arm's hand, and the " +
+                      "database gives '" + board + "' to the " + suction_arm +
+                      " arm's suction: put the tool on its stand first (handing the tool " +
+                      "between the arms is not planned)");
+  }
   Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
   running = &run;
   // Payload. The exchange: the suction arm carries the board on the tool, the receiving arm in

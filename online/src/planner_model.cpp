@@ -48,7 +48,10 @@ PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::Product
     for (auto& g : database_.robot_grasps(part.id)) b.robot_grasps[g.id] = std::move(g);
     for (auto& g : database_.suction_grasps(part.id)) b.suction_grasps[g.id] = std::move(g);
     for (auto& g : database_.human_grasps(part.id)) b.human_grasps[g.id] = std::move(g);
-    for (auto& h : database_.robot_handovers(part.id)) b.robot_handovers[h.id] = std::move(h);
+    for (auto& h : database_.robot_handovers(part.id)) {
+      if (b.suction_arm.empty()) b.suction_arm = h.arm;
+      b.robot_handovers[h.id] = std::move(h);
+    }
     std::map<std::int64_t, std::string> arm_of_roadmap;
     for (const auto& m : database_.roadmaps()) arm_of_roadmap[m.id] = m.arm;
     for (auto& f : database_.roadmap_filters(part.id)) {

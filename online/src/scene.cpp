@@ -124,7 +124,18 @@ Scene load_scene(const std::string& path, const core::Cell& cell,
   }
   if (const auto n = root.find("assembly_frame")) s.assembly_frame = n->as_pose();
   if (const auto n = root.find("tool")) s.tool = n->as_pose();
-  if (const auto n = root.find("tool_in_hand")) s.tool_in_hand = n->as_bool();
+  // true / false, or the name of the arm that holds the tool (true: the right arm's).
+  if (const auto n = root.find("tool_in_hand")) {
+    const std::string value = n->as_string();
+    if (value == "true" || value == "false") {
+      s.tool_in_hand = n->as_bool();
+    } else if (value.empty() || value.find_first_of(" \t\n") != std::string::npos) {
+      n->fail("true, false or the name of the arm holding the tool", "'" + value + "'");
+    } else {
+      s.tool_in_hand = true;
+      s.tool_arm = value;
+    }
+  }
 
   if (const auto list = root.find("finished")) {
     if (!list->is_sequence()) list->fail("a list of finished boards", "not a list");

@@ -179,6 +179,48 @@ TEST(Build, APartOutOfTheSuctionArmsReachIsNamedWithItsPose) {
   EXPECT_NE(last.handover_failure.find("; the right arm: "), std::string::npos);
 }
 
+// The same part with the suction tool standing where both arms reach it: the left arm takes the
+// tool and picks the part by suction, the right arm receives it (the roles swapped).
+TEST(Build, APartOnlyTheLeftArmReachesIsPickedByItsSuctionWhenItReachesTheTool) {
+  const std::string dir = test::temp_dir("build_swap");
+  // More candidates than the quick build's: the left arm's side has few comfortable ones.
+  offline::BuildSettings settings = quick_settings();
+  settings.handover.candidates = 500;
+  settings.handover.max_candidates = 500;
+  const std::string moved = product_variant(dir, "initial: {xyz: [0.30, -0.30, 1.0965]",
+                                            "initial: {xyz: [0.30, 0.30, 1.0965]");
+  {
+    const offline::BuildSummary summary =
+        offline::build_database(moved, test::cell_path(), dir + "/rack.hila", settings);
+    const auto& last = summary.parts.back();
+    EXPECT_EQ(last.goals, 0);
+    EXPECT_NE(last.handover_failure.find("with the left arm picking by suction it would have "),
+              std::string::npos)
+        << last.handover_failure;
+    EXPECT_NE(last.handover_failure.find("but the left arm does not reach the suction tool on its "
+                                         "stand at (0.3, -0.72, 1.229) m"),
+              std::string::npos)
+        << last.handover_failure;
+  }
+  std::string text = test::read_file(moved);
+  const std::string rack = "suction_tool_pose: {xyz: [0.30, -0.72, 1.229]";
+  ASSERT_NE(text.find(rack), std::string::npos);
+  text.replace(text.find(rack), rack.size(), "suction_tool_pose: {xyz: [0.10, 0.0, 1.229]");
+  const std::string product = test::write_file(dir, "product.yaml", text);
+  const std::string out = dir + "/both.hila";
+  const offline::BuildSummary summary =
+      offline::build_database(product, test::cell_path(), out, settings);
+  const auto& last = summary.parts.back();
+  EXPECT_GT(last.goals, 0) << last.handover_failure;
+  EXPECT_EQ(last.suction_arm, "left");
+  EXPECT_EQ(summary.parts.front().suction_arm, "right");
+  // Stored: the part's exchange poses hold it on the left arm's cup.
+  const auto database = db::Database::open(out);
+  const auto handovers = database.robot_handovers(database.part(last.name).id);
+  ASSERT_FALSE(handovers.empty());
+  for (const auto& h : handovers) EXPECT_EQ(h.arm, "left");
+}
+
 TEST(Build, SameSeedSameDigestForAnyNumberOfJobs) {
   const std::string dir = test::temp_dir("build_digest");
   const std::string a = build(dir, "a.hila", quick_settings(7, 1));

@@ -186,7 +186,10 @@ int run_plan(const PlanOptions& opt) {
     // finished, so one failure does not hide whether the rest can be planned.
     if (!plan.solved()) ++failed;
     scene = scene.with_finished(model->product(), board);
-    if (plan.solved()) scene.tool_in_hand = plan.tool_in_hand_after;
+    if (plan.solved()) {
+      scene.tool_in_hand = plan.tool_in_hand_after;
+      scene.tool_arm = plan.suction_arm;
+    }
     for (const auto& arm : model->cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
   }
   if (opt.output_given) write_file_atomically(opt.output, out.dump(1) + "\n");

@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/comfort_map.hpp"
 #include "hila/core/human_model.hpp"
 #include "hila/core/product.hpp"
 #include "hila/db/provenance.hpp"
-#include "hila/core/comfort_map.hpp"
 #include "hila/offline/ergonomics.hpp"
 #include "hila/offline/handover.hpp"
 #include "hila/offline/human_grasps.hpp"
@@ -58,6 +58,7 @@ struct PartBuildSummary {
   double goal_quality = 0.0;     // the first goal's
   double goal_distance = 0.0;    // Eq. 8
   std::string handover_failure;  // empty when the board has goals
+  std::string suction_arm;       // the arm that picks by suction and hands over (its goals')
   double handover_seconds = 0.0;
   // Regrasp graph (filtered roadmaps, paper §V).
   int regrasp_filters = 0;

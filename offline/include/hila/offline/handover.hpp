@@ -65,6 +65,10 @@ struct HandoverSettings {
   // arm that picks the part sets it down where it lay on another resting pose and takes it again
   // with a grasp that holds it at the goal (up to direct_stored per goal and arm).
   TableRegraspSettings table_regrasp;
+  // A part with no goal in these roles is tried again with the arms' roles swapped (the
+  // receiving arm takes the tool and picks by suction, the suction arm receives), and the swapped
+  // roles are kept when they give goals and the new suction arm reaches the tool on its stand.
+  bool swap_roles = true;
   std::uint64_t seed = 3;
 };
 
@@ -97,6 +101,12 @@ struct BoardGrasps {
 HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSpec& product,
                                    std::size_t index, const BoardGrasps& grasps,
                                    const HumanComfort& comfort, const HandoverSettings& settings);
+
+// Whether `arm` can take the suction tool from its stand (product.suction_tool_pose): an IK
+// solution with the open hand at the handle, within the joint limits and clear of the cell and
+// of the parts standing at the stage of product.parts[index].
+bool reaches_tool_stand(const core::Cell& cell, const core::ProductSpec& product, std::size_t index,
+                        const std::string& arm);
 
 // Eq. 8 distance between two poses.
 double handover_distance(const core::Pose& a, const core::Pose& b, double rotation_weight);

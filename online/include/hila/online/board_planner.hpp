@@ -88,7 +88,7 @@ struct GoalAttempt {
   std::string arm;  // the delivering arm
   std::int64_t robot_grasp_id = 0;
   std::int64_t robot_handover_id = 0;  // 0 for a direct pick
-  std::string outcome;  // "planned" or the reason
+  std::string outcome;                 // "planned" or the reason
 };
 
 // kHumanOutOfReach: the scene's human can take the board at none of its stored goals (where they
@@ -161,8 +161,9 @@ struct BoardPlan {
   // Motions planned over every goal tried (fallbacks and re-plans included): the work done, as
   // no clock on a shared machine measures it.
   int motions_planned = 0;
-  Eigen::VectorXd robot_q_after;  // the robot when the board has been taken
-  bool tool_in_hand_after = false;  // the suction arm still holds the tool then
+  Eigen::VectorXd robot_q_after;    // the robot when the board has been taken
+  bool tool_in_hand_after = false;  // an arm still holds the tool then: suction_arm
+  std::string suction_arm;          // the arm that holds the tool in this plan
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };
 

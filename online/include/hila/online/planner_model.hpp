@@ -22,13 +22,16 @@ namespace hila::online {
 struct BoardRecords {
   db::PartRecord part;
   std::vector<db::HandoverCandidateRecord> goals;  // Eq. 8 order: by rank (then id)
-  std::map<std::int64_t, std::vector<db::SharedGraspRecord>> shared_grasps;  // by goal, id order
-  std::map<std::int64_t, std::vector<db::DirectGraspRecord>> direct_grasps;  // by goal, id order
+  std::map<std::int64_t, std::vector<db::SharedGraspRecord>> shared_grasps;    // by goal, id order
+  std::map<std::int64_t, std::vector<db::DirectGraspRecord>> direct_grasps;    // by goal, id order
   std::map<std::int64_t, std::vector<db::TableRegraspRecord>> table_regrasps;  // by goal, id order
   std::map<std::int64_t, db::RobotGraspRecord> robot_grasps;
   std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps;
   std::map<std::int64_t, db::HumanGraspRecord> human_grasps;
   std::map<std::int64_t, db::RobotHandoverRecord> robot_handovers;
+  // The arm the build gave the suction tool for this board (its robot handovers' arm), or ""
+  // when it has none: the default roles (World's kDefaultSuctionArm).
+  std::string suction_arm;
   // By (arm, grasp kind, grasp id): the filter of that arm's roadmap.
   std::map<std::tuple<std::string, std::string, std::int64_t>, std::vector<bool>> filters;
   std::vector<db::RegraspNodeRecord> regrasp_nodes;

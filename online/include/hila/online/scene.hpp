@@ -37,7 +37,8 @@ struct Scene {
   // Detected initial poses (world) of the boards still to be handled; others stay nominal.
   std::map<std::string, core::Pose> detected;
   core::Pose tool = core::Pose::Identity();  // the suction tool's handle (world) when on the table
-  bool tool_in_hand = false;                 // the suction arm already holds it
+  bool tool_in_hand = false;                 // an arm already holds it: tool_arm
+  std::string tool_arm = "right";            // the arm holding it when tool_in_hand
   core::Pose assembly_frame = core::Pose::Identity();  // where the assembly stands (world)
   std::vector<FinishedBoard> finished;                 // in assembly order
   core::Pose human_stance = core::Pose::Identity();

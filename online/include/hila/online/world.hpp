@@ -16,10 +16,14 @@ namespace hila::online {
 // the scene has them (detected, else nominal), the board and the suction tool (both moving) and
 // the scene's extra obstacles (static). Const after construction: one
 // CollisionData per thread (make_data()).
+// The arm that holds the suction tool when the database gives a board no other (the build's
+// default roles: offline::HandoverSettings::suction_arm).
+inline constexpr const char* kDefaultSuctionArm = "right";
+
 class World {
  public:
   World(const core::Cell& cell, const core::ProductSpec& product, const Scene& scene,
-        const std::string& board, const std::string& suction_arm = "right");
+        const std::string& board, const std::string& suction_arm = kDefaultSuctionArm);
 
   const core::Cell& cell() const { return cell_; }
   const core::StageScene& stage() const { return stage_; }
