@@ -169,6 +169,8 @@ TEST(HumanModel, TheCellCheckIsCleanForFiveBodiesFromTheSmallWomanToATallMan) {
 // cell's human posture is what it always was); a woman's shoulders abduct by half a degree to a
 // degree, the same on both sides, and nothing else moves.
 TEST(HumanModel, NeutralPostureHangsAMansArmsAndHoldsAWomansOffTheHip) {
+  const auto reference = test::reference_cell();
+  EXPECT_EQ(reference->human_neutral(), reference->human().neutral_configuration());
   for (int cm = 145; cm <= 195; cm += 5) {
     const core::HumanBodySpec male{cm / 100.0, core::Sex::Male};
     const auto m = core::RobotModel::load_urdf_string(core::generate_human_urdf(male), "male");

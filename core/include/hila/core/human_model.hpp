@@ -59,9 +59,9 @@ inline constexpr double kHumanNeutralClearance = 0.003;
 // the body both shoulders abduct by the smallest multiple of 0.5 degrees, at most 10, that
 // clears it. The arm hangs straight from the shoulder at biacromial/2 from the midline, the hips
 // below are 0.19 H wide: a woman's shoulders (0.230 H) leave her hanging forearm (0.0203 H in
-// radius) 0.3 mm inside her hips, and people hold the arm off the hip (the elbow's carrying
-// angle does it in life; this model's elbow has none), here by 0.5 to 1 degree. A man's arm
-// (0.245 H) hangs clear (at least 4.2 mm from 1.45 m up) and stays at zero. A model without
+// radius) 0.0003 H (0.5 mm) inside her hips, and people hold the arm off the hip (the elbow's
+// carrying angle does it in life; this model's elbow has none), here by 0.5 to 1 degree. A man's
+// arm (0.245 H) hangs clear (at least 4.2 mm from 1.45 m up) and stays at zero. A model without
 // `left_shoulder_abduction` / `right_shoulder_abduction` joints gets the zero posture.
 Eigen::VectorXd human_neutral_configuration(const RobotModel& human);
 
