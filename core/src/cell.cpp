@@ -1,8 +1,10 @@
 #include "hila/core/cell.hpp"
 
+#include <algorithm>
 #include <set>
 
 #include "hila/core/error.hpp"
+#include "hila/core/human_model.hpp"
 #include "hila/core/yaml_reader.hpp"
 
 namespace hila::core {
@@ -312,6 +314,8 @@ std::shared_ptr<const Cell> Cell::load(const std::string& path) {
                      std::to_string(cell->human_.num_variables()) + " joint angles",
                      std::to_string(spec.human_neutral.size()));
   }
+  cell->human_neutral_ =
+      spec.human_neutral.size() ? spec.human_neutral : human_neutral_configuration(cell->human_);
   check_pose(spec.human_stance, path, "human.stance");
   for (const auto& o : spec.obstacles) check_pose(o.pose, path, "obstacles." + o.name + ".pose");
   return cell;
@@ -354,7 +358,7 @@ Eigen::VectorXd Cell::home_configuration(double jaw_opening) const {
 }
 
 Eigen::VectorXd Cell::human_neutral() const {
-  return spec_.human_neutral.size() ? spec_.human_neutral : human_.neutral_configuration();
+  return human_neutral_;
 }
 
 CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options) {
@@ -417,6 +421,17 @@ void check_human_stance(const Cell& cell) {
   set_robot_pose(data, human, poses, cell.spec().human_stance);
   CollisionPair pair;
   if (in_collision(model, data, &pair)) {
+    const auto is_human = [&](int body) {
+      return std::find(human.link_to_body.begin(), human.link_to_body.end(), body) !=
+             human.link_to_body.end();
+    };
+    if (is_human(pair.body_a) && is_human(pair.body_b)) {
+      // No stance helps: the posture (or the human model) is at fault.
+      throw InputError(cell.spec().file,
+                       cell.spec().human_neutral.size() ? "human.neutral_deg" : "human.urdf",
+                       "a neutral posture in which the human clears itself",
+                       "the human intersecting itself (" + describe_pair(model, pair) + ")");
+    }
     throw InputError(cell.spec().file, "human.stance",
                      "a stance where the human stands clear of the table, obstacles and robot",
                      "the human intersecting them (" + describe_pair(model, pair) + ")");

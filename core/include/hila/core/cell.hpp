@@ -108,7 +108,7 @@ struct CellSpec {
   Pose human_stance = Pose::Identity();
   std::vector<HumanArmSpec> human_arms;
   HumanHandSpec human_hand;
-  Eigen::VectorXd human_neutral;  // empty: zero clamped into limits
+  Eigen::VectorXd human_neutral;  // empty: human_neutral_configuration() of the human model
   double gravity = 9.81;
 };
 
@@ -145,6 +145,8 @@ class Cell {
   void set_arm(Eigen::VectorXd& robot_q, const Arm& arm, const Eigen::VectorXd& arm_q) const;
   Eigen::VectorXd arm_joints(const Eigen::VectorXd& robot_q, const Arm& arm) const;
   void set_jaw(Eigen::VectorXd& robot_q, const Arm& arm, double opening) const;
+  // The human's posture while the robot works: human.neutral_deg, or without it the model's
+  // relaxed standing posture (human_neutral_configuration).
   Eigen::VectorXd human_neutral() const;
 
  private:
@@ -154,6 +156,7 @@ class Cell {
   RobotModel tool_;
   std::vector<Arm> arms_;
   std::vector<HumanArm> human_arms_;
+  Eigen::VectorXd human_neutral_;
 };
 
 // The static cell as a collision scene: robot links, table and obstacles, the human at the
@@ -175,7 +178,8 @@ struct CellSceneOptions {
 CellScene build_cell_scene(const Cell& cell, const CellSceneOptions& options = {});
 
 // Throws InputError (field human.stance) when the human at the stance, in the neutral posture,
-// intersects an obstacle (the table) or the robot at home: a stance inside the table.
+// intersects an obstacle (the table) or the robot at home: a stance inside the table; (field
+// human.neutral_deg, or human.urdf without it) when that posture intersects the human itself.
 void check_human_stance(const Cell& cell);
 
 // Poses the robot's bodies only (the human unchanged): what a robot motion check needs.
