@@ -1,6 +1,7 @@
 #include "hila/viz/plan_export.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "cell_nodes.hpp"
 #include "hila/core/error.hpp"
@@ -63,8 +64,12 @@ class PlanPlayer {
   Eigen::VectorXd robot_q_;
 };
 
-// Scale keys that show a node from `begin` to `end` within [0, total]; false if never shown.
-bool visibility_keys(double begin, double end, double total, std::vector<float>& times,
+// To the plan's end and after (glTF holds the last key).
+constexpr double kForever = std::numeric_limits<double>::infinity();
+
+// Scale keys that show a node from `begin` to `end` (kForever: and after the plan's end); false
+// if never shown.
+bool visibility_keys(double begin, double end, std::vector<float>& times,
                      std::vector<float>& values) {
   const float b = std::max(0.0f, static_cast<float>(begin));
   const float e = static_cast<float>(end);
@@ -75,7 +80,7 @@ bool visibility_keys(double begin, double end, double total, std::vector<float>&
   };
   if (b > 0.0f) key(0.0f, 0.0f);
   key(b, 1.0f);
-  if (e < static_cast<float>(total)) key(e, 0.0f);
+  if (end < kForever) key(e, 0.0f);
   return true;
 }
 
@@ -103,7 +108,6 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
     builder.add_node("finished/" + part.name, -1, part.pose,
                      add_part_mesh(builder, "finished/" + part.name, *part.mesh, m.finished));
   }
-  const double total = plan.duration();
   auto tip_node = [&](const std::string& arm) {
     return nodes.robot_links[static_cast<std::size_t>(
         cell.robot().link_index(cell.arm(arm).spec.tip_link))];
@@ -191,13 +195,14 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
     }
     // Assembled at the board's end (an unsolved board by hand, at its start).
     phase_until(end);
-    phases.push_back({"finished/" + b.board, -1, start.assembly_frame * part.target, end, total});
+    phases.push_back(
+        {"finished/" + b.board, -1, start.assembly_frame * part.target, end, kForever});
     const int held_mesh = add_part_mesh(builder, "held/" + b.board, part.mesh, m.held);
     const int stack_mesh = add_part_mesh(builder, "stack/" + b.board, part.mesh, m.stacked);
     const int finished_mesh = add_part_mesh(builder, "finished/" + b.board, part.mesh, m.finished);
     for (const Phase& p : phases) {
       std::vector<float> times, values;
-      if (!visibility_keys(p.begin, p.end, total, times, values)) continue;
+      if (!visibility_keys(p.begin, p.end, times, values)) continue;
       const int mesh = p.name.rfind("stack/", 0) == 0      ? stack_mesh
                        : p.name.rfind("finished/", 0) == 0 ? finished_mesh
                                                            : held_mesh;
@@ -210,12 +215,10 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
     }
     offset = end;
   }
-  tool_phase_until(total);
+  tool_phase_until(kForever);
   for (const Phase& p : tool_phases) {
     std::vector<float> times, values;
-    // Without motion (no board solved) the tool stands where the plan found it.
-    const bool shown = visibility_keys(p.begin, p.end, total, times, values);
-    if (!shown && total > 0.0) continue;
+    if (!visibility_keys(p.begin, p.end, times, values)) continue;
     const int root = add_tool_nodes(builder, cell, p.parent, p.local, p.name, m.tool);
     builder.set_node_scale(root, p.begin <= 0.0 ? 1.0 : 0.0);
     if (times.size() > 1) {
