@@ -22,7 +22,7 @@ echo "== install $build_dir into $prefix"
 cmake --install "$build_dir" --prefix "$prefix" >"$work/install.log"
 
 # The installed headers are the public ones: none includes a private dependency's headers.
-if grep -rlE '#include <(fcl|ompl|CGAL|sqlite3|assimp|urdf|cholmod)' "$prefix/include"; then
+if grep -rlE '#include <(fcl|ompl|CGAL|sqlite3|assimp|urdf|cholmod|tiny_gltf)' "$prefix/include"; then
   echo "FAIL: installed headers above include a private dependency's headers" >&2
   exit 1
 fi

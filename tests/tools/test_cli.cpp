@@ -558,7 +558,7 @@ TEST(Cli, PlanOnAFullDiskLeavesNoTemporaryFile) {
 TEST(Cli, CommandLineErrorsExitTwoOnOneLine) {
   const std::string dir = test::temp_dir("cli_command_line");
   expect_one_line_error(run("frobnicate"), "expected a subcommand (cell, human, mesh, product, "
-                                           "build, inspect, report, plan), got 'frobnicate'");
+                                           "build, inspect, report, plan, export), got 'frobnicate'");
   expect_one_line_error(run(""), "A subcommand is required");
   expect_one_line_error(run("build"), "product is required (hila build --help");
   const std::string build = "build " + test::product_path() + kSmall + " -o " + dir + "/x.hila";

@@ -20,6 +20,7 @@ void add_build_command(CLI::App& app, Action& action);
 void add_inspect_command(CLI::App& app, Action& action);
 void add_report_command(CLI::App& app, Action& action);
 void add_plan_command(CLI::App& app, Action& action);
+void add_export_command(CLI::App& app, Action& action);
 
 std::string default_cell_path();
 // Runs the build's mesh checks (closed, manifold, no degenerate faces, ...) on every part of the

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   hila::tools::add_inspect_command(app, action);
   hila::tools::add_report_command(app, action);
   hila::tools::add_plan_command(app, action);
+  hila::tools::add_export_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,154 @@
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "hila/core/error.hpp"
+#include "hila/online/planner_model.hpp"
+#include "hila/online/scene.hpp"
+#include "hila/viz/cell_export.hpp"
+#include "hila/viz/plan_export.hpp"
+#include "hila/viz/plan_file.hpp"
+#include "io_checks.hpp"
+
+namespace hila::tools {
+
+namespace {
+
+struct ExportCellOptions {
+  std::string cell_file;
+  std::string product_file;         // empty: the cell only
+  std::vector<std::string> joints;  // "ARM=q1,q2,...": an arm's joints (rad); others at home
+  std::string output;
+};
+
+struct ExportPlanOptions {
+  std::string database;
+  std::string plan_file;
+  std::string scene;  // empty: the scene the plan file names
+  std::string output;
+};
+
+// "--joints ARM=q1,...,qn" into the robot's configuration `robot_q`.
+void set_joints(const core::Cell& cell, const std::string& text, Eigen::VectorXd& robot_q) {
+  const auto equals = text.find('=');
+  if (equals == std::string::npos) {
+    throw core::InputError("hila export cell", "--joints", "ARM=q1,q2,... (rad)", text);
+  }
+  const core::Arm& arm = cell.arm(text.substr(0, equals));
+  std::vector<double> values;
+  std::stringstream list(text.substr(equals + 1));
+  for (std::string item; std::getline(list, item, ',');) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(v)) {
+      throw core::InputError("hila export cell", "--joints", "finite numbers (rad)", item);
+    }
+    values.push_back(v);
+  }
+  const Eigen::VectorXd q =
+      Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  if (q.size() != arm.chain.dof() || !arm.chain.within_limits(q)) {
+    throw core::InputError(
+        "hila export cell", "--joints",
+        std::to_string(arm.chain.dof()) + " joints of arm " + arm.spec.name + " within its limits",
+        text);
+  }
+  cell.set_arm(robot_q, arm, q);
+}
+
+int run_export_cell(const ExportCellOptions& opt) {
+  std::vector<InputFile> inputs = cell_input_files(opt.cell_file);
+  if (!opt.product_file.empty()) {
+    const auto more = product_input_files(opt.product_file);
+    inputs.insert(inputs.end(), more.begin(), more.end());
+  }
+  check_output_path("-o", opt.output, inputs);
+  const auto cell = core::Cell::load(opt.cell_file);
+  core::ProductSpec product;
+  viz::CellView view;
+  if (!opt.product_file.empty()) {
+    product = core::load_product(opt.product_file);
+    view = viz::product_view(product);
+  }
+  view.robot_q = cell->home_configuration(cell->spec().gripper.jaw_max);
+  for (const std::string& j : opt.joints) set_joints(*cell, j, view.robot_q);
+  const std::string glb = viz::cell_glb(*cell, view);
+  write_file_atomically(opt.output, glb);
+  std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes)\n";
+  return 0;
+}
+
+int run_export_plan(const ExportPlanOptions& opt) {
+  std::vector<InputFile> inputs{{opt.database, "the database"}, {opt.plan_file, "the plan file"}};
+  check_output_path("-o", opt.output, inputs);
+  const viz::PlanFile plan = viz::read_plan_file(opt.plan_file);
+  const std::string scene_file = opt.scene.empty() ? plan.scene : opt.scene;
+  inputs.push_back({scene_file, "the scene file"});
+  const online::SceneFiles files = online::read_scene_files(scene_file);
+  for (auto&& more : {cell_input_files(files.cell), product_input_files(files.product)}) {
+    inputs.insert(inputs.end(), more.begin(), more.end());
+  }
+  check_output_path("-o", opt.output, inputs);
+  // The database checks that it was built from the scene's cell and product.
+  const auto model = online::PlannerModel::load(opt.database, files.cell, files.product);
+  const online::Scene scene = online::load_scene(scene_file, model->cell(), model->product());
+  if (plan.product != model->product().name) {
+    throw core::InputError(opt.plan_file, "product", "'" + model->product().name + "'",
+                           "'" + plan.product + "'");
+  }
+  viz::PlanStart start;
+  for (const viz::PlanFileBoard& b : plan.boards) {
+    start.initial[b.board] = scene.initial_pose(model->product().part(b.board));
+  }
+  for (const online::FinishedBoard& f : scene.finished) {
+    start.finished.push_back({f.name, &model->product().part(f.name).mesh, f.pose});
+  }
+  start.assembly_frame = scene.assembly_frame;
+  start.tool = scene.tool;
+  start.tool_in_hand = scene.tool_in_hand;
+  start.human_stance = scene.human_stance;
+  start.robot = scene.robot;
+  const std::string glb = viz::plan_glb(model->cell(), model->product(), start, plan);
+  write_file_atomically(opt.output, glb);
+  std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes, " << plan.boards.size()
+            << " board(s), " << plan.duration() << " s)\n";
+  return 0;
+}
+
+}  // namespace
+
+void add_export_command(CLI::App& app, Action& action) {
+  auto* cmd = app.add_subcommand("export", "write the cell or a plan as glTF 2.0 binary (.glb)");
+  cmd->require_subcommand(1);
+
+  auto cell_opt = std::make_shared<ExportCellOptions>();
+  cell_opt->cell_file = default_cell_path();
+  auto* cell = cmd->add_subcommand(
+      "cell", "the cell: robot, tool, table and human; with --product the parts");
+  cell->add_option("--cell", cell_opt->cell_file, "cell YAML file")->capture_default_str();
+  cell->add_option("--product", cell_opt->product_file,
+                   "product YAML file: the tool where it puts it, the parts at their targets and "
+                   "their initial poses");
+  cell->add_option("--joints", cell_opt->joints,
+                   "ARM=q1,q2,... an arm's joints (rad; repeatable); other arms at home");
+  cell->add_option("-o,--output", cell_opt->output, "the .glb to write")->required();
+  cell->callback(
+      [cell_opt, &action] { action = [cell_opt] { return run_export_cell(*cell_opt); }; });
+
+  auto plan_opt = std::make_shared<ExportPlanOptions>();
+  auto* plan = cmd->add_subcommand("plan", "a plan (hila plan -o) animated along its time stamps");
+  plan->add_option("--db", plan_opt->database, "the product database the plan was made with")
+      ->required();
+  plan->add_option("--plan", plan_opt->plan_file, "the plan file (hila plan -o)")->required();
+  plan->add_option("--scene", plan_opt->scene, "the scene file (default: the one the plan names)");
+  plan->add_option("-o,--output", plan_opt->output, "the .glb to write")->required();
+  plan->callback(
+      [plan_opt, &action] { action = [plan_opt] { return run_export_plan(*plan_opt); }; });
+}
+
+}  // namespace hila::tools
