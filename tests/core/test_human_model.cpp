@@ -90,7 +90,11 @@ namespace {
 // The reference cell (meshes/cell/cell.yaml) with `spec`'s human in place of the default one, as
 // a user gets it by `hila human --stature H --sex S -o human.urdf` in the cell's directory.
 std::shared_ptr<const core::Cell> cell_with_human(const core::HumanBodySpec& spec) {
-  const std::string dir = test::temp_dir("human_model_cell");
+  // One directory per test and body: ctest runs the tests of this file in parallel processes.
+  const std::string dir = test::temp_dir(
+      std::string("human_model_cell_") +
+      ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
+      core::format_number(spec.stature) + (spec.sex == core::Sex::Male ? "_male" : "_female"));
   const std::string cell_file = test::cell_variant(dir, "urdf: human.urdf", "urdf: human.urdf");
   test::write_file(dir, "human.urdf", core::generate_human_urdf(spec));
   return core::Cell::load(cell_file);
