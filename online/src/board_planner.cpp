@@ -53,7 +53,8 @@ BoardPlanner::BoardPlanner(const PlannerModel& model, const BoardPlanSettings& s
 BoardPlanner::~BoardPlanner() = default;
 
 BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
-                             std::chrono::steady_clock::time_point deadline) {
+                             std::chrono::steady_clock::time_point deadline,
+                             const BoardPlanOptions& options) {
   using detail::ArmsState;
   using detail::Run;
   const auto started = std::chrono::steady_clock::now();
@@ -86,8 +87,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
   // The tool stays in the hand that used it last; the board's suction arm must be that one.
-  const std::string suction_arm =
-      records->suction_arm.empty() ? kDefaultSuctionArm : records->suction_arm;
+  const std::string suction_arm = model_.suction_arm(board);
   result.suction_arm = suction_arm;
   if (scene.tool_in_hand && scene.tool_arm != suction_arm) {
     return finish(BoardPlanStatus::kNoGoal,
@@ -359,7 +359,26 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
     }
     return false;
   };
-  if (try_goals("")) return finish(BoardPlanStatus::kSolved, "");
+  // A solved board, with the tool put back when asked.
+  auto solved = [&] {
+    if (options.return_tool && result.tool_in_hand_after) {
+      ArmsState end;
+      end.robot_q = result.robot_q_after;
+      end.tool_in_hand = true;
+      const std::size_t before = result.steps.size();
+      result.tool_kept = run.return_tool(result.human_handover, result.steps, end);
+      if (result.tool_kept.empty()) {
+        for (std::size_t i = before; i < result.steps.size(); ++i) {
+          result.path_length += result.steps[i].path_length;
+        }
+        result.duration = result.steps.back().time.back();
+        result.robot_q_after = end.robot_q;
+        result.tool_in_hand_after = false;
+      }
+    }
+    return finish(BoardPlanStatus::kSolved, "");
+  };
+  if (try_goals("")) return solved();
   // Every goal failed within the cheap budgets and time is left: once more with bridges as
   // large as the baselines' from-scratch budget, where the roadmap is cut.
   if (settings_.motion.planner == MotionPlannerKind::kRoadmap &&
@@ -369,7 +388,7 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                  settings_.motion.escalated_repair_checks);
     if (try_goals("(larger bridges) ")) {
       result.larger_bridges = true;
-      return finish(BoardPlanStatus::kSolved, "");
+      return solved();
     }
   }
   if (!goals.empty() && std::all_of(goals.begin(), goals.end(), [&](const auto* goal) {

@@ -67,15 +67,17 @@ const Stage& Run::tool_down() {
   Stage& st = *tool_down_;
   st.end = start_;
   if (!st.end.tool_in_hand) return st;
-  auto fail = [&](std::string why) -> const Stage& {
-    st.failure = "tool_place: " + std::move(why);
-    return st;
-  };
+  put_tool_down(st, board_initial_);
+  return st;
+}
+
+void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
+  auto fail = [&](std::string why) { st.failure = "tool_place: " + std::move(why); };
   const core::Pose tcp = scene_.tool * cell_.spec().suction.handle_in_tcp.inverse();
   const core::Pose pre = shifted(tcp, -settings_.approach * (tcp.linear() * approach_tcp_));
   const core::Pose raised = shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift));
   MotionRequest r;
-  r.board_world = board_initial_;
+  r.board_world = board_world;
   // At the place the tool stands on the table in the open hand (as the tool pick sees it).
   Stage standing = st;
   standing.end.tool_in_hand = false;
@@ -95,7 +97,7 @@ const Stage& Run::tool_down() {
   to.goal = above.front();
   if (auto e = step(st, suction_planner_, suction_, to, "tool_to_place", "", ""); !e.empty()) {
     st.failure = e;
-    return st;
+    return;
   }
   MotionRequest down = r;
   down.start = above.front();
@@ -104,7 +106,7 @@ const Stage& Run::tool_down() {
   if (auto e = step(st, suction_planner_, suction_, down, "tool_lower", "", "tool_released");
       !e.empty()) {
     st.failure = e;
-    return st;
+    return;
   }
   st.end.tool_in_hand = false;
   cell_.set_jaw(st.end.robot_q, suction_, cell_.spec().gripper.jaw_max);
@@ -113,9 +115,39 @@ const Stage& Run::tool_down() {
   back.goal = before.front();
   if (auto e = step(st, suction_planner_, suction_, back, "tool_retreat", "", ""); !e.empty()) {
     st.failure = e;
-    return st;
   }
-  return st;
+}
+
+std::string Run::return_tool(const core::Pose& board_world, std::vector<PlanStep>& steps,
+                             ArmsState& end) {
+  if (!end.tool_in_hand) return "";
+  const Stage* stages[1] = {};
+  plan_settled(stages, 0, [&] {
+    if (tool_return_ && queue_) abandon(*tool_return_);  // re-planned after a late rejection
+    Stage& st = tool_return_.emplace();
+    st.end = end;
+    put_tool_down(st, board_world);
+    if (st.ok()) {
+      MotionRequest home;
+      home.board_world = board_world;
+      home.start = arm_q(st, suction_);
+      home.goal = suction_.spec.home;
+      if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home_empty", "", "");
+          !e.empty()) {
+        st.failure = e;
+      }
+    }
+    stages[0] = &st;
+  });
+  const Stage& st = *tool_return_;
+  if (!st.ok()) return st.failure;
+  const double clock = steps.empty() ? 0.0 : steps.back().time.back();
+  for (PlanStep s : st.steps) {
+    for (double& t : s.time) t += clock;
+    steps.push_back(std::move(s));
+  }
+  end = st.end;
+  return "";
 }
 
 const Stage& Run::gripper_pick(const core::Arm& arm, const db::RobotGraspRecord& grasp,

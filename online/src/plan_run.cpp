@@ -134,6 +134,7 @@ void Run::stop_validation() {
   if (!queue_) return;
   if (tool_) abandon(*tool_);
   if (tool_down_) abandon(*tool_down_);
+  if (tool_return_) abandon(*tool_return_);
   each_memo([&](auto& stages) {
     for (auto& entry : stages) abandon(entry.second);
   });
@@ -403,6 +404,7 @@ bool Run::settle(std::span<const Stage* const> chain) {
   };
   if (tool_) drop_failed(*tool_);
   if (tool_down_) drop_failed(*tool_down_);
+  if (tool_return_) drop_failed(*tool_return_);
   each_memo([&](auto& stages) {
     for (auto& entry : stages) drop_failed(entry.second);
   });
@@ -417,6 +419,7 @@ bool Run::settle(std::span<const Stage* const> chain) {
   };
   if (tool_) add(*tool_);
   if (tool_down_) add(*tool_down_);
+  if (tool_return_) add(*tool_return_);
   each_memo([&](auto& stages) {
     for (auto& entry : stages) add(entry.second);
   });

@@ -160,6 +160,14 @@ class Run {
   // database's for a robot-robot pose not planned).
   std::int64_t suction_grasp_of(const db::RobotHandoverRecord& rr) const;
 
+  // After a planned way that ends with the suction arm holding the tool (`end`): the tool put
+  // back where the scene has its place and the arm home (steps tool_to_place, tool_lower,
+  // tool_retreat, tool_to_home_empty), appended to `steps` with their times after the last, and
+  // `end` updated; the board stands at `board_world` (the human has it). "" or the failure
+  // (steps and end then unchanged). Settled before it returns.
+  std::string return_tool(const core::Pose& board_world, std::vector<PlanStep>& steps,
+                          ArmsState& end);
+
   // The whole chain for one goal and shared grasp: the memoised stages in order.
   std::string chain(const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared,
                     std::vector<PlanStep>& steps, ArmsState& end);
@@ -210,6 +218,7 @@ class Run {
   void forget(Which which) {
     if (tool_ && which(*tool_)) tool_.reset();
     if (tool_down_ && which(*tool_down_)) tool_down_.reset();
+    if (tool_return_ && which(*tool_return_)) tool_return_.reset();
     each_memo([&](auto& stages) {
       std::erase_if(stages, [&](const auto& entry) { return which(entry.second); });
     });
@@ -428,6 +437,9 @@ class Run {
   // the last sample touches by design), the gripper opens (`tool_released`), back along the
   // gripper's approach axis. Once per call, from the start.
   const Stage& tool_down();
+  // The same from st.end (the suction arm holding the tool), the board standing at
+  // `board_world`: fills st's steps and end, or its failure.
+  void put_tool_down(Stage& st, const core::Pose& board_world);
 
   // The gripper's pick at the detected pose: the open gripper from a pre-grasp (approach) to the
   // grasp, closed, and the lift straight up. A branch whose way in, grasp and lift are valid;
@@ -518,6 +530,7 @@ class Run {
   PlanTimes times_;
   std::optional<Stage> tool_;
   std::optional<Stage> tool_down_;
+  std::optional<Stage> tool_return_;  // return_tool's, once a way is planned
   std::map<std::int64_t, Stage> picks_;                              // by suction grasp
   std::map<std::int64_t, Stage> transfers_;                          // by robot handover
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> receives_;  // by (handover, grasp)

@@ -2,6 +2,7 @@
 
 #include "hila/core/error.hpp"
 #include "hila/db/provenance.hpp"
+#include "hila/online/world.hpp"
 
 namespace hila::online {
 
@@ -91,6 +92,12 @@ const WorkerComfort* PlannerModel::worker_comfort(std::string* error) const noex
 const BoardRecords* PlannerModel::board_records(const std::string& board) const {
   const auto it = boards_.find(board);
   return it == boards_.end() ? nullptr : it->second.get();
+}
+
+std::string PlannerModel::suction_arm(const std::string& board) const {
+  const BoardRecords* records = board_records(board);
+  return records == nullptr || records->suction_arm.empty() ? kDefaultSuctionArm
+                                                            : records->suction_arm;
 }
 
 const ArmRoadmap& PlannerModel::roadmap(const std::string& arm) const {

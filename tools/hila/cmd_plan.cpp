@@ -162,10 +162,15 @@ int run_plan(const PlanOptions& opt) {
     std::cout
         << "  board           theta_c   Q      goals  plan ms   path rad  motion s  validated\n";
   }
-  for (const auto& board : boards) {
+  for (std::size_t k = 0; k < boards.size(); ++k) {
+    const std::string& board = boards[k];
     const auto deadline = std::chrono::steady_clock::now() +
                           std::chrono::microseconds(static_cast<long>(opt.deadline_s * 1e6));
-    const online::BoardPlan plan = planner.plan(scene, board, deadline);
+    // The tool goes back on its stand when the next board is the other arm's to pick by suction.
+    online::BoardPlanOptions options;
+    options.return_tool =
+        k + 1 < boards.size() && model->suction_arm(boards[k + 1]) != model->suction_arm(board);
+    const online::BoardPlan plan = planner.plan(scene, board, deadline, options);
     out["boards"].push_back(plan_json(plan));
     if (!opt.json) {
       std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;

@@ -164,6 +164,7 @@ struct BoardPlan {
   Eigen::VectorXd robot_q_after;    // the robot when the board has been taken
   bool tool_in_hand_after = false;  // an arm still holds the tool then: suction_arm
   std::string suction_arm;          // the arm that holds the tool in this plan
+  std::string tool_kept;            // why the tool was not put back (BoardPlanOptions::return_tool)
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };
 
@@ -177,6 +178,14 @@ struct BoardPlan {
 // for the scene; every step timed and re-checked by the validator: nothing invalid is returned.
 // Failing pieces shared by several goals (a cup's pick, a transfer to a robot-robot pose, a
 // gripper's pick) are planned once per call. One per thread.
+// What one query asks beyond the scene and the board.
+struct BoardPlanOptions {
+  // Put the suction tool back where the scene has its place once the board is delivered, and
+  // take that arm home (the next board is the other arm's to pick by suction). Where it cannot
+  // be put back, the plan stands and keeps the tool in hand (BoardPlan::tool_kept says why).
+  bool return_tool = false;
+};
+
 class BoardPlanner {
  public:
   explicit BoardPlanner(const PlannerModel& model, const BoardPlanSettings& settings = {});
@@ -185,7 +194,8 @@ class BoardPlanner {
   BoardPlanner& operator=(const BoardPlanner&) = delete;
 
   BoardPlan plan(const Scene& scene, const std::string& board,
-                 std::chrono::steady_clock::time_point deadline);
+                 std::chrono::steady_clock::time_point deadline,
+                 const BoardPlanOptions& options = {});
 
  private:
   const PlannerModel& model_;

@@ -66,6 +66,8 @@ class PlannerModel {
   void load_worker_comfort() const;
   // The board's records; nullptr when the database has no such board.
   const BoardRecords* board_records(const std::string& board) const;
+  // The arm that picks `board` by suction (BoardRecords::suction_arm, else kDefaultSuctionArm).
+  std::string suction_arm(const std::string& board) const;
 
  private:
   PlannerModel(std::shared_ptr<const core::Cell> cell, core::ProductSpec product,
