@@ -308,7 +308,8 @@ void swap_roles(const core::Cell& cell, const core::ProductSpec& product, std::s
   std::swap(swapped.suction_arm, swapped.receiving_arm);
   HandoverResult other = plan_handover_goals(cell, product, i, grasps, comfort, swapped);
   if (other.stage.goals == 0) return;
-  if (!reaches_tool_stand(cell, product, i, swapped.suction_arm)) {
+  if (!reaches_tool_stand(cell, product, i, swapped.suction_arm, handover.exchange_approach,
+                          handover.pick_lift)) {
     const Eigen::Vector3d at = product.suction_tool_pose.translation();
     r.handover.stage.failure +=
         "; with the " + swapped.suction_arm + " arm picking by suction it would have " +

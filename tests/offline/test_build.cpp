@@ -205,7 +205,7 @@ TEST(Build, APartOnlyTheLeftArmReachesIsPickedByItsSuctionWhenItReachesTheTool) 
   std::string text = test::read_file(moved);
   const std::string rack = "suction_tool_pose: {xyz: [0.30, -0.72, 1.229]";
   ASSERT_NE(text.find(rack), std::string::npos);
-  text.replace(text.find(rack), rack.size(), "suction_tool_pose: {xyz: [0.10, 0.0, 1.229]");
+  text.replace(text.find(rack), rack.size(), "suction_tool_pose: {xyz: [0.25, 0.05, 1.229]");
   const std::string product = test::write_file(dir, "product.yaml", text);
   const std::string out = dir + "/both.hila";
   const offline::BuildSummary summary =

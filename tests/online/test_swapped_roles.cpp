@@ -1,0 +1,130 @@
+// Roles per board: the cabinet's back_upper laid on the left of the table, where only the left arm
+// picks it by suction, with the tool standing where both arms reach it. The build gives that
+// board to the left arm's suction (offline::HandoverSettings::swap_roles); the board before it
+// is the right arm's, which puts the tool back on its stand (BoardPlanOptions::return_tool) so
+// that the left arm can take it; the right arm receives back_upper and delivers it.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "hila/db/database.hpp"
+#include "hila/offline/build.hpp"
+#include "hila/online/board_planner.hpp"
+#include "util/quick_build.hpp"
+#include "util/test_util.hpp"
+
+using namespace hila;
+
+namespace {
+
+std::chrono::steady_clock::time_point in_seconds(double s) {
+  return std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(s * 1e6));
+}
+
+void replace_once(std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+}
+
+// The cabinet with back_upper on the left (mirrored from the stack) and the tool between the
+// arms (beside the stack, where both reach its handle, lift it and set it down).
+std::string product_with_a_board_on_the_left(const std::string& dir) {
+  std::string text = test::read_file(test::product_path());
+  for (const char* mesh : {"shelf.stl", "lateral.stl", "back_panel.stl"}) {
+    const std::string rel = std::string("mesh: ") + mesh;
+    for (auto at = text.find(rel); at != std::string::npos; at = text.find(rel, at + 1)) {
+      text.replace(at, rel.size(), "mesh: " + test::data_path(std::string("cabinet/") + mesh));
+    }
+  }
+  replace_once(text, "initial: {xyz: [0.30, -0.30, 1.0965]", "initial: {xyz: [0.30, 0.30, 1.0965]");
+  replace_once(text, "suction_tool_pose: {xyz: [0.30, -0.72, 1.229]",
+               "suction_tool_pose: {xyz: [0.25, 0.05, 1.229]");
+  return test::write_file(dir, "product.yaml", text);
+}
+
+// The steps chain (each arm's from where it last stopped) and are valid; the events in order as
+// "arm:event".
+std::string events_of(const online::BoardPlan& plan, Eigen::VectorXd& robot_q,
+                      const core::Cell& cell) {
+  std::string events;
+  for (const auto& step : plan.steps) {
+    const core::Arm& arm = cell.arm(step.arm);
+    EXPECT_TRUE(step.q.front().isApprox(cell.arm_joints(robot_q, arm), 1e-9)) << step.name;
+    cell.set_arm(robot_q, arm, step.q.back());
+    EXPECT_TRUE(step.validation.valid()) << step.name;
+    if (!step.event.empty()) events += step.arm + ":" + step.event + " ";
+  }
+  return events;
+}
+
+}  // namespace
+
+TEST(SwappedRoles, ABoardOnlyTheLeftArmPicksBySuctionIsDeliveredByTheRightArm) {
+  const std::string dir = test::temp_dir("swapped_roles");
+  const std::string product = product_with_a_board_on_the_left(dir);
+  offline::BuildSettings settings = test::quick_build_settings(7, 2);
+  // The left side has few comfortable candidates among the quick build's 60.
+  settings.handover.candidates = 500;
+  settings.handover.max_candidates = 500;
+  const std::string db_path = dir + "/cabinet.hila";
+  offline::build_database(product, test::cell_path(), db_path, settings);
+  const auto model = online::PlannerModel::load(db_path, test::cell_path(), product);
+  ASSERT_EQ(model->suction_arm("back_upper"), "left")
+      << model->database().handover_stage(model->board_records("back_upper")->part.id)->failure;
+  ASSERT_EQ(model->suction_arm("top"), "right");
+
+  // The boards before top are assembled; the right arm holds the tool, as after them.
+  online::Scene scene = online::nominal_scene(model->cell(), model->product());
+  for (const auto& part : model->product().parts) {
+    if (part.name == "top") break;
+    scene = scene.with_finished(model->product(), part.name);
+  }
+  scene.tool_in_hand = true;
+  scene.tool_arm = "right";
+  online::BoardPlanner planner(*model);
+
+  // back_upper now: the tool is in the wrong hand, and the status says so.
+  {
+    const online::Scene early = scene.with_finished(model->product(), "top");
+    const online::BoardPlan refused = planner.plan(early, "back_upper", in_seconds(30));
+    EXPECT_EQ(refused.status, online::BoardPlanStatus::kNoGoal);
+    EXPECT_NE(refused.reason.find("the suction tool is in the right arm's hand"), std::string::npos)
+        << refused.reason;
+  }
+
+  // top, the tool put back at the end.
+  online::BoardPlanOptions options;
+  options.return_tool = true;
+  const online::BoardPlan top = planner.plan(scene, "top", in_seconds(60), options);
+  ASSERT_TRUE(top.solved()) << top.reason;
+  EXPECT_TRUE(top.validated);
+  EXPECT_TRUE(top.tool_kept.empty()) << top.tool_kept;
+  EXPECT_FALSE(top.tool_in_hand_after);
+  EXPECT_EQ(top.suction_arm, "right");
+  Eigen::VectorXd robot_q = model->cell().home_configuration();
+  const std::string top_events = events_of(top, robot_q, model->cell());
+  EXPECT_EQ(top_events.substr(top_events.size() - std::string("right:tool_released ").size()),
+            "right:tool_released ")
+      << top_events;
+  EXPECT_EQ(top.steps.back().name, "tool_to_home_empty");
+  EXPECT_TRUE(robot_q.isApprox(model->cell().home_configuration(), 1e-9));
+  EXPECT_NEAR(top.duration, top.steps.back().time.back(), 1e-12);
+
+  // back_upper: the left arm takes the tool from its stand and picks, the right arm delivers.
+  scene = scene.with_finished(model->product(), "top");
+  scene.tool_in_hand = top.tool_in_hand_after;
+  scene.tool_arm = top.suction_arm;
+  const online::BoardPlan plan = planner.plan(scene, "back_upper", in_seconds(60));
+  ASSERT_TRUE(plan.solved()) << plan.reason;
+  EXPECT_TRUE(plan.validated);
+  EXPECT_EQ(plan.mode, online::DeliveryMode::kExchange);
+  EXPECT_EQ(plan.picking_arm, "left");
+  EXPECT_EQ(plan.delivering_arm, "right");
+  EXPECT_EQ(plan.suction_arm, "left");
+  robot_q = model->cell().home_configuration();
+  const std::string events = events_of(plan, robot_q, model->cell());
+  EXPECT_EQ(events.rfind("left:tool_grasped left:suction_on ", 0), 0u) << events;
+  EXPECT_NE(events.find("right:gripper_close left:suction_off "), std::string::npos) << events;
+  EXPECT_NE(events.find("right:wait_for_human right:gripper_open"), std::string::npos) << events;
+}
