@@ -1,6 +1,7 @@
 #include "cmd_report_html.hpp"
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -107,7 +108,7 @@ int run_report_html(const ReportHtmlOptions& opt) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::cout << "wrote " << opt.output << " (" << page.size() << " bytes, " << input.scenes.size()
             << " scene(s), " << seconds << " s); open it in a browser: file://"
-            << (opt.output.front() == '/' ? "" : "$PWD/") << opt.output << "\n";
+            << std::filesystem::absolute(opt.output).string() << "\n";
   return 0;
 }
 
