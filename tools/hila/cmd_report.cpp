@@ -189,6 +189,10 @@ void add_report_command(CLI::App& app, Action& action) {
   report->add_flag("--json", opt->json, "print JSON (ergonomics)");
   report->add_option("--plan", opt->html.plan_file, "html: a plan file (hila plan -o) to animate");
   report->add_option("--scene", opt->html.scene, "html: the plan's scene (default: the plan's)");
+  report->add_option("--cell", opt->html.cell_file,
+                     "html without --plan: the database's cell YAML (default: the bundled)");
+  report->add_option("--product", opt->html.product_file,
+                     "html without --plan: the database's product YAML (default: the cabinet)");
   report->add_option("-o,--output", opt->html.output, "html: the page to write");
   report->add_option("--three-js", opt->html.three_dir, "html: three.js folder (libjs-three)")
       ->capture_default_str();

@@ -6,8 +6,10 @@
 #include <iostream>
 #include <sstream>
 
+#include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
+#include "hila/online/planner_model.hpp"
 #include "hila/viz/cell_export.hpp"
 #include "hila/viz/report_html.hpp"
 #include "io_checks.hpp"
@@ -81,13 +83,20 @@ int run_report_html(const ReportHtmlOptions& opt) {
     check_output_path("-o", opt.output, inputs);
   }
   const db::Database database = db::Database::open(opt.database);
-  // The cell and product the plan's scene names, else the files the database was built from.
-  const std::string cell_file = plan ? plan->files.cell : database.meta().cell_file;
-  const std::string product_file = plan ? plan->files.product : database.meta().product_file;
+  // The cell and product the plan's scene names, else the ones given (default: the bundled).
+  const std::string cell_file =
+      plan ? plan->files.cell : (opt.cell_file.empty() ? default_cell_path() : opt.cell_file);
+  const std::string product_file =
+      plan ? plan->files.product
+           : (opt.product_file.empty() ? default_product_path() : opt.product_file);
   for (auto&& more : {cell_input_files(cell_file), product_input_files(product_file)}) {
     inputs.insert(inputs.end(), more.begin(), more.end());
   }
   check_output_path("-o", opt.output, inputs);
+
+  // Checks that the database was built from these files (the plan's scene's are checked when
+  // the plan is exported).
+  if (!plan) online::PlannerModel::load(opt.database, cell_file, product_file);
 
   viz::ReportInput input;
   input.product = database.meta().product_name;

@@ -9,8 +9,10 @@ inline constexpr const char* kDefaultThreeJsDir = "/usr/share/javascript/three";
 
 struct ReportHtmlOptions {
   std::string database;
-  std::string plan_file;  // empty: the cell and the charts only
-  std::string scene;      // empty: the scene the plan names
+  std::string plan_file;     // empty: the cell and the charts only
+  std::string scene;         // empty: the scene the plan names
+  std::string cell_file;     // without a plan: the database's cell (empty: the bundled one)
+  std::string product_file;  // without a plan: the database's product (empty: the bundled one)
   std::string output;
   std::string three_dir = kDefaultThreeJsDir;
 };
