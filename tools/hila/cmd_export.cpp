@@ -3,12 +3,9 @@
 
 #include "commands.hpp"
 #include "hila/core/error.hpp"
-#include "hila/online/planner_model.hpp"
-#include "hila/online/scene.hpp"
 #include "hila/viz/cell_export.hpp"
-#include "hila/viz/plan_export.hpp"
-#include "hila/viz/plan_file.hpp"
 #include "io_checks.hpp"
+#include "scene_exports.hpp"
 
 namespace hila::tools {
 
@@ -84,39 +81,14 @@ int run_export_cell(const ExportCellOptions& opt) {
 }
 
 int run_export_plan(const ExportPlanOptions& opt) {
-  std::vector<InputFile> inputs{{opt.database, "the database"}, {opt.plan_file, "the plan file"}};
-  check_output_path("-o", opt.output, inputs);
-  const viz::PlanFile plan = viz::read_plan_file(opt.plan_file);
-  const std::string scene_file = opt.scene.empty() ? plan.scene : opt.scene;
-  inputs.push_back({scene_file, "the scene file"});
-  const online::SceneFiles files = online::read_scene_files(scene_file);
-  for (auto&& more : {cell_input_files(files.cell), product_input_files(files.product)}) {
-    inputs.insert(inputs.end(), more.begin(), more.end());
-  }
-  check_output_path("-o", opt.output, inputs);
-  // The database checks that it was built from the scene's cell and product.
-  const auto model = online::PlannerModel::load(opt.database, files.cell, files.product);
-  const online::Scene scene = online::load_scene(scene_file, model->cell(), model->product());
-  if (plan.product != model->product().name) {
-    throw core::InputError(opt.plan_file, "product", "'" + model->product().name + "'",
-                           "'" + plan.product + "'");
-  }
-  viz::PlanStart start;
-  for (const viz::PlanFileBoard& b : plan.boards) {
-    start.initial[b.board] = scene.initial_pose(model->product().part(b.board));
-  }
-  for (const online::FinishedBoard& f : scene.finished) {
-    start.finished.push_back({f.name, &model->product().part(f.name).mesh, f.pose});
-  }
-  start.assembly_frame = scene.assembly_frame;
-  start.tool = scene.tool;
-  start.tool_in_hand = scene.tool_in_hand;
-  start.human_stance = scene.human_stance;
-  start.robot = scene.robot;
-  const std::string glb = viz::plan_glb(model->cell(), model->product(), start, plan);
+  check_output_path("-o", opt.output,
+                    {{opt.database, "the database"}, {opt.plan_file, "the plan file"}});
+  const PlanScene plan = read_plan_scene(opt.database, opt.plan_file, opt.scene);
+  check_output_path("-o", opt.output, plan.inputs);
+  const std::string glb = plan_scene_glb(plan);
   write_file_atomically(opt.output, glb);
-  std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes, " << plan.boards.size()
-            << " board(s), " << plan.duration() << " s)\n";
+  std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes, " << plan.plan.boards.size()
+            << " board(s), " << plan.plan.duration() << " s)\n";
   return 0;
 }
 

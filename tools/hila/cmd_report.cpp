@@ -4,6 +4,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "cmd_report_html.hpp"
 #include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
@@ -20,6 +21,7 @@ struct ReportOptions {
   std::string what = "ergonomics";
   std::string database;
   bool json = false;
+  ReportHtmlOptions html;  // `report html`
 };
 
 struct Totals {
@@ -126,9 +128,16 @@ std::string cell_text(const nlohmann::json& m) {
   return s.str();
 }
 
-int run_report(const ReportOptions& opt) {
+int run_report(ReportOptions opt) {
+  if (opt.what == "html") {
+    if (opt.html.output.empty()) {
+      throw core::InputError("command line", "report html", "-o report.html", "none");
+    }
+    opt.html.database = opt.database;
+    return run_report_html(opt.html);
+  }
   if (opt.what != "ergonomics") {
-    throw core::InputError("command line", "report", "ergonomics", "'" + opt.what + "'");
+    throw core::InputError("command line", "report", "ergonomics or html", "'" + opt.what + "'");
   }
   const db::Database database = db::Database::open(opt.database);
   const auto j = ergonomics_json(database);
@@ -172,9 +181,21 @@ int run_report(const ReportOptions& opt) {
 void add_report_command(CLI::App& app, Action& action) {
   auto opt = std::make_shared<ReportOptions>();
   auto* report = app.add_subcommand("report", "Reports computed from a product database");
-  report->add_option("what", opt->what, "ergonomics")->required();
+  report
+      ->add_option("what", opt->what,
+                   "ergonomics (a table), or html (a page with a 3D viewer and charts, -o)")
+      ->required();
   report->add_option("database", opt->database, "database file")->required();
-  report->add_flag("--json", opt->json, "print JSON");
+  report->add_flag("--json", opt->json, "print JSON (ergonomics)");
+  report->add_option("--plan", opt->html.plan_file, "html: a plan file (hila plan -o) to animate");
+  report->add_option("--scene", opt->html.scene, "html: the plan's scene (default: the plan's)");
+  report->add_option("--cell", opt->html.cell_file,
+                     "html without --plan: the database's cell YAML (default: the bundled)");
+  report->add_option("--product", opt->html.product_file,
+                     "html without --plan: the database's product YAML (default: the cabinet)");
+  report->add_option("-o,--output", opt->html.output, "html: the page to write");
+  report->add_option("--three-js", opt->html.three_dir, "html: three.js folder (libjs-three)")
+      ->capture_default_str();
   report->callback([opt, &action] { action = [opt] { return run_report(*opt); }; });
 }
 

@@ -1,0 +1,66 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hila/viz/plan_file.hpp"
+
+namespace hila::viz {
+
+// What the report shows of one part of a product database.
+struct ReportPart {
+  std::string name;
+  int order = 0;                     // assembly order
+  std::vector<double> theta_c_deg;   // relaxation limit θc of every robot grasp, deg
+  bool has_stage = false;            // the database holds the part's handover stage
+  int candidates = 0;                // Eq. 1 candidates
+  int comfortable = 0;               // |S|
+  int goals = 0;                     // |𝕊|
+  std::vector<double> goal_quality;  // Q of the goals by rank (first: the best by Eq. 8)
+  std::string failure;               // why the part has no goal ("" when it has one)
+};
+
+// The report's 3D scenes: glTF 2.0 binaries (.glb) as hila::viz writes them.
+struct ReportScene {
+  std::string title;  // shown in the viewer's scene menu
+  std::string glb;
+};
+
+// three.js as plain (non-module) scripts: three.min.js, then GLTFLoader.js and OrbitControls.js
+// from its examples/js, which extend the global THREE.
+struct ThreeJs {
+  std::string three;
+  std::string gltf_loader;
+  std::string orbit_controls;
+};
+
+struct ReportInput {
+  std::string product;
+  std::string database;  // as given on the command line
+  std::vector<ReportPart> parts;
+  std::vector<ReportScene> scenes;  // the viewer opens the last; a scene's animation plays
+  const PlanFile* plan = nullptr;   // the timeline chart's plan; nullptr: none
+  ThreeJs three;
+};
+
+// The report as one self-contained HTML page (no network, no server: the scripts and the .glb
+// files are inlined, the .glb as base64). The viewer reads the URL's hash: "#t=SECONDS" shows
+// the animation paused at that time (for screenshots); "#scene=N" opens scene N (0-based). The
+// page sets <body data-status> to "ready" once the scene is drawn, or "error" with the message in
+// #errors (also for errors the page's scripts log with console.error), and data-canvas-filled to
+// the fraction of sampled canvas pixels that differ from the background.
+std::string report_html(const ReportInput& input);
+
+// The report's charts as inline SVG elements (width in CSS pixels, scaled to the page):
+// θc of every grasp per part (dots), the candidates, |S| and |𝕊| per part (bars), the goals' Q
+// per part (dots by rank), and the plan's steps per arm against time (bars, boards one after the
+// other as the plan plays them).
+std::string theta_c_svg(const std::vector<ReportPart>& parts);
+std::string stages_svg(const std::vector<ReportPart>& parts);
+std::string goal_quality_svg(const std::vector<ReportPart>& parts);
+std::string timeline_svg(const PlanFile& plan);
+
+// Base64 (RFC 4648, with padding) of `bytes`.
+std::string base64(const std::string& bytes);
+
+}  // namespace hila::viz
