@@ -608,11 +608,55 @@ TEST(Cli, NumericOptionsOutsideTheirRangeAreRefused) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
   const std::string plan = "plan --db x.hila --scene s.yaml --all --deadline ";
-  for (const char* deadline : {"inf", "nan", "0", "-1", "9.3e9", "86401"}) {
-    expect_one_line_error(run(plan + deadline),
-                          std::string("--deadline: expected seconds in (0, 86400], got ") +
-                              deadline);
+  // A deadline under a millisecond ends every board before its first goal attempt.
+  for (const char* deadline : {"inf", "nan", "0", "-1", "9.3e9", "86401", "1e-300", "0.0009"}) {
+    expect_one_line_error(
+        run(plan + deadline),
+        std::string("--deadline: expected seconds in [0.001, 86400], got ") + deadline);
   }
+}
+
+// A key given twice in a YAML input is refused (yaml-cpp would keep the first), as is a mass or
+// an angle outside its documented range; exit 2, one line, file and field named.
+TEST(Cli, DuplicateKeysAndFieldsOutOfRangeAreBadInput) {
+  const std::string dir = test::temp_dir("cli_field_bounds");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string cell = dir + "/cell/cell.yaml";
+  const std::string text = test::read_file(product);
+  struct Case {
+    std::string from, to, message;
+  };
+  const std::vector<Case> cases = {
+      {"    mass: 0.8\n", "    mass: 0.8\n    mass: 100\n",
+       product + ": parts[0].mass: expected a key that appears once in its map, got 'mass' again "
+                 "on line 18 (first on line 17)"},
+      {"mass: 0.8", "mass: 100",
+       product + ": parts[0].mass: expected a mass in kilograms in "
+                 "[0.001, 25], got 100"},
+      {"mass: 0.8", "mass: 1e-300",
+       product + ": parts[0].mass: expected a mass in kilograms in "
+                 "[0.001, 25], got 1e-300"},
+      {"rpy_deg: [0, 0, 90]", "rpy_deg: [0, 0, 1e300]",
+       product + ": parts[0].target.rpy_deg[2]: expected an angle in degrees in [-360, 360], got "
+                 "1e+300"},
+  };
+  for (const Case& c : cases) {
+    std::string changed = text;
+    changed.replace(changed.find(c.from), c.from.size(), c.to);
+    test::write_file(dir + "/cabinet", "product.yaml", changed);
+    expect_one_line_error(run("product check " + product + " --cell " + cell), c.message);
+    expect_one_line_error(
+        run("build " + product + " --cell " + cell + kSmall + " -o " + dir + "/x.hila"), c.message);
+  }
+  test::write_file(dir + "/cabinet", "product.yaml", text);
+  std::string cell_text = test::read_file(cell);
+  cell_text.replace(cell_text.find("  grip_force: 100\n"), 18,
+                    "  grip_force: 100\n  grip_force: 235\n");
+  test::write_file(dir + "/cell", "cell.yaml", cell_text);
+  expect_one_line_error(run("cell check " + cell),
+                        cell + ": gripper.grip_force: expected a key that appears once in its map");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
 }
 
 TEST(Cli, MeshBoxRefusesAbsurdSizesAndAnOutputWithoutAFormat) {
