@@ -130,6 +130,8 @@ TEST(Cli, MeshBoxAndProductCheck) {
   EXPECT_EQ(j["parts"].size(), 7u);
   EXPECT_EQ(j["targets_collision_free"], true);
   EXPECT_EQ(j["initial_collision_free"], true);
+  EXPECT_TRUE(j["pose_errors"].empty()) << r.out;
+  EXPECT_TRUE(j["pose_warnings"].empty()) << r.out;
 }
 
 TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
@@ -750,4 +752,60 @@ TEST(Cli, AUrdfThatIsNotXmlIsNamed) {
   expect_one_line_error(run("build " + test::product_path() + " --cell " + dir +
                             "/cell/cell.yaml" + kSmall + " -o " + dir + "/x.hila"),
                         urdf + ": (file): expected a URDF (XML)");
+}
+
+// `product check` checks the poses: initial poses on the table (not below its top, not
+// floating), clear of the suction tool on its stand, within some arm's reach; targets not below
+// the table top (errors, exit 1); targets beyond the human's reach are a warning (exit 0).
+TEST(Cli, ProductCheckChecksInitialAndTargetPoses) {
+  const std::string dir = test::temp_dir("cli_product_poses");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string check = "product check " + product + " --cell " + dir + "/cell/cell.yaml";
+  const std::string text = test::read_file(product);
+  const std::string base_initial = "initial: {xyz: [0.30, -0.30, 1.152]";
+  struct Case {
+    std::string from, to;
+    int status;
+    std::string line;
+  };
+  const std::vector<Case> cases = {
+      // 9 cm below the table top, beside the stack (no overlap with the table or a part).
+      {base_initial, "initial: {xyz: [0.30, 0.30, 1.009]", 1,
+       "error: base: initial pose: its lowest point is 90 mm below the top of 'table'"},
+      {base_initial, "initial: {xyz: [0.30, 0.30, 1.2]", 1,
+       "error: base: initial pose: its lowest point floats 101 mm above the top of 'table'"},
+      // Behind the human, 1.5 m beyond the table's edge.
+      {base_initial, "initial: {xyz: [2.65, 0.0, 1.152]", 1,
+       "error: base: initial pose: out of every robot arm's reach by "},
+      {base_initial, "initial: {xyz: [2.65, 0.0, 1.152]", 1,
+       "error: base: initial pose: not over the table or any obstacle"},
+      // On the suction tool's stand.
+      {base_initial, "initial: {xyz: [0.30, -0.72, 1.099]", 1, "base <-> tool/"},
+      {"target: {xyz: [0.0035, 0.0, 0.006]", "target: {xyz: [0.0035, 0.0, -0.09]", 1,
+       "error: base: target pose: its lowest point is 95 mm below the top of 'table'"},
+      // The assembly at the robot's side of the table: on the table, out of the human's reach.
+      {"assembly_frame: {xyz: [0.62, 0.0, 1.094]", "assembly_frame: {xyz: [0.15, 0.0, 1.094]", 0,
+       "warning: back_lower: target pose: out of the human's reach from the stance by "},
+  };
+  for (const Case& c : cases) {
+    std::string changed = text;
+    changed.replace(changed.find(c.from), c.from.size(), c.to);
+    test::write_file(dir + "/cabinet", "product.yaml", changed);
+    const CommandRun r = run(check);
+    EXPECT_EQ(r.status, c.status) << c.to << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.line), std::string::npos) << c.to << "\n" << r.out;
+  }
+  // The same in the JSON report.
+  std::string changed = text;
+  changed.replace(changed.find(base_initial), base_initial.size(),
+                  "initial: {xyz: [0.30, 0.30, 1.009]");
+  test::write_file(dir + "/cabinet", "product.yaml", changed);
+  const CommandRun r = run(check + " --json");
+  EXPECT_EQ(r.status, 1) << r.out;
+  const auto j = nlohmann::json::parse(json_part(r.out));
+  ASSERT_EQ(j["pose_errors"].size(), 1u) << r.out;
+  EXPECT_EQ(j["pose_errors"][0]["part"], "base");
+  EXPECT_EQ(j["pose_errors"][0]["pose"], "initial");
+  EXPECT_TRUE(j["pose_warnings"].empty());
 }

@@ -4,6 +4,11 @@
 #include <string>
 #include <vector>
 
+namespace hila::core {
+class Cell;
+struct ProductSpec;
+}  // namespace hila::core
+
 namespace hila::tools {
 
 // A file a command reads, with how messages name it ("the product file").
@@ -40,5 +45,27 @@ void write_atomically(const std::string& path,
                       const std::function<void(const std::string& temporary)>& write);
 // write_atomically of a text; a failed write throws core::InputError naming `path` and the reason.
 void write_file_atomically(const std::string& path, const std::string& text);
+
+// Checks of the inputs' content that `product check` and `cell check` report and `build` makes
+// before its long work.
+
+// The pairs ("a <-> b") that interpenetrate with every part at its target (`at_targets`) or at
+// its initial pose, beside the cell's obstacles; at the initial poses also the suction tool at
+// product.suction_tool_pose.
+std::vector<std::string> colliding_parts(const core::Cell& cell, const core::ProductSpec& product,
+                                         bool at_targets);
+
+// A problem with a part's pose: an error makes `product check` exit 1, a warning does not.
+struct PoseFinding {
+  std::string part;
+  std::string pose;  // "initial" or "target"
+  bool error = true;
+  std::string problem;
+};
+// Initial poses resting on an obstacle's top or on another part (the lowest point within 5 mm,
+// not below), each within some robot arm's reach (the TCP's reach from the shoulder plus the
+// suction cup's offset, against the part's bounding sphere): errors. Targets not below the top
+// of the obstacle under them: errors; within the reach of a human arm at the stance: warnings.
+std::vector<PoseFinding> check_part_poses(const core::Cell& cell, const core::ProductSpec& product);
 
 }  // namespace hila::tools
