@@ -809,3 +809,41 @@ TEST(Cli, ProductCheckChecksInitialAndTargetPoses) {
   EXPECT_EQ(j["pose_errors"][0]["pose"], "initial");
   EXPECT_TRUE(j["pose_warnings"].empty());
 }
+
+// `build` refuses, before the comfort maps and roadmaps and with exit 1, a product whose
+// finished assembly interpenetrates and a cell whose robot home collides (they used to build
+// for the whole run, then exit 0 with every board "no goal reachable").
+TEST(Cli, BuildRefusesInterpenetratingTargetsAndACollidingHomeBeforeTheWork) {
+  const std::string dir = test::temp_dir("cli_build_refuses");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string cell = dir + "/cell/cell.yaml";
+  const std::string build =
+      "build " + product + " --cell " + cell + kSmall + " --jobs 2 -o " + dir + "/x.hila";
+  const std::string product_text = test::read_file(product);
+  std::string sunk = product_text;
+  // The middle shelf at the base's height: the two boards overlap.
+  const std::string middle = "target: {xyz: [0.0035, 0.0, 0.2945]";
+  sunk.replace(sunk.find(middle), middle.size(), "target: {xyz: [0.0035, 0.0, 0.006]");
+  test::write_file(dir + "/cabinet", "product.yaml", sunk);
+  const CommandRun targets = run(build);
+  EXPECT_EQ(targets.status, 1) << targets.out;
+  EXPECT_NE(targets.out.find("hila: " + product + ": the finished assembly interpenetrates ("),
+            std::string::npos)
+      << targets.out;
+  EXPECT_NE(targets.out.find("shelf_middle"), std::string::npos) << targets.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+
+  test::write_file(dir + "/cabinet", "product.yaml", product_text);
+  std::string cell_text = test::read_file(cell);
+  const std::string home = "home_deg: [15, -60, -120, -180, -120, 0]";
+  cell_text.replace(cell_text.find(home), home.size(), "home_deg: [15, 90, -120, -180, -120, 0]");
+  test::write_file(dir + "/cell", "cell.yaml", cell_text);
+  const CommandRun colliding = run(build);
+  EXPECT_EQ(colliding.status, 1) << colliding.out;
+  EXPECT_NE(colliding.out.find("hila: " + cell + ": the robot at home is in collision ("),
+            std::string::npos)
+      << colliding.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+  EXPECT_TRUE(temporaries_in(dir).empty());
+}

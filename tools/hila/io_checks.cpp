@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/collision.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/robot_model.hpp"
 #include "hila/core/yaml_reader.hpp"
@@ -169,6 +170,15 @@ void write_file_atomically(const std::string& path, const std::string& text) {
     out.close();
     if (!out) fail("the write failed");
   });
+}
+
+std::string home_collision(const core::Cell& cell) {
+  const core::CellScene scene = core::build_cell_scene(cell, {.human_moves = true});
+  core::CollisionData data(scene.model);
+  core::set_cell_state(cell, scene, data, cell.home_configuration(cell.spec().gripper.jaw_max),
+                       cell.human_neutral());
+  core::CollisionPair pair;
+  return core::in_collision(scene.model, data, &pair) ? core::describe_pair(scene.model, pair) : "";
 }
 
 }  // namespace hila::tools

@@ -55,6 +55,10 @@ void write_file_atomically(const std::string& path, const std::string& text);
 std::vector<std::string> colliding_parts(const core::Cell& cell, const core::ProductSpec& product,
                                          bool at_targets);
 
+// The colliding pair ("a <-> b") when the robot at home (jaws open) collides with itself, the
+// obstacles or the human at the stance in the neutral posture; "" when it is collision-free.
+std::string home_collision(const core::Cell& cell);
+
 // A problem with a part's pose: an error makes `product check` exit 1, a warning does not.
 struct PoseFinding {
   std::string part;
