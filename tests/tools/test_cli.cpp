@@ -1,9 +1,11 @@
 // End-to-end tests of the `hila` command: real process, real files, exit codes and JSON.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -846,4 +848,29 @@ TEST(Cli, BuildRefusesInterpenetratingTargetsAndACollidingHomeBeforeTheWork) {
       << colliding.out;
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
   EXPECT_TRUE(temporaries_in(dir).empty());
+}
+
+// A build killed while writing leaves OUT.tmp-PID-N; `--if-outdated` keeping OUT removes the
+// temporaries of processes that no longer run and keeps those of a running one.
+TEST(Cli, BuildIfOutdatedRemovesTheTemporariesOfDeadBuilds) {
+  const std::string dir = test::temp_dir("cli_stale_temporaries");
+  const std::string db = dir + "/c.hila";
+  const std::string build = "build " + test::product_path() + " --cell " + test::cell_path() +
+                            kSmall + " --jobs 2 --if-outdated -o " + db;
+  ASSERT_LE(run(build).status, 1);
+  // A process that has exited: its PID no longer runs.
+  FILE* pipe = popen("sh -c 'echo $$'", "r");
+  ASSERT_NE(pipe, nullptr);
+  char pid_text[32] = {};
+  ASSERT_NE(fgets(pid_text, sizeof pid_text, pipe), nullptr);
+  pclose(pipe);
+  const std::string dead = dir + "/c.hila.tmp-" + std::to_string(std::atol(pid_text)) + "-0";
+  const std::string live = dir + "/c.hila.tmp-" + std::to_string(::getpid()) + "-0";
+  test::write_file(dir, std::filesystem::path(dead).filename().string(), "");
+  test::write_file(dir, std::filesystem::path(live).filename().string(), "");
+  const CommandRun kept = run(build);
+  EXPECT_EQ(kept.status, 0) << kept.out;
+  EXPECT_NE(kept.out.find("is up to date"), std::string::npos) << kept.out;
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(live));
 }

@@ -100,6 +100,9 @@ int run_build(const BuildOptions& opt) {
   if (opt.if_outdated) {
     const std::string why = why_outdated(opt.output, opt.cell_file, opt.product_file, settings);
     if (why.empty()) {
+      // A build killed while writing left its temporary beside the output; the writer removes
+      // such files when it starts, and a kept output starts no writer.
+      remove_dead_temporaries(opt.output);
       std::cout << opt.output
                 << " is up to date (same hila version, cell, product, settings and seed): kept\n";
       return 0;

@@ -37,6 +37,11 @@ inline constexpr std::size_t kTemporarySuffixBytes = 32;
 // A temporary path beside `path`, unique to this process and call.
 std::string temporary_path_beside(const std::string& path);
 
+// Removes the temporaries of `path` (PATH.tmp-PID-..., the names temporary_path_beside and the
+// database writer make) whose process no longer runs: a build killed while writing left them.
+// A temporary of a running process, or anything else, is kept. Returns how many were removed.
+int remove_dead_temporaries(const std::string& path) noexcept;
+
 // Writes `path` through a temporary file beside it: `write` writes the temporary path (throwing
 // on failure), which is then renamed into place. On any failure (no space, no permission, an
 // exception from `write`) the temporary file is removed, a previous file at `path` is untouched,
