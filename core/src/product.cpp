@@ -18,6 +18,14 @@ double unit_scale_from_name(const std::string& unit, const std::string& file,
 }
 
 namespace {
+// The range of a part's mass (kg). 1 g: lighter than a small washer, a value below is a typo
+// (1e-300) or a unit slip. 25 kg: the reference mass a person may lift at all (ISO 11228-1),
+// so no part handed to a person weighs more, and over eight times a UR3's 3 kg rated payload;
+// 100 or 800 are grams written as kilograms. Whether an arm lifts a part within its payload is
+// `hila product check`'s question (exit 1), not this plausibility bound.
+constexpr double kMinPartMass = 0.001;
+constexpr double kMaxPartMass = 25.0;
+
 // The name quoted on one line: control characters as \n, \t or \xNN.
 std::string quoted_name(const std::string& name) {
   static const char* const kHex = "0123456789abcdef";
@@ -81,9 +89,12 @@ ProductSpec load_product(const std::string& path) {
     part.mesh_file = p.resolve_path(p.at("mesh").as_string());
     part.unit_scale =
         unit_scale_from_name(p.at("mesh_unit").as_string(), path, p.path() + ".mesh_unit");
-    part.mass = p.at("mass").as_positive();
-    if (part.mass > 100.0)
-      p.at("mass").fail("a mass in kilograms below 100 (grams given?)", format_number(part.mass));
+    part.mass = p.at("mass").as_double();
+    if (part.mass < kMinPartMass || part.mass > kMaxPartMass) {
+      p.at("mass").fail("a mass in kilograms in [" + format_number(kMinPartMass) + ", " +
+                            format_number(kMaxPartMass) + "]",
+                        format_number(part.mass));
+    }
     part.target = p.at("target").as_pose();
     check_pose(part.target, path, p.path() + ".target");
     part.initial = p.at("initial").as_pose();

@@ -1,9 +1,14 @@
 #include "hila/core/yaml_reader.hpp"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
 
 #include "hila/core/error.hpp"
 
@@ -16,6 +21,83 @@ std::string short_repr(const YAML::Node& node) {
   if (node.IsSequence()) return "a list of " + std::to_string(node.size()) + " items";
   if (node.IsMap()) return "a map";
   return "an unknown node";
+}
+
+// Walks the parser's events (aliases unexpanded) and refuses a key that appears twice in one
+// map: yaml-cpp's tree silently keeps the first value. Knows each node's path
+// ("parts[0].mass") and line for the message.
+class DuplicateKeyCheck : public YAML::EventHandler {
+ public:
+  explicit DuplicateKeyCheck(std::string file) : file_(std::move(file)) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { node(mark, nullptr); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { node(mark, nullptr); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string& value) override {
+    node(mark, &value);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    frames_.push_back({false, node(mark, nullptr)});
+  }
+  void OnSequenceEnd() override { frames_.pop_back(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    frames_.push_back({true, node(mark, nullptr)});
+  }
+  void OnMapEnd() override { frames_.pop_back(); }
+
+ private:
+  struct Frame {
+    bool map = false;
+    std::string path;
+    std::size_t index = 0;                 // next item of a list
+    bool expect_key = true;                // a map alternates key, value
+    std::string key;                       // the key of the value that follows
+    std::map<std::string, int> key_lines;  // 1-based line of each key so far
+  };
+
+  // Registers a node in its parent (as a key or a value) and returns its path.
+  std::string node(const YAML::Mark& mark, const std::string* scalar) {
+    if (frames_.empty()) return "";
+    Frame& parent = frames_.back();
+    const std::string prefix = parent.path.empty() ? "" : parent.path + ".";
+    if (!parent.map) return parent.path + "[" + std::to_string(parent.index++) + "]";
+    if (!parent.expect_key) {
+      parent.expect_key = true;
+      return prefix + parent.key;
+    }
+    parent.expect_key = false;
+    parent.key = scalar != nullptr ? *scalar : "?";  // a key that is a list or map: no name
+    if (scalar == nullptr) return prefix + "?";
+    const int line = mark.line + 1;
+    const auto [at, inserted] = parent.key_lines.emplace(*scalar, line);
+    if (!inserted) {
+      throw InputError(file_, prefix + *scalar, "a key that appears once in its map",
+                       "'" + *scalar + "' again on line " + std::to_string(line) +
+                           " (first on line " + std::to_string(at->second) + ")");
+    }
+    return prefix + *scalar;
+  }
+
+  std::string file_;
+  std::vector<Frame> frames_;
+};
+
+// The document in `text`, refused when malformed or when a map repeats a key.
+YAML::Node load_checked(const std::string& text, const std::string& file) {
+  try {
+    YAML::Node root = YAML::Load(text);
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    DuplicateKeyCheck check(file);
+    parser.HandleNextDocument(check);
+    return root;
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, "line " + std::to_string(e.mark.line + 1), "well-formed YAML", e.msg);
+  }
 }
 }  // namespace
 
@@ -31,23 +113,17 @@ YamlNode YamlNode::load_file(const std::string& path) {
   }
   std::ifstream in(path);
   if (!in) throw InputError(path, "(file)", "a readable YAML file", "a file that cannot be opened");
-  try {
-    YAML::Node root = YAML::Load(in);
-    if (!root.IsMap()) {
-      throw InputError(path, "(document)", "a YAML map at the top level", short_repr(root));
-    }
-    return YamlNode(root, std::make_shared<const std::string>(path), "");
-  } catch (const YAML::Exception& e) {
-    throw InputError(path, "line " + std::to_string(e.mark.line + 1), "well-formed YAML", e.msg);
+  std::ostringstream text;
+  text << in.rdbuf();
+  const YAML::Node root = load_checked(text.str(), path);
+  if (!root.IsMap()) {
+    throw InputError(path, "(document)", "a YAML map at the top level", short_repr(root));
   }
+  return YamlNode(root, std::make_shared<const std::string>(path), "");
 }
 
 YamlNode YamlNode::from_string(const std::string& text, const std::string& name) {
-  try {
-    return YamlNode(YAML::Load(text), std::make_shared<const std::string>(name), "");
-  } catch (const YAML::Exception& e) {
-    throw InputError(name, "line " + std::to_string(e.mark.line + 1), "well-formed YAML", e.msg);
-  }
+  return YamlNode(load_checked(text, name), std::make_shared<const std::string>(name), "");
 }
 
 std::string YamlNode::describe() const {
@@ -199,13 +275,26 @@ Pose YamlNode::as_pose() const {
   Pose pose = Pose::Identity();
   pose.translation() = at("xyz").as_vec3();
   int rotations = 0;
+  // Angles within one turn either way: beyond that a value is a typo (1e300 degrees is no
+  // rotation anyone meant, and its sine has lost every digit).
+  const auto angles = [](const YamlNode& node, double turn, const std::string& unit) {
+    const std::vector<double> v = node.as_doubles(3);
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (std::abs(v[i]) > turn) {
+        node.at(i).fail("an angle in " + unit + " in [" + format_number(-turn) + ", " +
+                            format_number(turn) + "]",
+                        format_number(v[i]));
+      }
+    }
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  };
   if (has("rpy_deg")) {
     ++rotations;
-    pose.linear() = rpy_to_matrix(at("rpy_deg").as_vec3() * kPi / 180.0);
+    pose.linear() = rpy_to_matrix(angles(at("rpy_deg"), 360.0, "degrees") * kPi / 180.0);
   }
   if (has("rpy")) {
     ++rotations;
-    pose.linear() = rpy_to_matrix(at("rpy").as_vec3());
+    pose.linear() = rpy_to_matrix(angles(at("rpy"), 2.0 * kPi, "radians"));
   }
   if (has("quat_wxyz")) {
     ++rotations;

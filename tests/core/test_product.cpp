@@ -221,14 +221,23 @@ TEST(Product, BadMass) {
   struct Case {
     std::string value, fragment;
   };
-  const std::vector<Case> cases = {{"0", "positive"}, {"-1", "positive"},   {".nan", "finite"},
-                                   {"nan", "finite"}, {"800", "below 100"}, {"heavy", "a number"}};
+  // A part's mass is in [1 g, 25 kg]: the 1e-300 and 100 are refused.
+  const std::string range = "a mass in kilograms in [0.001, 25]";
+  const std::vector<Case> cases = {{"0", range},         {"-1", range},     {".nan", "finite"},
+                                   {"nan", "finite"},    {"800", range},    {"100", range},
+                                   {"25.01", range},     {"1e-300", range}, {"0.0009", range},
+                                   {"heavy", "a number"}};
   for (std::size_t i = 0; i < cases.size(); ++i) {
     SCOPED_TRACE("mass: " + cases[i].value);
     const std::string text = replace_once(product_text(), "mass: 1.8", "mass: " + cases[i].value);
     const std::string path = write_product(temp_dir("product_mass_" + std::to_string(i)), text);
     // lateral_right is the second part in the file.
     expect_input_error([&] { load_product(path); }, {path, "parts[1].mass", cases[i].fragment});
+  }
+  for (const char* bound : {"0.001", "25"}) {
+    const std::string text =
+        replace_once(product_text(), "mass: 1.8", std::string("mass: ") + bound);
+    EXPECT_NO_THROW(load_product(write_product(temp_dir("product_mass_bound"), text))) << bound;
   }
 }
 

@@ -269,3 +269,48 @@ TEST(YamlReader, ResolvePathRelativeToFileFolder) {
   write_file(sub.string(), "robot.urdf", "<robot/>");
   EXPECT_TRUE(std::filesystem::exists(root.resolve_path("robot.urdf")));
 }
+
+// yaml-cpp keeps the first of two equal keys; a repeated key is refused, naming its path and
+// both lines, wherever the map is (top level, nested, in a list, flow style).
+TEST(YamlReader, DuplicateKeysAreRefused) {
+  const std::string dir = temp_dir("yaml_reader_duplicates");
+  const std::string top = write_file(dir, "top.yaml", "a: 1\nb: 2\na: 3\n");
+  expect_input_error([&] { YamlNode::load_file(top); },
+                     {top, ": a: ", "a key that appears once in its map",
+                      "'a' again on line 3 (first on line 1)"});
+  const std::string nested =
+      write_file(dir, "nested.yaml", "parts:\n  - name: x\n    mass: 1\n    mass: 100\n");
+  expect_input_error([&] { YamlNode::load_file(nested); },
+                     {nested, ": parts[0].mass: ", "'mass' again on line 4 (first on line 3)"});
+  const std::string flow = write_file(dir, "flow.yaml", "p: {xyz: [0, 0, 0], xyz: [1, 1, 1]}\n");
+  expect_input_error([&] { YamlNode::load_file(flow); }, {flow, ": p.xyz: ", "'xyz' again"});
+  expect_input_error([] { YamlNode::from_string("k: 1\nk: 2\n", "text.yaml"); },
+                     {"text.yaml", ": k: ", "'k' again on line 2"});
+  // Equal keys in different maps, and a map reused through an alias, are fine.
+  const std::string fine = write_file(dir, "fine.yaml",
+                                      "a: {x: 1, y: 2}\nb: {x: 1, y: 2}\n"
+                                      "c: &shared {x: 1}\nd: *shared\nl: [{x: 1}, {x: 2}]\n");
+  const YamlNode root = YamlNode::load_file(fine);
+  EXPECT_DOUBLE_EQ(root.at("d").at("x").as_double(), 1.0);
+}
+
+// Rotation angles are finite and within one turn either way: 1e300 degrees is a typo, not a
+// rotation (and loses every digit of the angle that matters).
+TEST(YamlReader, RotationAnglesBeyondOneTurnAreRefused) {
+  const auto [path, root] = load_text("pose_angles",
+                                      "huge: {xyz: [0, 0, 0], rpy_deg: [0, 0, 1e300]}\n"
+                                      "turn: {xyz: [0, 0, 0], rpy_deg: [-360, 0, 360]}\n"
+                                      "over: {xyz: [0, 0, 0], rpy_deg: [361, 0, 0]}\n"
+                                      "rad: {xyz: [0, 0, 0], rpy: [0, 7, 0]}\n"
+                                      "overflow: {xyz: [0, 0, 0], rpy_deg: [0, 1e400, 0]}\n");
+  expect_input_error([&] { root.at("huge").as_pose(); },
+                     {path, ": huge.rpy_deg[2]: ", "an angle in degrees in [-360, 360]", "1e+300"});
+  EXPECT_NO_THROW(root.at("turn").as_pose());
+  expect_input_error([&] { root.at("over").as_pose(); },
+                     {path, ": over.rpy_deg[0]: ", "[-360, 360]", "got 361"});
+  expect_input_error(
+      [&] { root.at("rad").as_pose(); },
+      {path, ": rad.rpy[1]: ", "an angle in radians in [-6.283185307, 6.283185307]", "got 7"});
+  expect_input_error([&] { root.at("overflow").as_pose(); },
+                     {path, ": overflow.rpy_deg[1]: ", "a number", "'1e400'"});
+}

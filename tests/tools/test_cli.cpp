@@ -1,9 +1,11 @@
 // End-to-end tests of the `hila` command: real process, real files, exit codes and JSON.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -130,6 +132,8 @@ TEST(Cli, MeshBoxAndProductCheck) {
   EXPECT_EQ(j["parts"].size(), 7u);
   EXPECT_EQ(j["targets_collision_free"], true);
   EXPECT_EQ(j["initial_collision_free"], true);
+  EXPECT_TRUE(j["pose_errors"].empty()) << r.out;
+  EXPECT_TRUE(j["pose_warnings"].empty()) << r.out;
 }
 
 TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
@@ -608,11 +612,55 @@ TEST(Cli, NumericOptionsOutsideTheirRangeAreRefused) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
   const std::string plan = "plan --db x.hila --scene s.yaml --all --deadline ";
-  for (const char* deadline : {"inf", "nan", "0", "-1", "9.3e9", "86401"}) {
-    expect_one_line_error(run(plan + deadline),
-                          std::string("--deadline: expected seconds in (0, 86400], got ") +
-                              deadline);
+  // A deadline under a millisecond ends every board before its first goal attempt.
+  for (const char* deadline : {"inf", "nan", "0", "-1", "9.3e9", "86401", "1e-300", "0.0009"}) {
+    expect_one_line_error(
+        run(plan + deadline),
+        std::string("--deadline: expected seconds in [0.001, 86400], got ") + deadline);
   }
+}
+
+// A key given twice in a YAML input is refused (yaml-cpp would keep the first), as is a mass or
+// an angle outside its documented range; exit 2, one line, file and field named.
+TEST(Cli, DuplicateKeysAndFieldsOutOfRangeAreBadInput) {
+  const std::string dir = test::temp_dir("cli_field_bounds");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string cell = dir + "/cell/cell.yaml";
+  const std::string text = test::read_file(product);
+  struct Case {
+    std::string from, to, message;
+  };
+  const std::vector<Case> cases = {
+      {"    mass: 0.8\n", "    mass: 0.8\n    mass: 100\n",
+       product + ": parts[0].mass: expected a key that appears once in its map, got 'mass' again "
+                 "on line 18 (first on line 17)"},
+      {"mass: 0.8", "mass: 100",
+       product + ": parts[0].mass: expected a mass in kilograms in "
+                 "[0.001, 25], got 100"},
+      {"mass: 0.8", "mass: 1e-300",
+       product + ": parts[0].mass: expected a mass in kilograms in "
+                 "[0.001, 25], got 1e-300"},
+      {"rpy_deg: [0, 0, 90]", "rpy_deg: [0, 0, 1e300]",
+       product + ": parts[0].target.rpy_deg[2]: expected an angle in degrees in [-360, 360], got "
+                 "1e+300"},
+  };
+  for (const Case& c : cases) {
+    std::string changed = text;
+    changed.replace(changed.find(c.from), c.from.size(), c.to);
+    test::write_file(dir + "/cabinet", "product.yaml", changed);
+    expect_one_line_error(run("product check " + product + " --cell " + cell), c.message);
+    expect_one_line_error(
+        run("build " + product + " --cell " + cell + kSmall + " -o " + dir + "/x.hila"), c.message);
+  }
+  test::write_file(dir + "/cabinet", "product.yaml", text);
+  std::string cell_text = test::read_file(cell);
+  cell_text.replace(cell_text.find("  grip_force: 100\n"), 18,
+                    "  grip_force: 100\n  grip_force: 235\n");
+  test::write_file(dir + "/cell", "cell.yaml", cell_text);
+  expect_one_line_error(run("cell check " + cell),
+                        cell + ": gripper.grip_force: expected a key that appears once in its map");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
 }
 
 TEST(Cli, MeshBoxRefusesAbsurdSizesAndAnOutputWithoutAFormat) {
@@ -706,4 +754,123 @@ TEST(Cli, AUrdfThatIsNotXmlIsNamed) {
   expect_one_line_error(run("build " + test::product_path() + " --cell " + dir +
                             "/cell/cell.yaml" + kSmall + " -o " + dir + "/x.hila"),
                         urdf + ": (file): expected a URDF (XML)");
+}
+
+// `product check` checks the poses: initial poses on the table (not below its top, not
+// floating), clear of the suction tool on its stand, within some arm's reach; targets not below
+// the table top (errors, exit 1); targets beyond the human's reach are a warning (exit 0).
+TEST(Cli, ProductCheckChecksInitialAndTargetPoses) {
+  const std::string dir = test::temp_dir("cli_product_poses");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string check = "product check " + product + " --cell " + dir + "/cell/cell.yaml";
+  const std::string text = test::read_file(product);
+  const std::string base_initial = "initial: {xyz: [0.30, -0.30, 1.152]";
+  struct Case {
+    std::string from, to;
+    int status;
+    std::string line;
+  };
+  const std::vector<Case> cases = {
+      // 9 cm below the table top, beside the stack (no overlap with the table or a part).
+      {base_initial, "initial: {xyz: [0.30, 0.30, 1.009]", 1,
+       "error: base: initial pose: its lowest point is 90 mm below the top of 'table'"},
+      {base_initial, "initial: {xyz: [0.30, 0.30, 1.2]", 1,
+       "error: base: initial pose: its lowest point floats 101 mm above the top of 'table'"},
+      // Behind the human, 1.5 m beyond the table's edge.
+      {base_initial, "initial: {xyz: [2.65, 0.0, 1.152]", 1,
+       "error: base: initial pose: out of every robot arm's reach by "},
+      {base_initial, "initial: {xyz: [2.65, 0.0, 1.152]", 1,
+       "error: base: initial pose: not over the table or any obstacle"},
+      // On the suction tool's stand.
+      {base_initial, "initial: {xyz: [0.30, -0.72, 1.099]", 1, "base <-> tool/"},
+      {"target: {xyz: [0.0035, 0.0, 0.006]", "target: {xyz: [0.0035, 0.0, -0.09]", 1,
+       "error: base: target pose: its lowest point is 95 mm below the top of 'table'"},
+      // The assembly at the robot's side of the table: on the table, out of the human's reach.
+      {"assembly_frame: {xyz: [0.62, 0.0, 1.094]", "assembly_frame: {xyz: [0.15, 0.0, 1.094]", 0,
+       "warning: back_lower: target pose: out of the human's reach from the stance by "},
+  };
+  for (const Case& c : cases) {
+    std::string changed = text;
+    changed.replace(changed.find(c.from), c.from.size(), c.to);
+    test::write_file(dir + "/cabinet", "product.yaml", changed);
+    const CommandRun r = run(check);
+    EXPECT_EQ(r.status, c.status) << c.to << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.line), std::string::npos) << c.to << "\n" << r.out;
+  }
+  // The same in the JSON report.
+  std::string changed = text;
+  changed.replace(changed.find(base_initial), base_initial.size(),
+                  "initial: {xyz: [0.30, 0.30, 1.009]");
+  test::write_file(dir + "/cabinet", "product.yaml", changed);
+  const CommandRun r = run(check + " --json");
+  EXPECT_EQ(r.status, 1) << r.out;
+  const auto j = nlohmann::json::parse(json_part(r.out));
+  ASSERT_EQ(j["pose_errors"].size(), 1u) << r.out;
+  EXPECT_EQ(j["pose_errors"][0]["part"], "base");
+  EXPECT_EQ(j["pose_errors"][0]["pose"], "initial");
+  EXPECT_TRUE(j["pose_warnings"].empty());
+}
+
+// `build` refuses, before the comfort maps and roadmaps and with exit 1, a product whose
+// finished assembly interpenetrates and a cell whose robot home collides (they used to build
+// for the whole run, then exit 0 with every board "no goal reachable").
+TEST(Cli, BuildRefusesInterpenetratingTargetsAndACollidingHomeBeforeTheWork) {
+  const std::string dir = test::temp_dir("cli_build_refuses");
+  copy_bundled_data(dir);
+  const std::string product = dir + "/cabinet/product.yaml";
+  const std::string cell = dir + "/cell/cell.yaml";
+  const std::string build =
+      "build " + product + " --cell " + cell + kSmall + " --jobs 2 -o " + dir + "/x.hila";
+  const std::string product_text = test::read_file(product);
+  std::string sunk = product_text;
+  // The middle shelf at the base's height: the two boards overlap.
+  const std::string middle = "target: {xyz: [0.0035, 0.0, 0.2945]";
+  sunk.replace(sunk.find(middle), middle.size(), "target: {xyz: [0.0035, 0.0, 0.006]");
+  test::write_file(dir + "/cabinet", "product.yaml", sunk);
+  const CommandRun targets = run(build);
+  EXPECT_EQ(targets.status, 1) << targets.out;
+  EXPECT_NE(targets.out.find("hila: " + product + ": the finished assembly interpenetrates ("),
+            std::string::npos)
+      << targets.out;
+  EXPECT_NE(targets.out.find("shelf_middle"), std::string::npos) << targets.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+
+  test::write_file(dir + "/cabinet", "product.yaml", product_text);
+  std::string cell_text = test::read_file(cell);
+  const std::string home = "home_deg: [15, -60, -120, -180, -120, 0]";
+  cell_text.replace(cell_text.find(home), home.size(), "home_deg: [15, 90, -120, -180, -120, 0]");
+  test::write_file(dir + "/cell", "cell.yaml", cell_text);
+  const CommandRun colliding = run(build);
+  EXPECT_EQ(colliding.status, 1) << colliding.out;
+  EXPECT_NE(colliding.out.find("hila: " + cell + ": the robot at home is in collision ("),
+            std::string::npos)
+      << colliding.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
+  EXPECT_TRUE(temporaries_in(dir).empty());
+}
+
+// A build killed while writing leaves OUT.tmp-PID-N; `--if-outdated` keeping OUT removes the
+// temporaries of processes that no longer run and keeps those of a running one.
+TEST(Cli, BuildIfOutdatedRemovesTheTemporariesOfDeadBuilds) {
+  const std::string dir = test::temp_dir("cli_stale_temporaries");
+  const std::string db = dir + "/c.hila";
+  const std::string build = "build " + test::product_path() + " --cell " + test::cell_path() +
+                            kSmall + " --jobs 2 --if-outdated -o " + db;
+  ASSERT_LE(run(build).status, 1);
+  // A process that has exited: its PID no longer runs.
+  FILE* pipe = popen("sh -c 'echo $$'", "r");
+  ASSERT_NE(pipe, nullptr);
+  char pid_text[32] = {};
+  ASSERT_NE(fgets(pid_text, sizeof pid_text, pipe), nullptr);
+  pclose(pipe);
+  const std::string dead = dir + "/c.hila.tmp-" + std::to_string(std::atol(pid_text)) + "-0";
+  const std::string live = dir + "/c.hila.tmp-" + std::to_string(::getpid()) + "-0";
+  test::write_file(dir, std::filesystem::path(dead).filename().string(), "");
+  test::write_file(dir, std::filesystem::path(live).filename().string(), "");
+  const CommandRun kept = run(build);
+  EXPECT_EQ(kept.status, 0) << kept.out;
+  EXPECT_NE(kept.out.find("is up to date"), std::string::npos) << kept.out;
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(live));
 }

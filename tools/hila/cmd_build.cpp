@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "hila/core/cell.hpp"
 #include "hila/core/product.hpp"
 #include "hila/db/database.hpp"
 #include "hila/db/provenance.hpp"
@@ -68,7 +69,25 @@ int run_build(const BuildOptions& opt) {
   for (auto&& file : cell_input_files(opt.cell_file)) inputs.push_back(file);
   check_output_path("-o", opt.output, inputs);
   // A mesh the build would refuse, refused before the comfort maps and roadmaps.
-  check_part_meshes(core::load_product(opt.product_file));
+  const core::ProductSpec product = core::load_product(opt.product_file);
+  check_part_meshes(product);
+  // What `product check` and `cell check` report as failed checks (exit 1), refused before the
+  // minutes of work: with them every board ends "no goal reachable".
+  const auto cell = core::Cell::load(opt.cell_file);
+  const std::vector<std::string> overlaps = colliding_parts(*cell, product, true);
+  if (!overlaps.empty()) {
+    std::string pairs;
+    for (const auto& p : overlaps) pairs += (pairs.empty() ? "" : ", ") + p;
+    std::cerr << "hila: " << opt.product_file << ": the finished assembly interpenetrates ("
+              << pairs << "); nothing built (hila product check " << opt.product_file << ")\n";
+    return 1;
+  }
+  const std::string home = home_collision(*cell);
+  if (!home.empty()) {
+    std::cerr << "hila: " << opt.cell_file << ": the robot at home is in collision (" << home
+              << "); nothing built (hila cell check " << opt.cell_file << ")\n";
+    return 1;
+  }
   offline::BuildSettings settings;
   settings.seed = opt.seed;
   settings.jobs = opt.jobs;
@@ -81,6 +100,9 @@ int run_build(const BuildOptions& opt) {
   if (opt.if_outdated) {
     const std::string why = why_outdated(opt.output, opt.cell_file, opt.product_file, settings);
     if (why.empty()) {
+      // A build killed while writing left its temporary beside the output; the writer removes
+      // such files when it starts, and a kept output starts no writer.
+      remove_dead_temporaries(opt.output);
       std::cout << opt.output
                 << " is up to date (same hila version, cell, product, settings and seed): kept\n";
       return 0;

@@ -18,6 +18,9 @@ namespace {
 // The longest --deadline: a day per board (the steady clock's nanoseconds overflow past 292
 // years; anything near that is a typo).
 constexpr double kMaxDeadlineSeconds = 86400.0;
+// The shortest --deadline: a millisecond. Below it a board ends before its first goal attempt
+// (1e-300 s reads as "no time at all"), which is never what the caller meant.
+constexpr double kMinDeadlineSeconds = 0.001;
 
 struct PlanOptions {
   std::string database;
@@ -220,7 +223,7 @@ void add_plan_command(CLI::App& app, Action& action) {
       cmd->add_option("-o,--output", opt->output, "write the plan (JSON, docs/online.md)");
   cmd->add_flag("--json", opt->json, "print the plan as JSON instead of the table");
   cmd->add_option("--deadline", opt->deadline_s, "seconds per board (default 30)")
-      ->check(number_in(0.0, kMaxDeadlineSeconds, true, "seconds"));
+      ->check(number_in(kMinDeadlineSeconds, kMaxDeadlineSeconds, false, "seconds"));
   cmd->callback([opt, output, &action] {
     opt->output_given = output->count() > 0;
     action = [opt] { return run_plan(*opt); };

@@ -1,7 +1,9 @@
 #include "io_checks.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -10,6 +12,7 @@
 #include <fstream>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/collision.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/robot_model.hpp"
 #include "hila/core/yaml_reader.hpp"
@@ -169,6 +172,39 @@ void write_file_atomically(const std::string& path, const std::string& text) {
     out.close();
     if (!out) fail("the write failed");
   });
+}
+
+int remove_dead_temporaries(const std::string& path) noexcept {
+  int removed = 0;
+  std::error_code error;
+  const fs::path parent = fs::path(path).parent_path();
+  const std::string prefix = fs::path(path).filename().string() + ".tmp-";
+  for (const auto& entry : fs::directory_iterator(parent.empty() ? "." : parent, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0 || !entry.is_regular_file(error)) continue;
+    // PATH.tmp-PID-N: the PID in decimal, then a dash.
+    const std::string rest = name.substr(prefix.size());
+    const auto dash = rest.find('-');
+    if (dash == std::string::npos || dash == 0 || dash > 9) continue;
+    if (!std::all_of(rest.begin(), rest.begin() + dash,
+                     [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(rest.substr(0, dash)));
+    // kill(pid, 0) fails with ESRCH only when no such process exists; a running process (even
+    // one that reused the PID) keeps its file.
+    if (pid <= 0 || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    if (fs::remove(entry.path(), error)) ++removed;
+  }
+  return removed;
+}
+
+std::string home_collision(const core::Cell& cell) {
+  const core::CellScene scene = core::build_cell_scene(cell, {.human_moves = true});
+  core::CollisionData data(scene.model);
+  core::set_cell_state(cell, scene, data, cell.home_configuration(cell.spec().gripper.jaw_max),
+                       cell.human_neutral());
+  core::CollisionPair pair;
+  return core::in_collision(scene.model, data, &pair) ? core::describe_pair(scene.model, pair) : "";
 }
 
 }  // namespace hila::tools
