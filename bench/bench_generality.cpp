@@ -323,8 +323,7 @@ std::string start_collision(const online::PlannerModel& model, const online::Sce
 
 PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& model,
                      const online::BoardPlanSettings& settings, const online::Scene& scene,
-                     const core::PartSpec& part, double deadline_s,
-                     const online::BoardPlanOptions& options = {}) {
+                     const core::PartSpec& part, double deadline_s) {
   PartResult r;
   r.name = part.name;
   r.order = part.order;
@@ -345,7 +344,7 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
                         std::chrono::microseconds(static_cast<long>(deadline_s * 1e6));
   online::BoardPlan plan;
   try {
-    plan = planner.plan(scene, part.name, deadline, options);
+    plan = planner.plan(scene, part.name, deadline);
   } catch (const std::exception& e) {
     // The planner reports failures as statuses; an exception is a bug worth seeing.
     r.status = "error";
@@ -477,15 +476,7 @@ std::vector<PartResult> plan_all(online::BoardPlanner& planner, const online::Pl
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const auto& part = parts[k];
     if (scene.is_finished(part.name)) continue;
-    // As `hila plan --all`: the tool goes back on its stand when the next part is the other
-    // arm's to pick by suction.
-    online::BoardPlanOptions options;
-    for (std::size_t n = k + 1; n < parts.size(); ++n) {
-      if (scene.is_finished(parts[n].name)) continue;
-      options.return_tool = model.suction_arm(parts[n].name) != model.suction_arm(part.name);
-      break;
-    }
-    PartResult r = plan_part(planner, model, settings, scene, part, deadline_s, options);
+    PartResult r = plan_part(planner, model, settings, scene, part, deadline_s);
     std::cerr << "  " << label << part.name << ": " << r.status << " " << fixed(r.plan_s, 2) << " s"
               << (r.delivered ? "" : "  (" + r.cause + ")")
               << (r.delivered && !r.recheck_valid ? "  !!! INVALID" : "")

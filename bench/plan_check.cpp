@@ -142,8 +142,73 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
   };
 
   double clock = -1e300;
+  // The tool put back first by the arm holding it (BoardPlan::tool_put_back_steps), checked in a
+  // world where that arm carries the tool; the board lies where it was detected meanwhile.
+  const auto put_back = static_cast<std::size_t>(std::max(0, plan.tool_put_back_steps));
+  if (put_back > 0) {
+    const online::World holder_world(cell, product, scene, plan.board, plan.tool_put_back_arm);
+    core::CollisionData holder_data = holder_world.make_data();
+    const core::Arm& holder =
+        cell.arms()[static_cast<std::size_t>(holder_world.stage().suction_arm)];
+    bool held = scene.tool_in_hand && scene.tool_arm == holder.spec.name;
+    if (!held || &holder == &suction || put_back > plan.steps.size()) {
+      problem(plan.board, "puts back a tool the other arm does not hold");
+      return out;
+    }
+    for (std::size_t i = 0; i < put_back; ++i) {
+      const online::PlanStep& step = plan.steps[i];
+      ++out.steps;
+      const std::string where = plan.board + ": " + step.name;
+      if (step.arm != holder.spec.name || step.q.empty() || step.q.size() != step.time.size()) {
+        problem(where, "expected the arm holding the tool and one time per waypoint");
+        return out;
+      }
+      const Eigen::VectorXd now = cell.arm_joints(robot_q, holder);
+      if (step.q.front().size() != now.size() || (step.q.front() - now).norm() > 1e-6) {
+        problem(where, "starts away from where its arm is");
+      }
+      if (step.time.front() < clock - 1e-9) problem(where, "starts before the previous step ends");
+      clock = step.time.back();
+      const auto events = split_events(step.event);
+      const bool released =
+          std::find(events.begin(), events.end(), "tool_released") != events.end();
+      for (const auto& e : events) {
+        if (e != "tool_released")
+          problem(where, "unexpected event '" + e + "' putting the tool back");
+      }
+      online::Motion motion;
+      motion.arm = holder.spec.name;
+      motion.time = step.time;
+      motion.q = step.q;
+      motion.robot_q = robot_q;
+      motion.board_world = board_world;
+      motion.tool_in_hand = held;
+      motion.tool_world = scene.tool;
+      motion.end_in_contact = released;
+      const online::ValidationReport report =
+          online::validate_motion(holder_world, holder_data, motion, settings.validator);
+      out.samples += report.samples;
+      for (const auto& v : report.violations) {
+        std::ostringstream s;
+        s.precision(3);
+        s << v.kind << " at " << v.time << " s: " << v.detail;
+        problem(where, s.str());
+      }
+      cell.set_arm(robot_q, holder, step.q.back());
+      if (released) {
+        if (!held) problem(where, "sets down a tool it does not hold");
+        const std::string off =
+            pose_error(tcp_of(holder) * cell.spec().suction.handle_in_tcp, scene.tool);
+        if (!off.empty()) problem(where, "sets the tool down " + off + " its place");
+        held = false;
+        cell.set_jaw(robot_q, holder, cell.spec().gripper.jaw_max);
+      }
+    }
+    if (held) problem(plan.board, "the tool put back first is still in hand");
+  }
   bool lifting = false;  // the step after a pick starts with the object still on the table
-  for (const online::PlanStep& step : plan.steps) {
+  for (std::size_t index = put_back; index < plan.steps.size(); ++index) {
+    const online::PlanStep& step = plan.steps[index];
     ++out.steps;
     const std::string where = plan.board + ": " + step.name;
     const core::Arm* arm = step.arm == suction.spec.name     ? &suction

@@ -86,17 +86,14 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (records == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
-  // The tool stays in the hand that used it last; the board's suction arm must be that one.
+  // The tool stays in the hand that used it last. Where that is not the board's suction arm, the
+  // holding arm first puts it on its stand and goes home; the board is planned from there.
   const std::string suction_arm = model_.suction_arm(board);
   result.suction_arm = suction_arm;
   if (scene.tool_in_hand && scene.tool_arm != suction_arm) {
-    return finish(BoardPlanStatus::kNoGoal,
-                  "the suction tool is in the " + scene.tool_arm + " arm's hand, and the " +
-                      "database gives '" + board + "' to the " + suction_arm +
-                      " arm's suction: put the tool on its stand first (handing the tool " +
-                      "between the arms is not planned)");
+    return plan_after_tool_put_back(scene, *part, *records, deadline, options, started);
   }
-  Run run(model_, settings_, scene, *part, *records, deadline, lazy_prm_);
+  Run run(model_, settings_, scene, *part, *records, suction_arm, deadline, lazy_prm_);
   running = &run;
   // Payload. The exchange: the suction arm carries the board on the tool, the receiving arm in
   // its jaws. A direct pick: the picking arm in its jaws. A way over an arm's payload is not
@@ -409,6 +406,63 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                           (any_connected_offline ? ""
                                                  : "; the database connects none of their chains "
                                                    "(hila inspect DB roadmap)"));
+}
+
+BoardPlan BoardPlanner::plan_after_tool_put_back(const Scene& scene, const core::PartSpec& part,
+                                                 const BoardRecords& records,
+                                                 std::chrono::steady_clock::time_point deadline,
+                                                 const BoardPlanOptions& options,
+                                                 std::chrono::steady_clock::time_point started) {
+  // The holding arm plays the suction arm's part for the put-back: its world carries the tool.
+  std::vector<PlanStep> steps;
+  std::string failure;
+  Scene after = scene;
+  int motions = 0, rejected = 0;
+  PlanTimes times;
+  {
+    detail::Run put_back(model_, settings_, scene, part, records, scene.tool_arm, deadline,
+                         lazy_prm_);
+    detail::ArmsState end = put_back.start();
+    failure = put_back.return_tool(scene.initial_pose(part), steps, end);
+    put_back.stop_validation();
+    motions = put_back.motions_planned();
+    rejected = put_back.rejected_motions();
+    times = put_back.times();
+    after.tool_in_hand = false;
+    after.robot[scene.tool_arm] = model_.cell().arm_joints(end.robot_q, put_back.suction_arm());
+  }
+  BoardPlan result;
+  if (!failure.empty()) {
+    result.board = part.name;
+    result.suction_arm = model_.suction_arm(part.name);
+    result.status = BoardPlanStatus::kNoGoal;
+    result.reason = "the suction tool is in the " + scene.tool_arm + " arm's hand, and '" +
+                    part.name + "' is the " + result.suction_arm +
+                    " arm's to pick by suction, but the tool cannot be put back on its stand (" +
+                    failure + ")";
+  } else {
+    result = plan(after, part.name, deadline, options);
+  }
+  result.motions_planned += motions;
+  result.rejected_motions += rejected;
+  result.times.motions += times.motions;
+  result.times.smoothing += times.smoothing;
+  result.times.validation += times.validation;
+  result.times.queued_validation += times.queued_validation;
+  result.times.queued_smoothing += times.queued_smoothing;
+  result.planning_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!result.solved() || steps.empty()) return result;
+  const double clock = steps.back().time.back();
+  for (PlanStep& s : result.steps) {
+    for (double& t : s.time) t += clock;
+  }
+  for (const PlanStep& s : steps) result.path_length += s.path_length;
+  result.duration += clock;
+  result.steps.insert(result.steps.begin(), steps.begin(), steps.end());
+  result.tool_put_back_steps = static_cast<int>(steps.size());
+  result.tool_put_back_arm = scene.tool_arm;
+  return result;
 }
 
 }  // namespace hila::online

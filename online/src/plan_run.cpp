@@ -86,7 +86,7 @@ Eigen::VectorXd in_roadmap_box(const core::Arm& arm, Eigen::VectorXd q) {
 }
 
 Run::Run(const PlannerModel& model, const BoardPlanSettings& settings, const Scene& scene,
-         const core::PartSpec& part, const BoardRecords& records,
+         const core::PartSpec& part, const BoardRecords& records, const std::string& suction_arm,
          std::chrono::steady_clock::time_point deadline,
          std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>>& lazy_prm)
     : model_(model),
@@ -102,8 +102,7 @@ Run::Run(const PlannerModel& model, const BoardPlanSettings& settings, const Sce
       filters_(records.filters),
       node_by_id_(records.node_by_id),
       edges_(records.regrasp_edges),
-      world_(cell_, model.product(), scene, part.name,
-             records.suction_arm.empty() ? kDefaultSuctionArm : records.suction_arm),
+      world_(cell_, model.product(), scene, part.name, suction_arm),
       suction_(cell_.arms()[static_cast<std::size_t>(world_.stage().suction_arm)]),
       receiving_(cell_.arms()[world_.stage().suction_arm == 0 ? 1u : 0u]),
       suction_planner_(world_, model.roadmap(suction_.spec.name), suction_.spec.name,
@@ -126,7 +125,7 @@ Run::Run(const PlannerModel& model, const BoardPlanSettings& settings, const Sce
     const auto it = scene.robot.find(arm.spec.name);
     if (it != scene.robot.end()) cell_.set_arm(start_.robot_q, arm, it->second);
   }
-  // The board planner plans no board whose suction arm is not the one holding the tool.
+  // The tool in the other arm's hand is put back first (BoardPlanner::plan).
   start_.tool_in_hand = scene.tool_in_hand && scene.tool_arm == suction_.spec.name;
 }
 

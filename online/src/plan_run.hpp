@@ -118,7 +118,7 @@ inline constexpr std::array<std::string_view, 3> kWayBackSteps = {
 class Run {
  public:
   Run(const PlannerModel& model, const BoardPlanSettings& settings, const Scene& scene,
-      const core::PartSpec& part, const BoardRecords& records,
+      const core::PartSpec& part, const BoardRecords& records, const std::string& suction_arm,
       std::chrono::steady_clock::time_point deadline,
       std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>>& lazy_prm);
 
@@ -126,6 +126,7 @@ class Run {
   const std::map<std::int64_t, db::RobotHandoverRecord>& handovers() const { return handovers_; }
   const core::Arm& suction_arm() const { return suction_; }
   const core::Arm& receiving_arm() const { return receiving_; }
+  const ArmsState& start() const { return start_; }  // the robot and the tool as the scene has them
   // The run's times so far, the validator's own time on either thread included.
   int rejected_motions() const { return rejected_motions_; }
   int motions_planned() const { return motions_planned_; }
@@ -530,9 +531,9 @@ class Run {
   PlanTimes times_;
   std::optional<Stage> tool_;
   std::optional<Stage> tool_down_;
-  std::optional<Stage> tool_return_;  // return_tool's, once a way is planned
-  std::map<std::int64_t, Stage> picks_;                              // by suction grasp
-  std::map<std::int64_t, Stage> transfers_;                          // by robot handover
+  std::optional<Stage> tool_return_;         // return_tool's, once a way is planned
+  std::map<std::int64_t, Stage> picks_;      // by suction grasp
+  std::map<std::int64_t, Stage> transfers_;  // by robot handover
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> receives_;  // by (handover, grasp)
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> releases_;
   std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, Stage> presents_;

@@ -1,8 +1,9 @@
 // Roles per board: the cabinet's back_upper laid on the left of the table, where only the left arm
 // picks it by suction, with the tool standing where both arms reach it. The build gives that
 // board to the left arm's suction (offline::HandoverSettings::swap_roles); the board before it
-// is the right arm's, which puts the tool back on its stand (BoardPlanOptions::return_tool) so
-// that the left arm can take it; the right arm receives back_upper and delivers it.
+// is the right arm's, which puts the tool back on its stand (BoardPlanOptions::return_tool, or
+// first thing in back_upper's plan) so that the left arm can take it; the right arm receives
+// back_upper and delivers it.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -48,7 +49,10 @@ std::string product_with_a_board_on_the_left(const std::string& dir) {
 std::string events_of(const online::BoardPlan& plan, Eigen::VectorXd& robot_q,
                       const core::Cell& cell) {
   std::string events;
+  double clock = 0.0;
   for (const auto& step : plan.steps) {
+    EXPECT_GE(step.time.front(), clock - 1e-9) << step.name << " starts before the last ends";
+    clock = step.time.back();
     const core::Arm& arm = cell.arm(step.arm);
     EXPECT_TRUE(step.q.front().isApprox(cell.arm_joints(robot_q, arm), 1e-9)) << step.name;
     cell.set_arm(robot_q, arm, step.q.back());
@@ -84,13 +88,24 @@ TEST(SwappedRoles, ABoardOnlyTheLeftArmPicksBySuctionIsDeliveredByTheRightArm) {
   scene.tool_arm = "right";
   online::BoardPlanner planner(*model);
 
-  // back_upper now: the tool is in the wrong hand, and the status says so.
+  // back_upper now, the tool in the right hand: the right arm puts it back on its stand and goes
+  // home first, then the left arm takes it, as below.
   {
     const online::Scene early = scene.with_finished(model->product(), "top");
-    const online::BoardPlan refused = planner.plan(early, "back_upper", in_seconds(30));
-    EXPECT_EQ(refused.status, online::BoardPlanStatus::kNoGoal);
-    EXPECT_NE(refused.reason.find("the suction tool is in the right arm's hand"), std::string::npos)
-        << refused.reason;
+    const online::BoardPlan first = planner.plan(early, "back_upper", in_seconds(60));
+    ASSERT_TRUE(first.solved()) << first.reason;
+    EXPECT_TRUE(first.validated);
+    EXPECT_EQ(first.suction_arm, "left");
+    EXPECT_EQ(first.tool_put_back_arm, "right");
+    ASSERT_EQ(first.tool_put_back_steps, 4);
+    for (int i = 0; i < first.tool_put_back_steps; ++i) EXPECT_EQ(first.steps[i].arm, "right");
+    EXPECT_EQ(first.steps[3].name, "tool_to_home_empty");
+    Eigen::VectorXd q = model->cell().home_configuration();
+    const std::string events = events_of(first, q, model->cell());
+    EXPECT_EQ(events.rfind("right:tool_released left:tool_grasped left:suction_on ", 0), 0u)
+        << events;
+    EXPECT_NE(events.find("right:wait_for_human right:gripper_open"), std::string::npos) << events;
+    EXPECT_NEAR(first.duration, first.steps.back().time.back(), 1e-12);
   }
 
   // top, the tool put back at the end.

@@ -87,12 +87,18 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                            {"to", plan.delivering_arm},
                            {"board", pose_to_json(plan.robot_handover)}});
     }
-    j["mode"] = {{"way", online::to_string(plan.mode)},
-                 {"pick",
-                  {{"arm", plan.picking_arm},
-                   {"by", plan.mode == online::DeliveryMode::kExchange ? "suction" : "gripper"}}},
-                 {"exchanges", exchanges},
-                 {"delivered_by", plan.delivering_arm}};
+    j["mode"] = {
+        {"way", online::to_string(plan.mode)},
+        {"pick",
+         {{"arm", plan.picking_arm},
+          {"by", plan.mode == online::DeliveryMode::kExchange ? "suction" : "gripper"}}},
+        {"exchanges", exchanges},
+        {"delivered_by", plan.delivering_arm},
+        {"suction_tool", {{"arm", plan.suction_arm}, {"in_hand_after", plan.tool_in_hand_after}}}};
+    if (plan.tool_put_back_steps > 0) {
+      j["mode"]["suction_tool"]["put_back_first"] = {{"arm", plan.tool_put_back_arm},
+                                                     {"steps", plan.tool_put_back_steps}};
+    }
     if (plan.mode == online::DeliveryMode::kRegrasp) {
       j["mode"]["set_down"] = {{"board", pose_to_json(plan.set_down)},
                                {"pick_grasp", plan.pick_grasp_id},
@@ -169,11 +175,8 @@ int run_plan(const PlanOptions& opt) {
     const std::string& board = boards[k];
     const auto deadline = std::chrono::steady_clock::now() +
                           std::chrono::microseconds(static_cast<long>(opt.deadline_s * 1e6));
-    // The tool goes back on its stand when the next board is the other arm's to pick by suction.
-    online::BoardPlanOptions options;
-    options.return_tool =
-        k + 1 < boards.size() && model->suction_arm(boards[k + 1]) != model->suction_arm(board);
-    const online::BoardPlan plan = planner.plan(scene, board, deadline, options);
+    // Where the tool is in the other arm's hand, the plan begins by putting it back on its stand.
+    const online::BoardPlan plan = planner.plan(scene, board, deadline);
     out["boards"].push_back(plan_json(plan));
     if (!opt.json) {
       std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;

@@ -164,7 +164,11 @@ struct BoardPlan {
   Eigen::VectorXd robot_q_after;    // the robot when the board has been taken
   bool tool_in_hand_after = false;  // an arm still holds the tool then: suction_arm
   std::string suction_arm;          // the arm that holds the tool in this plan
-  std::string tool_kept;            // why the tool was not put back (BoardPlanOptions::return_tool)
+  // Where the scene had the tool in the other arm's hand: that arm (tool_put_back_arm) puts it on
+  // its stand and goes home in the plan's first tool_put_back_steps steps, before the board's own.
+  int tool_put_back_steps = 0;
+  std::string tool_put_back_arm;
+  std::string tool_kept;  // why the tool was not put back (BoardPlanOptions::return_tool)
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };
 
@@ -198,6 +202,14 @@ class BoardPlanner {
                  const BoardPlanOptions& options = {});
 
  private:
+  // plan() where the scene has the tool in the other arm's hand: that arm puts it on its stand
+  // and goes home, then the board is planned from there; the plan begins with those steps.
+  BoardPlan plan_after_tool_put_back(const Scene& scene, const core::PartSpec& part,
+                                     const BoardRecords& records,
+                                     std::chrono::steady_clock::time_point deadline,
+                                     const BoardPlanOptions& options,
+                                     std::chrono::steady_clock::time_point started);
+
   const PlannerModel& model_;
   BoardPlanSettings settings_;
   // The LazyPRM baseline's roadmaps, kept between queries (settings.motion.planner kLazyPrm).
