@@ -419,6 +419,9 @@ Limit limit_of(const PartResult& r) {
   if (no_gripper && has("no suction grasp")) {
     return {true, "physical: no face for the cup, and no gripper takes it where it lies"};
   }
+  if (has("out of both arms' reach")) {
+    return {true, "physical: out of both arms' reach where the human takes it comfortably"};
+  }
   if (no_gripper && has("cannot pick the part by suction")) {
     return {false,
             "hila: the tool's arm cannot pick it by suction, no gripper takes it where it lies "

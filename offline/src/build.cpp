@@ -274,13 +274,14 @@ std::string settings_hash(const BuildSettings& s) {
        << s.comfort.spacing << ' ' << s.comfort.orientations << ' ' << s.comfort.samples << '\n';
   const auto& h = s.handover;
   text << "handover " << h.candidates << ' ' << h.max_draws << ' ' << h.max_rotation_deg << ' '
-       << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.two_hand_separation << ' '
-       << h.rotation_weight << ' ' << h.suction_arm << ' ' << h.receiving_arm << ' '
-       << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored << ' ' << h.rr_per_grasp
-       << ' ' << h.human_ik_goals << ' ' << h.direct << ' ' << h.direct_stored << ' ' << h.pick_lift
-       << ' ' << h.pick_resolution << ' ' << h.exchange_approach << ' ' << h.exchange_resolution
-       << ' ' << h.table_regrasp.enabled << ' ' << h.table_regrasp.placements << ' '
-       << h.table_regrasp.yaws << ' ' << h.table_regrasp.support_tolerance << ' ' << h.swap_roles;
+       << h.max_offset << ' ' << h.comfort_threshold << ' ' << h.comfort_floor << ' '
+       << h.two_hand_separation << ' ' << h.rotation_weight << ' ' << h.suction_arm << ' '
+       << h.receiving_arm << ' ' << h.rr_orientations << ' ' << h.rr_poses << ' ' << h.shared_stored
+       << ' ' << h.rr_per_grasp << ' ' << h.human_ik_goals << ' ' << h.direct << ' '
+       << h.direct_stored << ' ' << h.pick_lift << ' ' << h.pick_resolution << ' '
+       << h.exchange_approach << ' ' << h.exchange_resolution << ' ' << h.table_regrasp.enabled
+       << ' ' << h.table_regrasp.placements << ' ' << h.table_regrasp.yaws << ' '
+       << h.table_regrasp.support_tolerance << ' ' << h.swap_roles;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg

@@ -25,6 +25,8 @@ namespace hila::offline {
 namespace {
 
 const core::Pose kParked = core::Pose(Eigen::Translation3d(100.0, 100.0, 100.0));
+// Candidates (the nearest by Eq. 8) a part with no goal is checked at for either arm's reach.
+constexpr std::size_t kReachCensus = 200;
 // The human's fingers open this much wider than the grasp's aperture around the board.
 constexpr double kHandOpeningMargin = 0.01;
 const Eigen::Vector3d kDown(0.0, 0.0, -1.0);
@@ -312,6 +314,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   const double max_rotation = core::deg_to_rad(settings.max_rotation_deg);
   std::vector<HumanChoice> choices;
   double best_q = 0.0;
+  // S's threshold: comfort_threshold, lowered towards comfort_floor for a part with no goal.
+  double threshold = settings.comfort_threshold;
   auto sample_candidates = [&](int until) {
     while (static_cast<int>(result.candidates.size()) < until && stage.draws < settings.max_draws) {
       ++stage.draws;
@@ -342,10 +346,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         c.second_quality = h.second_quality;
       }
       if (h.default_quality > settings.comfort_threshold) ++stage.comfortable_default_body;
-      if (h.quality > settings.comfort_threshold) {
-        ++stage.comfortable;
-        c.status = "no_shared_grasp";
-      }
+      if (h.quality > settings.comfort_threshold) ++stage.comfortable;
+      if (h.quality > threshold) c.status = "no_shared_grasp";
       result.candidates.push_back(c);
       choices.push_back(h);
     }
@@ -767,8 +769,75 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                           suction_arm.spec.name + " arm goes home)";
     }
   }
+  // Whether either arm's gripper could hold the part at the candidates the human takes
+  // comfortably at all, however it got there ("; ..." for a failure): where neither can, no way
+  // from where the part lies would help (out of both arms' reach).
+  auto reach_census = [&]() -> std::string {
+    std::vector<int> census;
+    for (std::size_t i = 0; i < result.candidates.size(); ++i) {
+      if (choices[i].grasp >= 0 && choices[i].quality > threshold)
+        census.push_back(static_cast<int>(i));
+    }
+    std::stable_sort(census.begin(), census.end(), [&](int a, int b) {
+      return result.candidates[static_cast<std::size_t>(a)].distance <
+             result.candidates[static_cast<std::size_t>(b)].distance;
+    });
+    census.resize(std::min<std::size_t>(census.size(), kReachCensus));
+    std::map<const core::Arm*, int> held_at;  // census candidates each arm's gripper holds it at
+    for (const core::Arm* a : {&receiving_arm, &suction_arm}) {
+      int& count = held_at[a];
+      std::vector<int> bodies;
+      for (std::size_t k = 0; k < cell.arms().size(); ++k) {
+        if (&cell.arms()[k] == a) bodies = scene.cell.arm_bodies[k];
+      }
+      bodies.push_back(scene.board);
+      const core::Pose base_inv = core::arm_base_in_world(cell, *a).inverse();
+      for (const int ci : census) {
+        const auto& c = result.candidates[static_cast<std::size_t>(ci)];
+        const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
+        reset_state();
+        // The suction arm's gripper holds parts only with the tool on its stand.
+        if (a == &suction_arm) {
+          core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                               product.suction_tool_pose);
+        }
+        data.set_body_pose(scene.board, c.board);
+        const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
+        place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
+        if (h.second_grasp >= 0) {
+          const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+          place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
+        }
+        for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+          Receiving r;
+          if (reach_with(*a, base_inv, c.board, g, bodies, false, r)) {
+            ++count;
+            break;
+          }
+        }
+        restore_arm(*a);
+      }
+    }
+    reset_state();
+    std::string why;
+    if (!census.empty()) {
+      const std::string n = std::to_string(census.size());
+      if (held_at[&receiving_arm] == 0 && held_at[&suction_arm] == 0) {
+        why +=
+            "; out of both arms' reach: neither arm's gripper holds the part (within its "
+            "slip limit, clear of the human's hands) at any of the " +
+            n + " nearest candidates the human takes comfortably";
+      } else {
+        why += "; the " + receiving_arm.spec.name + " arm's gripper would hold it at " +
+               std::to_string(held_at[&receiving_arm]) + " of the " + n +
+               " nearest candidates the human takes comfortably, the " + suction_arm.spec.name +
+               " arm's at " + std::to_string(held_at[&suction_arm]);
+      }
+    }
+    return why;
+  };
   if (!exchange_failure.empty() && direct_arms.empty()) {
-    return finish(exchange_failure + "; " + direct_failure);
+    return finish(exchange_failure + "; " + direct_failure + reach_census());
   }
 
   // --- 𝕊: members of S sharing a grasp with a robot-robot pose, in Eq. 8 order -------------
@@ -785,6 +854,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     return core::best_comfort(chain, hand, seed, ik_settings);
   };
   int verified = 0;
+  int human_ik_rejected = 0;  // candidates a way served that the human's own IK then rejected
   // At the robot-human pose the receiving arm and the board it holds move against the rest.
   std::vector<int> rh_bodies = receiving_bodies;
   rh_bodies.push_back(scene.board);
@@ -922,12 +992,12 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
         const double q =
             h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
-        if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) ||
-            q <= settings.comfort_threshold) {
+        if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) || q <= threshold) {
           // Not comfortable after all: out of S, and its shared grasps go.
           c.status = "uncomfortable";
           c.quality = q;
-          --stage.comfortable;
+          ++human_ik_rejected;
+          if (threshold == settings.comfort_threshold) --stage.comfortable;
           result.shared.erase(
               std::remove_if(result.shared.begin(), result.shared.end(),
                              [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; }),
@@ -962,6 +1032,23 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     sample_candidates(std::min(settings.max_candidates, stage.candidates + settings.candidates));
     search_shared();
   }
+  // No goal: the candidates down to comfort_floor, in two steps, the human's IK confirming each
+  // as before (a candidate it found below the old threshold may pass the new one).
+  for (const double relaxed :
+       {0.5 * (settings.comfort_threshold + settings.comfort_floor), settings.comfort_floor}) {
+    if (stage.goals > 0 || relaxed >= threshold) break;
+    threshold = relaxed;
+    for (std::size_t i = 0; i < result.candidates.size(); ++i) {
+      auto& c = result.candidates[i];
+      const HumanChoice& h = choices[i];
+      if (c.status == "uncomfortable" && h.grasp >= 0 && h.quality > threshold) {
+        c.status = "no_shared_grasp";
+        c.quality = h.quality;
+      }
+    }
+    searched = 0;
+    search_shared();
+  }
   // Eq. 8 ranks over every batch.
   std::vector<db::HandoverCandidateRecord*> goals;
   for (auto& c : result.candidates) {
@@ -993,6 +1080,15 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     } else {
       why += "; " + direct_failure;
     }
+    if (threshold < settings.comfort_threshold) {
+      why += "; none either down to comfort Q " + core::format_number(threshold);
+    }
+    if (human_ik_rejected > 0) {
+      why += "; the human's arm IK found the " + std::to_string(human_ik_rejected) +
+             " candidates a way served uncomfortable after all (the comfort maps' Q too high "
+             "there)";
+    }
+    why += reach_census();
     return finish(why);
   }
   // Shared grasps by goal rank.

@@ -316,6 +316,52 @@ TEST(Handover, NoRobotRobotPoseFailsWithAReason) {
   EXPECT_NE(r.stage.failure.find("no robot-robot handover pose"), std::string::npos)
       << r.stage.failure;
   for (const auto& c : r.candidates) EXPECT_NE(c.status, "goal");
+  // The arms do reach the part where the human takes it: the way from the stack is missing.
+  EXPECT_NE(r.stage.failure.find("the left arm's gripper would hold it at"), std::string::npos)
+      << r.stage.failure;
+  EXPECT_EQ(r.stage.failure.find("out of both arms' reach"), std::string::npos) << r.stage.failure;
+}
+
+TEST(Handover, APartWithNoGoalAboveTheThresholdGetsTheMostComfortableBelowIt) {
+  // back_lower's goals at the default threshold; then the threshold raised above every goal's Q:
+  // without the floor no goal, with it the goals come back from below, each one of the default's.
+  const auto cell = test::reference_cell();
+  const auto grasps = board_grasps(2);
+  offline::HandoverSettings settings;
+  settings.candidates = 200;
+  settings.max_candidates = 200;
+  settings.comfort_floor = settings.comfort_threshold;  // off
+  const auto plain = offline::plan_handover_goals(*cell, product(), 2, grasps, comfort(), settings);
+  ASSERT_GT(plain.stage.goals, 0) << plain.stage.failure;
+  double best = 0.0;
+  std::map<int, double> plain_goals;  // sample -> Q
+  for (const auto& c : plain.candidates) {
+    if (c.status != "goal") continue;
+    best = std::max(best, c.quality);
+    plain_goals[c.sample] = c.quality;
+  }
+  offline::HandoverSettings high = settings;
+  high.comfort_threshold = best + 1e-3;
+  high.comfort_floor = high.comfort_threshold;
+  const auto none = offline::plan_handover_goals(*cell, product(), 2, grasps, comfort(), high);
+  EXPECT_EQ(none.stage.goals, 0);
+  EXPECT_EQ(none.stage.failure.find("none either down to comfort Q"), std::string::npos);
+
+  high.comfort_floor = settings.comfort_threshold;
+  const auto relaxed = offline::plan_handover_goals(*cell, product(), 2, grasps, comfort(), high);
+  ASSERT_GT(relaxed.stage.goals, 0) << relaxed.stage.failure;
+  EXPECT_EQ(relaxed.stage.failure, "");
+  EXPECT_EQ(relaxed.stage.comfortable, none.stage.comfortable);  // |S| at the stated threshold
+  int ranked = 0;
+  for (const auto& c : relaxed.candidates) {
+    if (c.status != "goal") continue;
+    EXPECT_EQ(plain_goals.count(c.sample), 1u) << "goal " << c.sample << " is not a default goal";
+    EXPECT_GT(c.quality, settings.comfort_threshold);
+    EXPECT_LE(c.quality, high.comfort_threshold);
+    EXPECT_GE(c.rank, 0);
+    ++ranked;
+  }
+  EXPECT_EQ(ranked, relaxed.stage.goals);
 }
 
 TEST(Handover, ACellWithoutAnalyticIkIsAClearError) {

@@ -26,6 +26,12 @@ struct HandoverSettings {
   // (a 7-DoF arm with the reach as length scale); 0.06 keeps the better ~40 % of the reachable
   // hand poses.
   double comfort_threshold = 0.06;
+  // A part with no goal above comfort_threshold (the comfortable candidates out of the delivering
+  // arm's reach, or the human's own inverse kinematics finding the maps' Q too high there) gets
+  // the goals it has down to this Q, in two steps (halfway, then here): delivered as comfortably
+  // as the cell allows rather than left on the table for the human to fetch. Equal to
+  // comfort_threshold: off.
+  double comfort_floor = 0.02;
   double two_hand_separation = 0.20;  // m between the two hands' grasp points (two-hand boards)
   // Eq. 8: distance = position offset + rotation_weight * rotation angle (m per rad): 10 degrees
   // count as 3.5 cm.
