@@ -287,8 +287,9 @@ struct PartResult {
   double duration = 0.0;
   double path_length = 0.0;
   std::string start_collision;  // the part at its start pose touches this (empty: nothing)
-  std::string way;              // "exchange" or "direct" (delivered parts)
+  std::string way;              // "exchange", "direct" or "regrasp" (delivered parts)
   std::string delivering_arm;
+  double quality = 0.0;            // the human's comfort Q at the goal delivered to (paper Eq. 4)
   bool tool_in_hand_after = true;  // the suction arm holds the tool after the part
   std::string tool_arm = online::kDefaultSuctionArm;  // the arm holding it then
 };
@@ -355,6 +356,7 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
   r.delivered = plan.solved();
   if (r.delivered) {
     r.way = online::to_string(plan.mode);
+    r.quality = plan.quality;
     r.delivering_arm = plan.delivering_arm;
     r.tool_in_hand_after = plan.tool_in_hand_after;
     r.tool_arm = plan.suction_arm;
@@ -459,6 +461,9 @@ nlohmann::json part_json(const PartResult& r) {
     j["invalidity"] = r.invalidity;
     j["duration_s"] = r.duration;
     j["path_length_rad"] = r.path_length;
+    j["way"] = r.way;
+    j["delivering_arm"] = r.delivering_arm;
+    j["quality"] = r.quality;
   } else {
     const Limit limit = limit_of(r);
     j["cause"] = r.cause;
@@ -651,6 +656,9 @@ int run_products(const Options& opt) {
   std::map<std::string, int> causes;
   std::map<std::string, int> limits;  // Limit::what of the undelivered parts
   int physical = 0;
+  // Delivered at a goal below the build's comfort threshold (HandoverSettings::comfort_floor).
+  const double threshold = offline::HandoverSettings{}.comfort_threshold;
+  int below_threshold = 0;
   std::map<std::string, std::pair<int, int>> by_kind;  // delivered, parts
   for (const auto& pr : results) {
     if (!pr.error.empty()) ++errors;
@@ -662,6 +670,7 @@ int run_products(const Options& opt) {
       plan_all_s.push_back(p.plan_s);
       if (p.delivered) {
         plan_s.push_back(p.plan_s);
+        below_threshold += p.quality <= threshold;
       } else {
         ++causes[p.cause];
         const Limit limit = limit_of(p);
@@ -719,6 +728,9 @@ int run_products(const Options& opt) {
     std::cout << "| " << kind << " | " << k.first << "/" << k.second << " |\n";
   }
 
+  std::cout << "\nDelivered below the comfort threshold (Q <= " << fixed(threshold, 2)
+            << ", goals from the build's fallback down to its comfort floor): " << below_threshold
+            << " of " << delivered << ".\n";
   std::cout << "\nWhy parts were not delivered: " << physical << " of " << parts - delivered
             << " physically impossible in this cell, the rest limits of hila's planner.\n\n";
   print_causes(limits);
@@ -771,6 +783,7 @@ int run_products(const Options& opt) {
                       {"invalid", invalid},
                       {"errors", errors},
                       {"physical", physical},
+                      {"below_comfort_threshold", below_threshold},
                       {"limits", limits},
                       {"causes", causes}};
     out["products"] = nlohmann::json::array();
