@@ -1013,6 +1013,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
           continue;
         }
         ++verified;
+        // Below the stated threshold the goal says how comfortable the human's own IK found it
+        // where that is less than the maps' Q: the plan reports it as delivered below.
+        if (threshold < settings.comfort_threshold) c.quality = std::min(c.quality, q);
         c.human_joints = first.joints;
         c.human_quality = first.quality;
         if (h.second_grasp >= 0) {
