@@ -406,7 +406,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   }
   if (!exchange_failure.empty() && direct_candidates.empty()) return finish(over_payload);
   sample_candidates(settings.candidates);
-  if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates) {
+  // Nothing to search for: no candidate, or none the human takes even at the comfort floor.
+  if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates &&
+      (stage.candidates == 0 || best_q <= std::min(settings.comfort_floor, threshold))) {
     return finish(no_candidate_reason());
   }
 
@@ -1061,7 +1063,12 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                    [](const auto* a, const auto* b) { return a->distance < b->distance; });
   for (std::size_t r = 0; r < goals.size(); ++r) goals[r]->rank = static_cast<int>(r);
 
-  if (!no_candidate_reason().empty()) return finish(no_candidate_reason());
+  if (stage.goals == 0 && !no_candidate_reason().empty()) {
+    return finish(no_candidate_reason() +
+                  (threshold < settings.comfort_threshold
+                       ? "; none either down to comfort Q " + core::format_number(threshold)
+                       : std::string()));
+  }
   if (stage.goals == 0) {
     std::string why = "no comfortable candidate (|S| = " + std::to_string(stage.comfortable) + ")";
     why += exchange_failure.empty()

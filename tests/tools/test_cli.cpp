@@ -338,7 +338,7 @@ TEST(Cli, BuildAndInspectBadInputs) {
   // with the reasons, names each failing board and exits 1.
   const CommandRun strict = run("build " + test::product_path() + " -o " + dir +
                                 "/ok.hila --comfort-samples 20000 --handover-candidates 40 "
-                                "--comfort-threshold 0.99 --roadmap-nodes 200");
+                                "--comfort-threshold 0.99 --comfort-floor 0.99 --roadmap-nodes 200");
   EXPECT_EQ(strict.status, 1) << strict.out;
   EXPECT_NE(strict.out.find("lateral_left: no handover goal: no candidate is comfortable"),
             std::string::npos)

@@ -32,6 +32,7 @@ struct BuildOptions {
   long comfort_samples = core::ComfortMapSettings{}.samples;
   int handover_candidates = offline::HandoverSettings{}.candidates;
   double comfort_threshold = offline::HandoverSettings{}.comfort_threshold;
+  double comfort_floor = offline::HandoverSettings{}.comfort_floor;
   std::string bodies;
   int roadmap_nodes = offline::RoadmapSettings{}.nodes;
   bool if_outdated = false;
@@ -94,6 +95,7 @@ int run_build(const BuildOptions& opt) {
   settings.comfort.samples = opt.comfort_samples;
   settings.handover.candidates = opt.handover_candidates;
   settings.handover.comfort_threshold = opt.comfort_threshold;
+  settings.handover.comfort_floor = opt.comfort_floor;
   settings.roadmap.nodes = opt.roadmap_nodes;
   if (!opt.bodies.empty())
     settings.human_bodies = offline::parse_human_bodies(opt.bodies, "--bodies");
@@ -227,6 +229,12 @@ void add_build_command(CLI::App& app, Action& action) {
   build
       ->add_option("--comfort-threshold", opt->comfort_threshold,
                    "least human comfort Q of a handover goal (S)")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1.0));
+  build
+      ->add_option("--comfort-floor", opt->comfort_floor,
+                   "least comfort Q of the goals of a part with none above --comfort-threshold "
+                   "(the threshold itself: none below it)")
       ->capture_default_str()
       ->check(number_in(0.0, 1.0));
   build->add_option("--bodies", opt->bodies,
