@@ -4,8 +4,10 @@
 #include <map>
 
 #include "atomic_file.hpp"
+#include "digest.hpp"
 #include "hila/db/database.hpp"
 #include "open_checks.hpp"
+#include "schema.hpp"
 #include "sqlite_handle.hpp"
 
 namespace hila::db {
@@ -75,6 +77,12 @@ void migrate_with_steps(const std::string& path, const std::vector<MigrationStep
                          {field, "a writable meta table", ""});
         update.bind_next(std::to_string(from + 1));
         update.run();
+      }
+      if (target_version >= kTableDigestsSince) {
+        // What the writer stores at commit, for the content the file now holds: the file had no
+        // digests to check it against, so they vouch for the migration's result only.
+        write_table_digests(connection, table_digests(connection, path, target_version, rebuild),
+                            {"migration (content digests)", "a writable meta table", rebuild});
       }
       connection.exec("COMMIT", {"(commit)", "a migration that commits", ""});
       connection.close();

@@ -50,6 +50,37 @@ std::string describe_foreign(const std::string& head, std::uintmax_t size) {
   return "a " + std::to_string(size) + "-byte file that is not SQLite (it starts with " + hex + ")";
 }
 
+// The numbers of a dotted version ("0.10.0" -> 0, 10, 0); empty unless it is only that.
+std::vector<long> version_numbers(const std::string& version) {
+  std::vector<long> numbers;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t dot = version.find('.', start);
+    const std::size_t end = dot == std::string::npos ? version.size() : dot;
+    long number = 0;
+    const auto [next, error] =
+        std::from_chars(version.data() + start, version.data() + end, number);
+    if (end == start || error != std::errc() || next != version.data() + end) return {};
+    numbers.push_back(number);
+    if (dot == std::string::npos) return numbers;
+    start = dot + 1;
+  }
+}
+
+// "SELECT column FROM table WHERE rowid = ?" as text ("?" when it cannot be read).
+std::string referencing_value(Connection& connection, const std::string& table,
+                              const std::string& column, std::int64_t rowid) {
+  try {
+    Statement select(connection,
+                     "SELECT quote(\"" + column + "\") FROM \"" + table + "\" WHERE rowid = ?",
+                     {table, "a readable row", ""});
+    select.bind_next(rowid);
+    return select.step() ? select.column_text(0) : "?";
+  } catch (const DatabaseError&) {
+    return "?";
+  }
+}
+
 }  // namespace
 
 std::string rebuild_hint(const std::string& path, const std::map<std::string, std::string>& meta) {
@@ -125,7 +156,9 @@ void check_sqlite_file(const std::string& path) {
 std::unique_ptr<Connection> open_hila_database(const std::string& path) {
   check_sqlite_file(path);
   // READONLY: never creates the file, never writes to it, so opening cannot damage a database.
-  auto connection = std::make_unique<Connection>(path, SQLITE_OPEN_READONLY, path);
+  // NOMUTEX: a connection is used by one thread only, so SQLite need not lock around every call.
+  auto connection =
+      std::make_unique<Connection>(path, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, path);
   const ErrorContext integrity{"(integrity)", "an intact hila database (SQLite)",
                                rebuild_hint(path)};
   {
@@ -200,6 +233,73 @@ void check_schema_version(const std::string& path, int stored, int expected, boo
   }
   throw DatabaseError(path, "meta.schema_version", wanted, written + " (a newer hila)",
                       "upgrade hila, or " + rebuild);
+}
+
+void check_hila_version(const std::string& path, const std::string& stored,
+                        const std::string& expected, const std::string& rebuild) {
+  if (stored == expected) return;
+  const std::vector<long> have = version_numbers(stored);
+  const std::vector<long> want = version_numbers(expected);
+  const bool ordered = !have.empty() && !want.empty();
+  const bool newer = ordered && have > want;
+  std::string got = "one built by hila " + (stored.empty() ? std::string("''") : stored);
+  if (ordered) {
+    got += newer ? " (a newer hila)"
+                 : " (an older hila, whose build differs: hila build --if-outdated rebuilds it)";
+  }
+  throw DatabaseError(path, "meta.hila_version", "a database built by this hila (" + expected + ")",
+                      got, newer ? "upgrade hila, or " + rebuild : rebuild);
+}
+
+void check_references(Connection& connection, const std::string& path, const std::string& fix) {
+  const ErrorContext context{"(foreign keys)", "references that can be checked", fix};
+  {
+    // One row per reference that names no row: table, rowid, parent table, foreign key number.
+    Statement check(connection, "PRAGMA foreign_key_check", context);
+    if (check.step()) {
+      const std::string table = check.column_text(0);
+      const std::int64_t rowid = check.column_int64(1);
+      const std::string parent = check.column_text(2);
+      const std::int64_t key = check.column_int64(3);
+      std::int64_t count = 1;
+      while (check.step()) ++count;
+      std::string column = "?";
+      {
+        Statement list(connection, "SELECT \"from\" FROM pragma_foreign_key_list(?) WHERE id = ?",
+                       context);
+        list.bind_next(table);
+        list.bind_next(key);
+        if (list.step()) column = list.column_text(0);
+      }
+      throw DatabaseError(path, table + "." + column + " (id " + std::to_string(rowid) + ")",
+                          "the id of a " + parent + " row",
+                          referencing_value(connection, table, column, rowid) +
+                              ", which names none (" +
+                              (count == 1 ? std::string("the only reference")
+                                          : "one of " + std::to_string(count) + " references") +
+                              " PRAGMA foreign_key_check finds broken)",
+                          fix);
+    }
+  }
+  // grasp_id names a robot_grasps row for 'gripper', a suction_grasps row for 'suction'.
+  for (const char* table : {"roadmap_filters", "regrasp_nodes"}) {
+    const std::string t = table;
+    Statement check(connection,
+                    "SELECT id, grasp_kind, grasp_id FROM " + t +
+                        " AS r WHERE (grasp_kind = 'gripper' AND NOT EXISTS (SELECT 1 FROM "
+                        "robot_grasps AS g WHERE g.id = r.grasp_id)) OR (grasp_kind = 'suction' "
+                        "AND NOT EXISTS (SELECT 1 FROM suction_grasps AS g WHERE g.id = "
+                        "r.grasp_id)) ORDER BY id LIMIT 1",
+                    {t, "a readable hila table", fix});
+    if (check.step()) {
+      const std::string kind = check.column_text(1);
+      throw DatabaseError(path, t + ".grasp_id (id " + std::to_string(check.column_int64(0)) + ")",
+                          std::string("the id of a ") +
+                              (kind == "gripper" ? "robot_grasps" : "suction_grasps") +
+                              " row (grasp_kind '" + kind + "')",
+                          std::to_string(check.column_int64(2)) + ", which names none", fix);
+    }
+  }
 }
 
 }  // namespace hila::db::detail

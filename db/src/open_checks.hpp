@@ -34,4 +34,15 @@ int stored_schema_version(const std::string& path, const std::map<std::string, s
 void check_schema_version(const std::string& path, int stored, int expected, bool can_migrate,
                           const std::string& rebuild);
 
+// Throws DatabaseError unless meta.hila_version `stored` equals `expected` (the test `hila build
+// --if-outdated` makes): the message says which hila built the file, older or newer when both are
+// dotted numbers, and how to rebuild (or to upgrade hila, for a newer one).
+void check_hila_version(const std::string& path, const std::string& stored,
+                        const std::string& expected, const std::string& rebuild);
+
+// Throws DatabaseError naming the table, column, row id and the missing id when a reference names
+// no row: a foreign key (PRAGMA foreign_key_check, which must return no row) or a grasp_id of
+// roadmap_filters or regrasp_nodes, whose table depends on grasp_kind so SQLite cannot check it.
+void check_references(Connection& connection, const std::string& path, const std::string& fix);
+
 }  // namespace hila::db::detail

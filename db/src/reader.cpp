@@ -1,13 +1,16 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <iterator>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 
 #include "comfort_codec.hpp"
+#include "digest.hpp"
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
 #include "list_codec.hpp"
@@ -23,21 +26,46 @@ namespace {
 using detail::pose_columns;
 using detail::vector_columns;
 
-// Reads rows of `table` in id order; `read_row` gets the row's id and consumes `columns`.
+// What the loaders verify besides their own checks, in the same pass over the rows: each row's
+// storage classes before it is read, and each table's content digest, kept to be compared with
+// the stored ones once everything is loaded (so that damage a loader can name is reported by it).
+struct Verification {
+  std::string path;
+  std::string fix;
+  std::map<std::string, std::string> digests;  // table -> computed content digest
+};
+
+// Starts verifying `table` as read by `select`, which must select all its columns in the schema's
+// order (all the loaders do).
+std::unique_ptr<detail::TableDigest> begin_verifying(Verification& verify,
+                                                     detail::Connection& connection,
+                                                     const std::string& table,
+                                                     const detail::Statement& select) {
+  auto digest = std::make_unique<detail::TableDigest>(verify.path, table, verify.fix, true);
+  digest->begin(connection, select);
+  return digest;
+}
+
+// Reads rows of `table` in id order; `read_row` gets the row's id and consumes `columns` (all the
+// table's columns after id, in the schema's order).
 template <typename Record>
 std::vector<Record> load_rows(
     detail::Connection& connection, const std::string& table, const std::string& columns,
-    const std::string& fix,
+    const std::string& fix, Verification& verify,
     const std::function<void(detail::Statement&, std::int64_t id, Record&)>& read_row) {
   detail::Statement select(connection, "SELECT id, " + columns + " FROM " + table + " ORDER BY id",
                            {table, "a readable hila table", fix});
+  const auto digest = begin_verifying(verify, connection, table, select);
   std::vector<Record> records;
   while (select.step()) {
+    digest->check_row(select);
+    digest->hash_row(select);
     Record record;
     const std::int64_t id = select.next_int64();
     read_row(select, id, record);
     records.push_back(std::move(record));
   }
+  verify.digests[table] = digest->finish();
   return records;
 }
 
@@ -45,8 +73,9 @@ std::vector<Record> load_rows(
 template <typename Record>
 std::vector<Record> load_table(detail::Connection& connection, const std::string& table,
                                const std::string& columns, const std::string& fix,
+                               Verification& verify,
                                const std::function<void(detail::Statement&, Record&)>& read_row) {
-  return load_rows<Record>(connection, table, "part_id, " + columns, fix,
+  return load_rows<Record>(connection, table, "part_id, " + columns, fix, verify,
                            [&](detail::Statement& s, std::int64_t id, Record& record) {
                              record.id = id;
                              record.part_id = s.next_int64();
@@ -87,6 +116,13 @@ Eigen::VectorXd read_joints(detail::Statement& s, const std::string& path, const
                         fix);
   }
   return joints;
+}
+
+// A double as it is stored (17 significant digits), for "got ..." in a DatabaseError.
+std::string exact(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
 }
 
 std::string short_hash(const std::string& hash) {
@@ -136,15 +172,18 @@ Meta parse_meta(const std::string& path, const std::map<std::string, std::string
 // The comfort_maps table. Every size is checked against the others before anything is trusted: a
 // damaged row is a DatabaseError, never a map whose lookups read out of bounds.
 std::vector<ComfortMapRecord> load_comfort_maps(detail::Connection& connection,
-                                                const std::string& path, const std::string& fix) {
+                                                const std::string& path, const std::string& fix,
+                                                Verification& verify) {
   detail::Statement select(connection,
                            "SELECT id, arm, " + vector_columns("origin") +
                                ", spacing, dim_x, dim_y, dim_z, orientation_count, orientations, "
                                "value_bytes, values_deflate, samples, seed, coverage "
                                "FROM comfort_maps ORDER BY id",
                            {"comfort_maps", "a readable hila table", fix});
+  const auto digest = begin_verifying(verify, connection, "comfort_maps", select);
   std::vector<ComfortMapRecord> maps;
   while (select.step()) {
+    digest->check_row(select);
     ComfortMapRecord map;
     const std::int64_t id = select.next_int64();
     map.arm = select.next_text();
@@ -203,8 +242,11 @@ std::vector<ComfortMapRecord> load_comfort_maps(detail::Connection& connection,
     map.samples = select.next_int64();
     map.seed = static_cast<std::uint64_t>(select.next_int64());
     map.coverage = select.next_double();
+    // Hashed with the values inflated above, rather than inflating them again.
+    digest->hash_row(select, &map.values);
     maps.push_back(std::move(map));
   }
+  verify.digests["comfort_maps"] = digest->finish();
   return maps;
 }
 
@@ -274,13 +316,13 @@ std::string nth(const char* what, std::size_t i) {
 // The roadmaps table. Every array's size is checked against the row's counts, and every value
 // (finite numbers, edges joining existing nodes in order) before anything is trusted.
 std::vector<RoadmapRecord> load_roadmaps(detail::Connection& connection, const std::string& path,
-                                         const std::string& fix) {
+                                         const std::string& fix, Verification& verify) {
   RowCheck check(path, "roadmaps", fix);
   return load_rows<RoadmapRecord>(
       connection, "roadmaps",
       "arm, dof, resolution, node_count, edge_count, node_joints, node_gravity, "
       "node_inclination_deg, edge_nodes, edge_length, edge_max_inclination_deg",
-      fix, [&](detail::Statement& s, std::int64_t id, RoadmapRecord& r) {
+      fix, verify, [&](detail::Statement& s, std::int64_t id, RoadmapRecord& r) {
         r.id = id;
         r.arm = s.next_text();
         check.set_row("arm '" + r.arm + "', id " + std::to_string(id));
@@ -344,7 +386,7 @@ std::vector<RoadmapRecord> load_roadmaps(detail::Connection& connection, const s
 // against the bits and ids.
 std::vector<RoadmapFilterRecord> load_roadmap_filters(detail::Connection& connection,
                                                       const std::string& path,
-                                                      const std::string& fix,
+                                                      const std::string& fix, Verification& verify,
                                                       const std::vector<RoadmapRecord>& roadmaps) {
   RowCheck check(path, "roadmap_filters", fix);
   std::map<std::int64_t, const RoadmapRecord*> by_id;
@@ -353,7 +395,7 @@ std::vector<RoadmapFilterRecord> load_roadmap_filters(detail::Connection& connec
       connection, "roadmap_filters",
       "roadmap_id, grasp_kind, grasp_id, theta_c_deg, valid_edges, components, largest_component, "
       "edge_bits, node_component",
-      fix, [&](detail::Statement& s, RoadmapFilterRecord& f) {
+      fix, verify, [&](detail::Statement& s, RoadmapFilterRecord& f) {
         check.set_row("id " + std::to_string(f.id));
         f.roadmap_id = s.next_int64();
         f.grasp_kind = s.next_text();
@@ -441,9 +483,17 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
   Database db;
   db.path_ = path;
   db.meta_ = parse_meta(path, meta_map, version);
+  if (options.expected_hila_version) {
+    detail::check_hila_version(path, db.meta_.hila_version, *options.expected_hila_version, fix);
+  }
   check_hash(path, "cell", "cell_hash", db.meta_.cell_hash, options.expected_cell_hash, fix);
   check_hash(path, "product", "product_hash", db.meta_.product_hash, options.expected_product_hash,
              fix);
+  // While loading, each row's storage classes before its values are read (read as a number, 'abc'
+  // or NULL would pass as 0) and each table's digest; then every reference; last the digests are
+  // compared, so that damage a more specific check can name is reported by it.
+  Verification verify{path, fix, {}};
+  verify.digests["meta"] = detail::table_digest(*connection, path, "meta", fix, true);
 
   {
     detail::Statement select(
@@ -453,7 +503,10 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
             ", triangle_count, " + pose_columns("target") + ", " + pose_columns("initial") +
             " FROM parts ORDER BY id",
         {"parts", "a readable hila table", fix});
+    const auto digest = begin_verifying(verify, *connection, "parts", select);
     while (select.step()) {
+      digest->check_row(select);
+      digest->hash_row(select);
       PartRecord part;
       part.id = select.next_int64();
       part.name = select.next_text();
@@ -461,6 +514,11 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       part.mesh_file = select.next_text();
       part.mesh_hash = select.next_text();
       part.mass = select.next_double();
+      if (!(part.mass > 0.0) || !std::isfinite(part.mass)) {
+        throw DatabaseError(
+            path, "parts.mass (part '" + part.name + "', id " + std::to_string(part.id) + ")",
+            "a mass in kg, finite and > 0", exact(part.mass), fix);
+      }
       part.mass_properties.volume = select.next_double();
       part.mass_properties.com = read_vector(select);
       Eigen::Matrix3d& inertia = part.mass_properties.inertia;
@@ -476,10 +534,11 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       part.initial = read_pose(select, path, "parts", "initial", part.id, fix);
       db.parts_.push_back(std::move(part));
     }
+    verify.digests["parts"] = digest->finish();
   }
 
   db.placements_ = load_table<PlacementRecord>(
-      *connection, "placements", pose_columns("part_in_plane") + ", stability", fix,
+      *connection, "placements", pose_columns("part_in_plane") + ", stability", fix, verify,
       [&](detail::Statement& s, PlacementRecord& r) {
         r.part_in_plane = read_pose(s, path, "placements", "part_in_plane", r.id, fix);
         r.stability = s.next_double();
@@ -489,7 +548,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       pose_columns("tcp") + ", jaw_width, " + vector_columns("contact_1") + ", " +
           vector_columns("normal_1") + ", " + vector_columns("contact_2") + ", " +
           vector_columns("normal_2") + ", quality, friction_torque_capacity, lever, theta_c_deg",
-      fix, [&](detail::Statement& s, RobotGraspRecord& r) {
+      fix, verify, [&](detail::Statement& s, RobotGraspRecord& r) {
         r.tcp = read_pose(s, path, "robot_grasps", "tcp", r.id, fix);
         r.jaw_width = s.next_double();
         r.contact_1 = read_vector(s);
@@ -503,7 +562,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       });
   db.suction_grasps_ = load_table<SuctionGraspRecord>(
       *connection, "suction_grasps",
-      pose_columns("cup") + ", rotation_deg, force_margin, moment_margin", fix,
+      pose_columns("cup") + ", rotation_deg, force_margin, moment_margin", fix, verify,
       [&](detail::Statement& s, SuctionGraspRecord& r) {
         r.cup = read_pose(s, path, "suction_grasps", "cup", r.id, fix);
         r.rotation_deg = s.next_double();
@@ -514,7 +573,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       *connection, "human_grasps",
       pose_columns("hand") + ", aperture, " + vector_columns("contact_1") + ", " +
           vector_columns("contact_2") + ", quality, one_hand_stable",
-      fix, [&](detail::Statement& s, HumanGraspRecord& r) {
+      fix, verify, [&](detail::Statement& s, HumanGraspRecord& r) {
         r.hand = read_pose(s, path, "human_grasps", "hand", r.id, fix);
         r.aperture = s.next_double();
         r.contact_1 = read_vector(s);
@@ -523,13 +582,17 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.one_hand_stable = s.next_int64() != 0;
       });
   db.comfort_maps_loaded_ = options.comfort_maps;
-  if (options.comfort_maps) db.comfort_maps_ = load_comfort_maps(*connection, path, fix);
+  if (options.comfort_maps) {
+    db.comfort_maps_ = load_comfort_maps(*connection, path, fix, verify);
+  } else {
+    detail::check_table_types(*connection, path, "comfort_maps", fix);  // not hashed: not read
+  }
 
   db.handover_stages_ = load_rows<HandoverStageRecord>(
       *connection, "handover_stages",
       "part_id, finished_parts, draws, candidates, comfortable, comfortable_default_body, goals, "
       "robot_handovers, two_hands, failure",
-      fix, [&](detail::Statement& s, std::int64_t, HandoverStageRecord& r) {
+      fix, verify, [&](detail::Statement& s, std::int64_t, HandoverStageRecord& r) {
         r.part_id = s.next_int64();
         r.finished_parts = detail::decode_names(s.next_text());
         r.draws = static_cast<int>(s.next_int64());
@@ -543,7 +606,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       });
   db.robot_handovers_ = load_table<RobotHandoverRecord>(
       *connection, "robot_handovers", pose_columns("board") + ", suction_grasp_id, arm, joints",
-      fix, [&](detail::Statement& s, RobotHandoverRecord& r) {
+      fix, verify, [&](detail::Statement& s, RobotHandoverRecord& r) {
         r.board = read_pose(s, path, "robot_handovers", "board", r.id, fix);
         r.suction_grasp_id = s.next_int64();
         r.arm = s.next_text();
@@ -554,7 +617,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       "sample, " + pose_columns("board") +
           ", distance, quality, status, rank, human_arm, human_grasp_id, human_quality, "
           "second_arm, second_grasp_id, second_quality, human_joints, second_joints",
-      fix, [&](detail::Statement& s, HandoverCandidateRecord& r) {
+      fix, verify, [&](detail::Statement& s, HandoverCandidateRecord& r) {
         r.sample = static_cast<int>(s.next_int64());
         r.board = read_pose(s, path, "handover_candidates", "board", r.id, fix);
         r.distance = s.next_double();
@@ -574,7 +637,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       *connection, "shared_grasps",
       "candidate_id, robot_grasp_id, robot_handover_id, arm, joints_rr, joints_rh, "
       "inclination_rr_deg, inclination_rh_deg",
-      fix, [&](detail::Statement& s, std::int64_t id, SharedGraspRecord& r) {
+      fix, verify, [&](detail::Statement& s, std::int64_t id, SharedGraspRecord& r) {
         r.id = id;
         r.candidate_id = s.next_int64();
         r.robot_grasp_id = s.next_int64();
@@ -589,7 +652,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       *connection, "direct_grasps",
       "candidate_id, robot_grasp_id, arm, joints_pick, joints_rh, inclination_pick_deg, "
       "inclination_rh_deg",
-      fix, [&](detail::Statement& s, std::int64_t id, DirectGraspRecord& r) {
+      fix, verify, [&](detail::Statement& s, std::int64_t id, DirectGraspRecord& r) {
         r.id = id;
         r.candidate_id = s.next_int64();
         r.robot_grasp_id = s.next_int64();
@@ -604,7 +667,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       "candidate_id, pick_grasp_id, robot_grasp_id, arm, " + pose_columns("placement") +
           ", joints_pick, joints_place, joints_repick, joints_rh, inclination_pick_deg, "
           "inclination_place_deg, inclination_repick_deg, inclination_rh_deg",
-      fix, [&](detail::Statement& s, std::int64_t id, TableRegraspRecord& r) {
+      fix, verify, [&](detail::Statement& s, std::int64_t id, TableRegraspRecord& r) {
         r.id = id;
         r.candidate_id = s.next_int64();
         r.pick_grasp_id = s.next_int64();
@@ -624,7 +687,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       *connection, "ergonomics",
       "part_id, method, reachable, torso_flexion_deg, shoulder_elevated, reach, "
       "reorientation_deg, quality, arm",
-      fix, [&](detail::Statement& s, std::int64_t, ErgonomicsRecord& r) {
+      fix, verify, [&](detail::Statement& s, std::int64_t, ErgonomicsRecord& r) {
         r.part_id = s.next_int64();
         r.method = s.next_text();
         r.reachable = s.next_int64() != 0;
@@ -636,13 +699,13 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.arm = s.next_text();
       });
 
-  db.roadmaps_ = load_roadmaps(*connection, path, fix);
-  db.roadmap_filters_ = load_roadmap_filters(*connection, path, fix, db.roadmaps_);
+  db.roadmaps_ = load_roadmaps(*connection, path, fix, verify);
+  db.roadmap_filters_ = load_roadmap_filters(*connection, path, fix, verify, db.roadmaps_);
   db.regrasp_nodes_ = load_table<RegraspNodeRecord>(
       *connection, "regrasp_nodes",
       "kind, arm, grasp_kind, grasp_id, robot_handover_id, candidate_id, " + pose_columns("board") +
           ", dof, solution_count, solutions",
-      fix, [&](detail::Statement& s, RegraspNodeRecord& r) {
+      fix, verify, [&](detail::Statement& s, RegraspNodeRecord& r) {
         RowCheck check(path, "regrasp_nodes", fix);
         check.set_row("id " + std::to_string(r.id));
         r.kind = s.next_text();
@@ -665,7 +728,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       *connection, "regrasp_edges",
       "kind, arm, from_node, to_node, filter_id, connected, cost, path_nodes, via, path_dof, "
       "path_waypoints, path",
-      fix, [&](detail::Statement& s, RegraspEdgeRecord& r) {
+      fix, verify, [&](detail::Statement& s, RegraspEdgeRecord& r) {
         RowCheck check(path, "regrasp_edges", fix);
         check.set_row("id " + std::to_string(r.id));
         r.kind = s.next_text();
@@ -694,6 +757,8 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
                    [&] { return detail::decode_vectors(bytes, waypoints, dof, r.path); });
         check.finite("path", r.path, [](std::size_t i) { return nth("waypoint", i); });
       });
+  detail::check_references(*connection, path, fix);
+  detail::check_table_digests(path, meta_map, verify.digests, fix);
   return db;
 }
 
@@ -721,7 +786,10 @@ std::vector<ComfortMapRecord> Database::read_comfort_maps() const {
                         "a file rebuilt or replaced since (created " + now.created_at + ")",
                         "open it again");
   }
-  return load_comfort_maps(*connection, path_, fix);
+  Verification verify{path_, fix, {}};
+  auto maps = load_comfort_maps(*connection, path_, fix, verify);
+  detail::check_table_digests(path_, meta_map, verify.digests, fix);
+  return maps;
 }
 
 const ComfortMapRecord& Database::comfort_map(const std::string& arm) const {

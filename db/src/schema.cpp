@@ -1,13 +1,25 @@
 #include "schema.hpp"
 
+#include <map>
+#include <stdexcept>
+
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
+#include "sqlite_handle.hpp"
+
+#ifndef HILA_VERSION
+#error "HILA_VERSION (the project version) must be defined: db/CMakeLists.txt sets it"
+#endif
 
 namespace hila::db {
 
+std::string hila_version() {
+  return HILA_VERSION;
+}
+
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 6;
+  return 7;
 }
 
 namespace detail {
@@ -395,8 +407,58 @@ const std::vector<MigrationStep>& migration_steps() {
       {4, kCreateDirectGraspsV5},
       // 5 -> 6: regrasps on the table (a new table, empty in a migrated file until it is rebuilt).
       {5, kCreateTableRegraspsV6},
+      // 6 -> 7: a content digest per table in meta (digest.<table>, see kTableDigestsSince). SQL
+      // cannot hash, so the migration itself writes them after its last step, for the content the
+      // file then holds; the step only drops any the file already had.
+      {6, "DELETE FROM meta WHERE key GLOB 'digest.*';\n"},
   };
   return steps;
+}
+
+std::string digest_key(const std::string& table) {
+  return "digest." + table;
+}
+
+const std::vector<ColumnSpec>& schema_columns(const std::string& table) {
+  static const std::map<std::string, std::vector<ColumnSpec>> by_table = [] {
+    Connection connection(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, "(schema)");
+    const ErrorContext context{"(schema)", "hila's own schema to run", ""};
+    connection.exec(schema_sql(), context);
+    std::map<std::string, std::vector<ColumnSpec>> result;
+    for (const auto& t : kTables) {
+      Statement info(connection,
+                     std::string("SELECT name, type, \"notnull\", pk FROM pragma_table_info('") +
+                         t.name + "') ORDER BY cid",
+                     context);
+      auto& columns = result[t.name];
+      while (info.step()) {
+        ColumnSpec column;
+        column.name = info.next_text();
+        const std::string type = info.next_text();
+        const bool not_null = info.next_int64() != 0;
+        const bool primary_key = info.next_int64() != 0;
+        if (type == "INTEGER") {
+          column.storage_class = SQLITE_INTEGER;
+        } else if (type == "REAL") {
+          column.storage_class = SQLITE_FLOAT;
+        } else if (type == "TEXT") {
+          column.storage_class = SQLITE_TEXT;
+        } else if (type == "BLOB") {
+          column.storage_class = SQLITE_BLOB;
+        } else {
+          throw std::logic_error("schema_sql(): column " + std::string(t.name) + "." + column.name +
+                                 " has type '" + type + "'");
+        }
+        column.nullable = !not_null && !primary_key;
+        columns.push_back(std::move(column));
+      }
+    }
+    connection.close();
+    return result;
+  }();
+  static const std::vector<ColumnSpec> none;
+  const auto it = by_table.find(table);
+  return it == by_table.end() ? none : it->second;
 }
 
 std::string pose_columns(const std::string& prefix) {

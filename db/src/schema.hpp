@@ -2,6 +2,7 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 namespace hila::db::detail {
 
@@ -38,6 +39,27 @@ inline constexpr std::array<TableInfo, 18> kTables = {{{"meta", 1},
 inline constexpr std::array<const char*, 10> kMetaKeys = {
     "schema_version", "hila_version", "product_name", "cell_hash", "product_hash",
     "settings_hash",  "seed",         "created_at",   "cell_file", "product_file"};
+
+// The schema version since which every database holds a content digest per table in meta
+// (digest_key(table)): the writer stores them at commit, a migration to it or later writes them
+// after its last step, and Database::open compares them.
+inline constexpr int kTableDigestsSince = 7;
+
+// "digest.<table>": the meta key of a table's stored content digest.
+std::string digest_key(const std::string& table);
+
+// A column as the current schema declares it: its name, the SQLite storage class its values must
+// have (SQLITE_INTEGER, SQLITE_FLOAT, SQLITE_TEXT or SQLITE_BLOB) and whether NULL is allowed (the
+// optional references of version 4).
+struct ColumnSpec {
+  std::string name;
+  int storage_class = 0;
+  bool nullable = false;
+};
+
+// The columns of `table` in the current schema, in declaration order (read once from schema_sql()
+// run on an in-memory database, so they cannot drift from it). Empty for an unknown table.
+const std::vector<ColumnSpec>& schema_columns(const std::string& table);
 
 // Column lists of a pose ("p_x, p_y, p_z, p_qw, p_qx, p_qy, p_qz") and a vector ("v_x, v_y, v_z").
 std::string pose_columns(const std::string& prefix);

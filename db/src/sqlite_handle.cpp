@@ -150,4 +150,16 @@ std::string Statement::column_blob(int column) const {
   return blob ? std::string(blob, static_cast<std::size_t>(size)) : std::string();
 }
 
+std::string_view Statement::column_text_view(int column) const {
+  const auto* text = reinterpret_cast<const char*>(sqlite3_column_text(stmt_, column));
+  const int size = sqlite3_column_bytes(stmt_, column);
+  return text ? std::string_view(text, static_cast<std::size_t>(size)) : std::string_view();
+}
+
+std::string_view Statement::column_blob_view(int column) const {
+  const auto* blob = static_cast<const char*>(sqlite3_column_blob(stmt_, column));
+  const int size = sqlite3_column_bytes(stmt_, column);
+  return blob ? std::string_view(blob, static_cast<std::size_t>(size)) : std::string_view();
+}
+
 }  // namespace hila::db::detail

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace hila::db::detail {
@@ -69,6 +70,9 @@ class Statement {
   std::int64_t column_int64(int column) const;
   std::string column_text(int column) const;
   std::string column_blob(int column) const;
+  // The same bytes without a copy, valid until the next step() or reset() (for hashing).
+  std::string_view column_text_view(int column) const;
+  std::string_view column_blob_view(int column) const;
 
   // Sequential reads for the current row, starting at column 0 after each step().
   double next_double() { return column_double(read_column_++); }

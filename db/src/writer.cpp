@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <initializer_list>
 #include <limits>
@@ -10,6 +11,7 @@
 
 #include "atomic_file.hpp"
 #include "comfort_codec.hpp"
+#include "digest.hpp"
 #include "hila/db/database.hpp"
 #include "list_codec.hpp"
 #include "pose_codec.hpp"
@@ -391,7 +393,7 @@ void DatabaseWriter::write_meta(const Meta& meta) {
       m.insert_meta->run();
     };
     put("schema_version", std::to_string(current_schema_version()));
-    put("hila_version", meta.hila_version);
+    put("hila_version", meta.hila_version.empty() ? hila_version() : meta.hila_version);
     put("product_name", meta.product_name);
     put("cell_hash", meta.cell_hash);
     put("product_hash", meta.product_hash);
@@ -408,6 +410,14 @@ void DatabaseWriter::write_meta(const Meta& meta) {
 std::int64_t DatabaseWriter::add_part(const PartRecord& part) {
   Impl& m = *impl_;
   return m.guarded("add_part", [&] {
+    // Database::open refuses any other mass, so the writer refuses it first.
+    if (!(part.mass > 0.0) || !std::isfinite(part.mass)) {
+      char mass[32];
+      std::snprintf(mass, sizeof(mass), "%.17g", part.mass);
+      refuse(
+          "add_part", "parts.mass", "part '" + part.name + "'",
+          std::string("PartRecord::mass is ") + mass + ", expected a mass in kg, finite and > 0");
+    }
     detail::Statement& s = *m.insert_part;
     s.set_context(m.context("parts (part '" + part.name + "')"));
     s.bind_next(part.name);
@@ -1163,6 +1173,11 @@ void DatabaseWriter::commit() {
   }
   m.guarded("commit", [&] {
     m.finalize_statements();
+    // Hashed inside the transaction, from the rows as stored, so the digests are of exactly what
+    // Database::open will read.
+    const auto digests =
+        detail::table_digests(*m.connection, m.target, current_schema_version(), "");
+    detail::write_table_digests(*m.connection, digests, m.context("meta (content digests)"));
     m.connection->exec("COMMIT", m.context("(commit)"));
     m.connection->close();
     m.connection.reset();

@@ -538,7 +538,7 @@ inline void add_table_regrasps(Sample& s, std::uint64_t seed) {
 inline Sample make_sample(std::uint64_t seed = 7) {
   std::mt19937_64 rng(seed);
   Sample s;
-  s.meta.hila_version = "0.1.0";
+  s.meta.hila_version = hila_version();  // what Database::open expects by default
   s.meta.product_name = "cabinet";
   s.meta.cell_hash = std::string(64, 'c');
   s.meta.product_hash = std::string(64, 'a');

@@ -133,7 +133,7 @@ class HandoverRoundTrip : public ::testing::Test {
 TEST_F(HandoverRoundTrip, MetaHumanBodies) {
   const Database db = Database::open(path_);
   EXPECT_EQ(db.meta().human_bodies, "1.75 male; 1.55 female");
-  EXPECT_EQ(db.meta().schema_version, 6);
+  EXPECT_EQ(db.meta().schema_version, 7);
 }
 
 TEST_F(HandoverRoundTrip, Stages) {
@@ -608,12 +608,15 @@ TEST(HandoverReader, DamagedJointBlobIsADatabaseError) {
                      {"handover_candidates.board (id 5)", "a unit quaternion"});
 }
 
-TEST(HandoverReader, MissingHumanBodiesKeyReadsEmpty) {
-  // A version 3 file without the key (hand-made): "the cell's human only", not an error.
+TEST(HandoverReader, MissingHumanBodiesKeyIsAnEditTheMetaDigestRefuses) {
+  // The writer always stores the key, so a file without it was edited since: meta's stored
+  // content digest no longer matches. The content digest, which verifies nothing, still reads it.
   const std::string path = temp_dir("db_handover_meta") + "/p.db";
   write_sample(path, make_sample());
   detail::execute_script(path, "DELETE FROM meta WHERE key = 'human_bodies'");
-  EXPECT_EQ(Database::open(path).meta().human_bodies, "");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta: expected the content digest stored when it was written"});
+  EXPECT_EQ(content_digest(path).size(), 64u);
 }
 
 TEST(HandoverReader, EmptyTablesOpen) {
@@ -621,7 +624,9 @@ TEST(HandoverReader, EmptyTablesOpen) {
   {
     DatabaseWriter writer(path);
     writer.write_meta(Meta{});
-    writer.add_part(PartRecord{});
+    PartRecord part;
+    part.mass = 1.0;  // the only field the writer requires
+    writer.add_part(part);
     writer.commit();
   }
   const Database db = Database::open(path);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
@@ -629,6 +630,22 @@ void expect_no_direct_grasps(const Database& db) {
   EXPECT_TRUE(db.direct_grasps(1).empty());
 }
 
+// The by-hand files say hila 0.1.0 built them, and a migration keeps that: Database::open refuses
+// them by default, as `hila build --if-outdated` would rebuild them, and reads them when told to
+// accept any hila version.
+Database open_migrated(const std::string& path) {
+  OpenOptions options;
+  options.expected_hila_version = std::nullopt;
+  return Database::open(path, options);
+}
+
+// After rows were added by SQL, the per-table digests of the file as it now is, written the only
+// way outside the writer: set back to version 6 (which has none), a migration to 7 writes them.
+void reseal(const std::string& path) {
+  execute_script(path, "UPDATE meta SET value = '6' WHERE key = 'schema_version'");
+  migrate_in_place(path);
+}
+
 // A migrated file has the version 6 table, empty.
 void expect_no_table_regrasps(const Database& db) {
   EXPECT_TRUE(db.table_regrasps(1).empty());
@@ -645,10 +662,15 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v1 = content_digest(path);  // an old file still has a digest
 
-  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6
+  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7
 
-  const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 6);
+  // Readable now, but still what hila 0.1.0 built: refused unless any hila version is accepted.
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta.hila_version: expected a database built by this hila (" +
+                          hila_version() + "), got one built by hila 0.1.0 (an older hila",
+                      "rebuild with: hila build product.yaml -o " + path});
+  const Database db = open_migrated(path);
+  EXPECT_EQ(db.meta().schema_version, 7);
   EXPECT_EQ(db.meta().product_name, "cabinet");
   EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
@@ -682,16 +704,16 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
        "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_THROW(Database::open(path), DatabaseError);
   const std::string digest_v2 = content_digest(path);
 
-  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6
+  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6 -> 7
 
-  const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 6);
+  const Database db = open_migrated(path);
+  EXPECT_EQ(db.meta().schema_version, 7);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   expect_v1_records(db);
   ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
@@ -722,15 +744,15 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
        "written by schema version 3 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v3 = content_digest(path);
 
-  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6
+  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6 -> 7
 
-  const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 6);
+  const Database db = open_migrated(path);
+  EXPECT_EQ(db.meta().schema_version, 7);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -768,7 +790,11 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   execute_script(path,
                  "INSERT INTO roadmaps VALUES (1, 'left', 6, 0.05, 0, 0, x'', x'', x'', x'', x'', "
                  "x'');");
-  EXPECT_EQ(Database::open(path).roadmaps().size(), 1u);
+  // An edit after the migration is refused like any other.
+  expect_input_error([&] { open_migrated(path); },
+                     {path + ": roadmaps: expected the content digest stored when it was written"});
+  reseal(path);
+  EXPECT_EQ(open_migrated(path).roadmaps().size(), 1u);
   // The regrasp edges as a fresh file has them: how each was connected and its path.
   execute_script(path,
                  "CREATE TEMP TABLE probe AS SELECT via, path_dof, path_waypoints, path "
@@ -807,15 +833,15 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
        "written by schema version 4 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v4 = content_digest(path);
 
-  migrate_in_place(path);  // 4 -> 5 -> 6
+  migrate_in_place(path);  // 4 -> 5 -> 6 -> 7
 
-  const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 6);
+  const Database db = open_migrated(path);
+  EXPECT_EQ(db.meta().schema_version, 7);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -847,7 +873,8 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   execute_script(path,
                  "INSERT INTO direct_grasps VALUES (1, 1, 1, 'left', x'000000000000e03f', x'', "
                  "22.5, 45.0);");
-  const auto direct = Database::open(path).direct_grasps(1);
+  reseal(path);
+  const auto direct = open_migrated(path).direct_grasps(1);
   ASSERT_EQ(direct.size(), 1u);
   EXPECT_EQ(direct[0].robot_grasp_id, 1);
   EXPECT_EQ(direct[0].arm, "left");
@@ -881,22 +908,22 @@ TEST(Migration, Version4FileThatAlreadyHasTheNewTableFailsCleanly) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
-TEST(Migration, Version5FileIsUpgradedToVersion6) {
+TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   const std::string dir = temp_dir("db_migration_v5");
   const std::string path = write_v5(dir);
   // Unmigrated, the file is refused as outdated, with the way out.
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
        "written by schema version 5 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v5 = content_digest(path);
 
-  migrate_in_place(path);  // 5 -> 6 only
+  migrate_in_place(path);  // 5 -> 6 -> 7
 
-  const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 6);
+  const Database db = open_migrated(path);
+  EXPECT_EQ(db.meta().schema_version, 7);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -951,7 +978,8 @@ TEST(Migration, Version5FileIsUpgradedToVersion6) {
                  "INSERT INTO table_regrasps VALUES (1, 1, 1, 1, 'left', 0.5, -0.25, 0.75, "
                  "0.0, 0.0, 0.0, 1.0, x'000000000000e03f', x'', x'00000000000000c0', "
                  "x'000000000000e03f000000000000f03f', 10.5, 20.5, 30.5, 40.5);");
-  const auto regrasps = Database::open(path).table_regrasps(1);
+  reseal(path);
+  const auto regrasps = open_migrated(path).table_regrasps(1);
   ASSERT_EQ(regrasps.size(), 1u);
   EXPECT_EQ(regrasps[0].id, 1);
   EXPECT_EQ(regrasps[0].pick_grasp_id, 1);
@@ -972,7 +1000,7 @@ TEST(Migration, Version5FileIsUpgradedToVersion6) {
   EXPECT_EQ(regrasps[0].inclination_place_deg, 20.5);
   EXPECT_EQ(regrasps[0].inclination_repick_deg, 30.5);
   EXPECT_EQ(regrasps[0].inclination_rh_deg, 40.5);
-  EXPECT_EQ(Database::open(path).direct_grasps(1).size(), 1u) << "a table of its own";
+  EXPECT_EQ(open_migrated(path).direct_grasps(1).size(), 1u) << "a table of its own";
   expect_input_error(
       [&] {
         execute_script(path,
@@ -1006,7 +1034,7 @@ TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
   const std::string path = write_v2(dir);
   execute_script(path, "INSERT INTO meta (key, value) VALUES ('human_bodies', '1.80 male')");
   migrate_in_place(path);
-  EXPECT_EQ(Database::open(path).meta().human_bodies, "1.80 male");
+  EXPECT_EQ(open_migrated(path).meta().human_bodies, "1.80 male");
 }
 
 TEST(Migration, Version2FileThatAlreadyHasTheNewTablesFailsCleanly) {
@@ -1030,8 +1058,9 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
 
   migrate_with_steps(path, steps_from_v0(), current_schema_version());
 
+  // Made from the sample, which this hila wrote: it opens with the default options.
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 6);
+  EXPECT_EQ(db.meta().schema_version, 7);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -1052,16 +1081,17 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 6 -> 7 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
+  // Step 7 -> 8 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
   // 4 -> 5 and 5 -> 6 create; listed first to prove ordering.
-  std::vector<MigrationStep> steps = {{6,
-                                       "INSERT INTO notes (text) VALUES ('from step 6');"
+  std::vector<MigrationStep> steps = {{7,
+                                       "INSERT INTO notes (text) VALUES ('from step 7');"
                                        "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
                                        "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
                                        "INSERT INTO notes (text) SELECT arm FROM roadmaps;"
                                        "INSERT INTO notes (text) SELECT arm FROM direct_grasps;"
                                        "INSERT INTO notes (text) SELECT arm FROM table_regrasps;"}};
   steps.push_back(migration_steps().at(1));
+  steps.push_back(migration_steps().at(5));
   steps.push_back(migration_steps().at(4));
   steps.push_back(migration_steps().at(3));
   steps.push_back(migration_steps().at(2));
@@ -1069,13 +1099,13 @@ TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 7));
-  migrate_with_steps(path, steps, 7);
-  // The file is now version 7: this hila (6) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 7"});
-  // Migrating to 7 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 8));
+  migrate_with_steps(path, steps, 8);
+  // The file is now version 8: this hila (7) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 8"});
+  // Migrating to 8 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 7);
+  migrate_with_steps(path, steps, 8);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -1109,6 +1139,11 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
                             migration_steps().at(2), migration_steps().at(3)},
                            1, 6))
       << "1 -> 2 -> 3 -> 4 -> 5 does not reach 6";
+  EXPECT_FALSE(
+      can_migrate({migration_steps().at(0), migration_steps().at(1), migration_steps().at(2),
+                   migration_steps().at(3), migration_steps().at(4)},
+                  1, 7))
+      << "1 -> 2 -> 3 -> 4 -> 5 -> 6 does not reach 7";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },
@@ -1153,9 +1188,9 @@ TEST(Migration, NewerDatabaseIsRefused) {
   const std::string dir = temp_dir("db_migration_newer");
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
-  execute_script(path, "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  execute_script(path, "UPDATE meta SET value = '8' WHERE key = 'schema_version'");
   expect_input_error([&] { migrate_in_place(path); },
-                     {path, "written by schema version 7 (a newer hila)", "upgrade hila"});
+                     {path, "written by schema version 8 (a newer hila)", "upgrade hila"});
 }
 
 TEST(Migration, ForeignFilesAreRefused) {

@@ -123,7 +123,7 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   const std::string path = write_small(temp_dir("db_open_older"));
   detail::execute_script(path, "UPDATE meta SET value = '0' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "this hila reads (schema version 6)",
+                     {path + ": meta.schema_version", "this hila reads (schema version 7)",
                       "written by schema version 0 (an older hila)",
                       "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
   // There is no step from version 0, so the message must not offer one.
@@ -154,7 +154,7 @@ TEST(OpenChecks, Version1OffersMigration) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), "
        "got one written by schema version 1 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -171,7 +171,7 @@ TEST(OpenChecks, Version2OffersMigration) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), "
        "got one written by schema version 2 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -181,64 +181,64 @@ TEST(OpenChecks, Version2OffersMigration) {
 
 TEST(OpenChecks, Version3OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v3"));
-  const std::string digest_v6 = content_digest(path);
+  const std::string digest_current = content_digest(path);
   detail::execute_script(path, std::string(kDropVersion6Tables) + kDropVersion5Tables +
                                    kDropVersion4Tables +
                                    "UPDATE meta SET value = '3' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), "
        "got one written by schema version 3 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   // The digest still reads it (a version 3 file has no version 4 tables to hash), and differs.
   const std::string digest_v3 = content_digest(path);
   EXPECT_EQ(digest_v3.size(), 64u);
-  EXPECT_NE(digest_v3, digest_v6);
+  EXPECT_NE(digest_v3, digest_current);
 }
 
 TEST(OpenChecks, Version4OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v4"));
-  const std::string digest_v6 = content_digest(path);
+  const std::string digest_current = content_digest(path);
   detail::execute_script(path, std::string(kDropVersion6Tables) + kDropVersion5Tables +
                                    "UPDATE meta SET value = '4' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), "
        "got one written by schema version 4 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   // The digest still reads it (a version 4 file has no direct_grasps table to hash), and differs.
   const std::string digest_v4 = content_digest(path);
   EXPECT_EQ(digest_v4.size(), 64u);
-  EXPECT_NE(digest_v4, digest_v6);
+  EXPECT_NE(digest_v4, digest_current);
 }
 
 TEST(OpenChecks, Version5OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v5"));
-  const std::string digest_v6 = content_digest(path);
+  const std::string digest_current = content_digest(path);
   detail::execute_script(path, std::string(kDropVersion6Tables) +
                                    "UPDATE meta SET value = '5' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 6), "
+       ": meta.schema_version: expected a database this hila reads (schema version 7), "
        "got one written by schema version 5 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   // The digest still reads it (a version 5 file has no table_regrasps table to hash), and differs.
   const std::string digest_v5 = content_digest(path);
   EXPECT_EQ(digest_v5.size(), 64u);
-  EXPECT_NE(digest_v5, digest_v6);
+  EXPECT_NE(digest_v5, digest_current);
 }
 
 TEST(OpenChecks, NewerSchemaVersion) {
   const std::string path = write_small(temp_dir("db_open_newer"));
-  detail::execute_script(path, "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  detail::execute_script(path, "UPDATE meta SET value = '8' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "written by schema version 7 (a newer hila)",
+                     {path + ": meta.schema_version", "written by schema version 8 (a newer hila)",
                       "upgrade hila, or rebuild with: hila build"});
 }
 

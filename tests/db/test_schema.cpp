@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <string>
 #include <vector>
@@ -33,19 +34,21 @@ std::vector<std::string> create_statements(const std::string& sql) {
 
 }  // namespace
 
-TEST(Schema, VersionIsSixWithStepsFromOneToFive) {
-  EXPECT_EQ(current_schema_version(), 6);
-  ASSERT_EQ(migration_steps().size(), 5u);
+TEST(Schema, VersionIsSevenWithStepsFromOneToSix) {
+  EXPECT_EQ(current_schema_version(), 7);
+  ASSERT_EQ(migration_steps().size(), 6u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
   EXPECT_EQ(migration_steps()[1].from_version, 2);
   EXPECT_EQ(migration_steps()[2].from_version, 3);
   EXPECT_EQ(migration_steps()[3].from_version, 4);
   EXPECT_EQ(migration_steps()[4].from_version, 5);
+  EXPECT_EQ(migration_steps()[5].from_version, 6);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 3, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 4, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 5, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 6, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
   // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
@@ -96,6 +99,50 @@ TEST(Schema, VersionIsSixWithStepsFromOneToFive) {
     EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
   }
   EXPECT_EQ(migration_steps()[4].sql.find("INSERT"), std::string::npos);
+  // 6 -> 7: no table changes; the migration writes the per-table digests after its last step, the
+  // step only drops digests a file may already have.
+  EXPECT_TRUE(create_statements(migration_steps()[5].sql).empty());
+  EXPECT_EQ(migration_steps()[5].sql, "DELETE FROM meta WHERE key GLOB 'digest.*';\n");
+  EXPECT_EQ(kTableDigestsSince, 7);
+}
+
+// The column specs the checks at open compare values with come from schema_sql() itself.
+TEST(Schema, ColumnSpecsFollowTheSql) {
+  for (const auto& table : kTables) {
+    EXPECT_FALSE(schema_columns(table.name).empty()) << table.name;
+    if (std::string(table.name) != "meta") {
+      EXPECT_EQ(schema_columns(table.name).front().name, "id") << table.name;
+      EXPECT_FALSE(schema_columns(table.name).front().nullable) << table.name;
+    }
+  }
+  EXPECT_TRUE(schema_columns("no_such_table").empty());
+  const auto& meta = schema_columns("meta");
+  ASSERT_EQ(meta.size(), 2u);
+  EXPECT_EQ(meta[1].name, "value");
+  EXPECT_EQ(meta[1].storage_class, SQLITE_TEXT);
+  EXPECT_FALSE(meta[1].nullable);
+  const auto find = [](const std::string& table, const std::string& column) {
+    for (const auto& c : schema_columns(table)) {
+      if (c.name == column) return c;
+    }
+    return ColumnSpec{};
+  };
+  EXPECT_EQ(find("parts", "mass").storage_class, SQLITE_FLOAT);
+  EXPECT_EQ(find("parts", "name").storage_class, SQLITE_TEXT);
+  EXPECT_EQ(find("parts", "triangle_count").storage_class, SQLITE_INTEGER);
+  EXPECT_EQ(find("roadmaps", "edge_nodes").storage_class, SQLITE_BLOB);
+  EXPECT_EQ(schema_columns("robot_grasps").size(), 26u);
+  // Only the optional references of version 4 may be NULL.
+  std::vector<std::string> nullable;
+  for (const auto& table : kTables) {
+    for (const auto& c : schema_columns(table.name)) {
+      if (c.nullable) nullable.push_back(std::string(table.name) + "." + c.name);
+    }
+  }
+  EXPECT_EQ(nullable,
+            (std::vector<std::string>{"regrasp_nodes.robot_handover_id",
+                                      "regrasp_nodes.candidate_id", "regrasp_edges.filter_id"}));
+  EXPECT_EQ(digest_key("robot_grasps"), "digest.robot_grasps");
 }
 
 TEST(Schema, ColumnListHelpers) {

@@ -112,9 +112,11 @@ TEST(Writer, IdsAreAssignedInOrderIgnoringRecordIds) {
   PartRecord a;
   a.name = "a";
   a.id = 77;
+  a.mass = 1.0;
   PartRecord b;
   b.name = "b";
   b.id = -5;
+  b.mass = 2.0;
   EXPECT_EQ(writer.add_part(a), 1);
   EXPECT_EQ(writer.add_part(b), 2);
   RobotGraspRecord g;
@@ -135,6 +137,7 @@ TEST(Writer, DuplicatePartNameFailsAndTheWriterThenRefusesToCommit) {
   writer.write_meta(make_sample().meta);
   PartRecord part;
   part.name = "door";
+  part.mass = 1.0;
   writer.add_part(part);
   expect_input_error([&] { writer.add_part(part); },
                      {target, "parts (part 'door')", "UNIQUE constraint failed: parts.name"});

@@ -199,6 +199,7 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
 
 int run_inspect(const InspectOptions& opt) {
   if (opt.what == "digest") {
+    db::Database::open(opt.database);  // what the loader refuses is bad input here too (exit 2)
     const std::string digest = db::content_digest(opt.database);
     if (opt.json) {
       std::cout << nlohmann::json{{"database", opt.database}, {"digest", digest}}.dump(2) << "\n";

@@ -13,6 +13,11 @@ namespace hila::db {
 // The schema version this build of hila writes and reads.
 int current_schema_version();
 
+// This hila's version (the project version, e.g. "0.10.0"): what `hila build` stores in
+// meta.hila_version, what DatabaseWriter stores for an empty Meta::hila_version, and what
+// Database::open expects there by default (OpenOptions::expected_hila_version).
+std::string hila_version();
+
 // SHA-256 of bytes / of a file, lower-case hex. Throws core::InputError for an unreadable file.
 std::string sha256_hex(const std::string& bytes);
 std::string sha256_file(const std::string& path);
@@ -41,11 +46,13 @@ class DatabaseWriter {
   // Record ids are assigned by the database (1, 2, ... per table in call order; the add_ calls
   // that return ids return them in record order); the records' own id and, where the call takes a
   // part_id, their part_id fields are ignored. An empty meta.created_at is filled with the current
-  // UTC time. A part_id (and any other id a record refers to) must name a record written before,
-  // otherwise DatabaseError (FOREIGN KEY constraint failed). After any failed call the writer
-  // refuses to commit (the temporary file is discarded).
-  void write_meta(const Meta& meta);              // schema_version is set by the writer
-  std::int64_t add_part(const PartRecord& part);  // returns the part id
+  // UTC time, an empty meta.hila_version with hila_version(). A part_id (and any other id a record
+  // refers to) must name a record written before, otherwise DatabaseError (FOREIGN KEY constraint
+  // failed). After any failed call the writer refuses to commit (the temporary file is
+  // discarded).
+  void write_meta(const Meta& meta);  // schema_version is set by the writer
+  // Returns the part id. part.mass must be finite and > 0 (kg): std::invalid_argument otherwise.
+  std::int64_t add_part(const PartRecord& part);
   void add_placements(std::int64_t part_id, const std::vector<PlacementRecord>& placements);
   std::vector<std::int64_t> add_robot_grasps(std::int64_t part_id,
                                              const std::vector<RobotGraspRecord>& grasps);
@@ -121,6 +128,8 @@ class DatabaseWriter {
   // or "bridge" and a path of at least 2 waypoints, all of one size > 0 (finite); an edge that is
   // not connected and a "handover" edge have via "" and no path. Returns the ids.
   std::vector<std::int64_t> add_regrasp_edges(const std::vector<RegraspEdgeRecord>& edges);
+  // Stores each table's content digest in meta (digest.<table>, what Database::open compares),
+  // then commits as described above.
   void commit();
 
   const std::string& temporary_path() const;
@@ -139,14 +148,24 @@ struct OpenOptions {
   // read only when wanted: the online planner does not use them. Left out, comfort_maps() is
   // empty and comfort_map() says they were not loaded.
   bool comfort_maps = true;
+  // The hila version the database must have been built by (meta.hila_version), as `hila build
+  // --if-outdated` requires: by default this hila's. std::nullopt accepts any, e.g. to read a file
+  // built by another hila or migrated from an older schema (migrate_in_place keeps the version).
+  std::optional<std::string> expected_hila_version = hila_version();
 };
 
 // A read-only, fully loaded product database (small, except the comfort maps: about 13 MB per arm
 // in memory, and the roadmaps and their filters: a few MB). Const after open: safe to share.
 class Database {
  public:
-  // Throws DatabaseError for a missing, truncated, corrupt or foreign file (not SQLite, or SQLite
-  // without hila's meta table), another schema version, or a hash mismatch.
+  // Verifies the file, then loads it. Throws DatabaseError for a missing, truncated, corrupt or
+  // foreign file (not SQLite, or SQLite without hila's meta table), another schema version,
+  // another hila version (OpenOptions::expected_hila_version), a hash mismatch, a value of the
+  // wrong storage class (a REAL column holding TEXT, a NOT NULL column holding NULL), a reference
+  // that names no row, a damaged record (see docs/database.md), or a table whose content digest is
+  // not the one stored in meta when the file was written (the comfort maps' only when they are
+  // loaded). The message names the file, the table (and row where known), what was expected and
+  // found, and how to rebuild.
   static Database open(const std::string& path, const OpenOptions& options = {});
 
   const std::string& path() const { return path_; }
@@ -163,7 +182,8 @@ class Database {
   const ComfortMapRecord& comfort_map(const std::string& arm) const;  // throws core::InputError
   // The comfort maps read from the file now, for a database opened without them. Throws
   // DatabaseError when the file is no longer the one opened (its meta table differs: rebuilt or
-  // replaced) or its comfort_maps table is damaged.
+  // replaced) or its comfort_maps table is damaged (a value of the wrong storage class, a map
+  // that does not decode, or a content digest other than the stored one).
   std::vector<ComfortMapRecord> read_comfort_maps() const;
 
   // Handover goals and ergonomics. The part's stage, or nullptr when the database has none for it
@@ -212,14 +232,18 @@ class Database {
 };
 
 // Upgrades a database written by an older schema version to current_schema_version(): copies it
-// beside itself, applies the migration steps in one transaction and renames the copy over the
-// original (atomic: on any error the original is untouched). A current database is left as is.
+// beside itself, applies the migration steps in one transaction, stores the content digest of
+// every table of the result (as the writer does) and renames the copy over the original (atomic:
+// on any error the original is untouched). A current database is left as is. meta.hila_version
+// is kept: open the result with OpenOptions::expected_hila_version = std::nullopt.
 // Throws DatabaseError for a newer, foreign or corrupt file, or when no migration path exists.
 void migrate_in_place(const std::string& path);
 
 // A hash of the database content (every table of the file's schema version, rows in id order,
-// doubles by their exact bits, comfort map values uncompressed), ignoring meta.created_at: two
-// builds from the same inputs and seed have the same digest.
+// doubles by their exact bits, comfort map values uncompressed), ignoring meta.created_at and
+// the stored per-table digests (meta digest.*): two builds from the same inputs and seed have the
+// same digest. It reads any hila database of any schema version and verifies nothing beyond the
+// file's integrity: Database::open is what refuses a damaged or outdated file.
 std::string content_digest(const std::string& path);
 
 }  // namespace hila::db

@@ -13,14 +13,18 @@ struct MigrationStep {
 };
 
 // The steps this build of hila knows, in order (1 -> 2 adds comfort_maps, 2 -> 3 the handover and
-// ergonomics tables and meta.human_bodies, 3 -> 4 the roadmap and regrasp-graph tables).
+// ergonomics tables and meta.human_bodies, 3 -> 4 the roadmap and regrasp-graph tables, 4 -> 5
+// direct_grasps, 5 -> 6 table_regrasps, 6 -> 7 the per-table content digests in meta, which the
+// migration itself writes after its last step).
 const std::vector<MigrationStep>& migration_steps();
 
 // True if `steps` hold one step for every version from `from_version` up to `to_version` - 1.
 bool can_migrate(const std::vector<MigrationStep>& steps, int from_version, int to_version);
 
 // migrate_in_place with an explicit step list and target version, so the framework can be tested
-// with synthetic steps. Throws DatabaseError when a step is missing, fails, or the file is newer.
+// with synthetic steps. A target version of 7 or later gets the content digests of its tables
+// (those of hila's schema that the version has) after the last step. Throws DatabaseError when a
+// step is missing, fails, or the file is newer.
 void migrate_with_steps(const std::string& path, const std::vector<MigrationStep>& steps,
                         int target_version);
 
