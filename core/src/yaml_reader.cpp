@@ -173,10 +173,16 @@ bool YamlNode::is_sequence() const {
   return node_.IsSequence();
 }
 
+std::string YamlNode::key_text(const YAML::Node& key) const {
+  // A list or map written as a key (`[a, b]: 1`, a stray bracket in a flow map) names no field.
+  if (!key.IsScalar()) fail("field names as keys", "a list or map used as a key");
+  return key.Scalar();
+}
+
 void YamlNode::expect_only(std::initializer_list<const char*> allowed) const {
   if (!node_.IsMap()) fail("a map", describe());
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     const bool known =
         std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; });
     if (!known) {
@@ -266,7 +272,7 @@ Eigen::Vector3d YamlNode::as_unit_vec3() const {
 std::vector<std::string> YamlNode::keys() const {
   if (!node_.IsMap()) fail("a map", describe());
   std::vector<std::string> out;
-  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  for (const auto& kv : node_) out.push_back(key_text(kv.first));
   return out;
 }
 

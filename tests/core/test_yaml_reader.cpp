@@ -62,7 +62,8 @@ TEST(YamlReader, MissingFileNamesThePath) {
 
 TEST(YamlReader, ADirectoryIsNotAYamlFile) {
   const std::string dir = temp_dir("yaml_reader_directory");
-  expect_input_error([&] { YamlNode::load_file(dir); }, {dir, "expected a YAML file, got a directory"});
+  expect_input_error([&] { YamlNode::load_file(dir); },
+                     {dir, "expected a YAML file, got a directory"});
 }
 
 TEST(YamlReader, MalformedYamlNamesFileAndLine) {
@@ -313,4 +314,20 @@ TEST(YamlReader, RotationAnglesBeyondOneTurnAreRefused) {
       {path, ": rad.rpy[1]: ", "an angle in radians in [-6.283185307, 6.283185307]", "got 7"});
   expect_input_error([&] { root.at("overflow").as_pose(); },
                      {path, ": overflow.rpy_deg[1]: ", "a number", "'1e400'"});
+}
+
+TEST(YamlReader, AListOrMapAsAKeyIsAnInputError) {
+  // A stray bracket in a flow map makes a list a key (found by fuzz/fuzz_product): an input
+  // error at the map, not yaml-cpp's bad conversion escaping as an internal error.
+  const auto [path, root] = load_text("list_key",
+                                      "assembly_frame: {xyz: [0, 0, 0], rpy_deg: 0, [0, 90]}\n"
+                                      "robot: {[left, right]: 1}\n"
+                                      "boards: {{a: 1}: 2}\n");
+  expect_input_error(
+      [&] { root.at("assembly_frame").as_pose(); },
+      {path, "assembly_frame", "field names as keys", "a list or map used as a key"});
+  expect_input_error([&] { root.at("robot").keys(); },
+                     {path, "robot", "a list or map used as a key"});
+  expect_input_error([&] { root.at("boards").expect_only({"a"}); },
+                     {path, "boards", "a list or map used as a key"});
 }

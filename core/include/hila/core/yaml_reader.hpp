@@ -55,6 +55,8 @@ class YamlNode {
  private:
   YamlNode(YAML::Node node, std::shared_ptr<const std::string> file, std::string path);
   std::string describe() const;
+  // A map key's text; an InputError at this map for a key that is a list or a map.
+  std::string key_text(const YAML::Node& key) const;
 
   YAML::Node node_;
   std::shared_ptr<const std::string> file_;
