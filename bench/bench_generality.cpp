@@ -48,6 +48,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -292,6 +293,7 @@ struct PartResult {
   double quality = 0.0;            // the human's comfort Q at the goal delivered to (paper Eq. 4)
   bool tool_in_hand_after = true;  // the suction arm holds the tool after the part
   std::string tool_arm = online::kDefaultSuctionArm;  // the arm holding it then
+  std::optional<core::Pose> tool_place;               // where the plan moved the tool to
 };
 
 std::string most_frequent_outcome(const online::BoardPlan& plan) {
@@ -360,6 +362,7 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
     r.delivering_arm = plan.delivering_arm;
     r.tool_in_hand_after = plan.tool_in_hand_after;
     r.tool_arm = plan.suction_arm;
+    r.tool_place = plan.tool_place;
   } else {
     r.tool_in_hand_after = scene.tool_in_hand;
     r.tool_arm = scene.tool_arm;
@@ -492,10 +495,12 @@ std::vector<PartResult> plan_all(online::BoardPlanner& planner, const online::Pl
               << std::endl;
     const bool tool_in_hand = r.tool_in_hand_after;
     const std::string tool_arm = r.tool_arm;
+    const std::optional<core::Pose> tool_place = r.tool_place;
     results.push_back(std::move(r));
     scene = scene.with_finished(model.product(), part.name);
     scene.tool_in_hand = tool_in_hand;
     scene.tool_arm = tool_arm;
+    if (tool_place) scene.tool = *tool_place;
     for (const auto& arm : model.cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
   }
   return results;

@@ -90,8 +90,14 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     problem(plan.board, "the plan's theta_c is not its grasp's");
   }
 
+  // The board's own steps see the tool where the plan's first steps set it down, if they moved it.
+  online::Scene board_scene = scene;
+  if (plan.tool_place) {
+    board_scene.tool = *plan.tool_place;
+    board_scene.tool_in_hand = false;
+  }
   const online::World world(
-      cell, product, scene, plan.board,
+      cell, product, board_scene, plan.board,
       plan.suction_arm.empty() ? online::kDefaultSuctionArm : plan.suction_arm);
   core::CollisionData data = world.make_data();
   const core::StageScene& stage = world.stage();
@@ -128,7 +134,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     const auto it = scene.robot.find(arm.spec.name);
     if (it != scene.robot.end()) cell.set_arm(robot_q, arm, it->second);
   }
-  bool tool_in_hand = scene.tool_in_hand && scene.tool_arm == suction.spec.name;
+  bool tool_in_hand = board_scene.tool_in_hand && board_scene.tool_arm == suction.spec.name;
   bool on_cup = false, handed_over = false;
   const core::Arm* in_gripper = nullptr;              // the arm whose gripper holds the board
   core::Pose board_world = scene.initial_pose(part);  // while neither hand holds it
@@ -142,25 +148,30 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
   };
 
   double clock = -1e300;
-  // The tool put back first by the arm holding it (BoardPlan::tool_put_back_steps), checked in a
-  // world where that arm carries the tool; the board lies where it was detected meanwhile.
-  const auto put_back = static_cast<std::size_t>(std::max(0, plan.tool_put_back_steps));
-  if (put_back > 0) {
-    const online::World holder_world(cell, product, scene, plan.board, plan.tool_put_back_arm);
+  // The tool moved first by the other arm (BoardPlan::tool_move_steps): taken from the table
+  // where the scene has it (unless that arm holds it), set down at the plan's tool_place, the arm
+  // home; checked in a world where that arm carries the tool. The board lies where it was detected
+  // meanwhile.
+  const auto moving = static_cast<std::size_t>(std::max(0, plan.tool_move_steps));
+  if (moving > 0) {
+    const online::World holder_world(cell, product, scene, plan.board, plan.tool_move_arm);
     core::CollisionData holder_data = holder_world.make_data();
     const core::Arm& holder =
         cell.arms()[static_cast<std::size_t>(holder_world.stage().suction_arm)];
     bool held = scene.tool_in_hand && scene.tool_arm == holder.spec.name;
-    if (!held || &holder == &suction || put_back > plan.steps.size()) {
-      problem(plan.board, "puts back a tool the other arm does not hold");
+    if (&holder == &suction || moving > plan.steps.size() || !plan.tool_place ||
+        (!held && (scene.tool_in_hand || !plan.tool_taken_from_table))) {
+      problem(plan.board, "moves a tool the other arm neither holds nor finds on the table");
       return out;
     }
-    for (std::size_t i = 0; i < put_back; ++i) {
+    core::Pose tool_at = scene.tool;  // while on the table
+    bool lifting_tool = false, set_down = false;
+    for (std::size_t i = 0; i < moving; ++i) {
       const online::PlanStep& step = plan.steps[i];
       ++out.steps;
       const std::string where = plan.board + ": " + step.name;
       if (step.arm != holder.spec.name || step.q.empty() || step.q.size() != step.time.size()) {
-        problem(where, "expected the arm holding the tool and one time per waypoint");
+        problem(where, "expected the arm moving the tool and one time per waypoint");
         return out;
       }
       const Eigen::VectorXd now = cell.arm_joints(robot_q, holder);
@@ -170,11 +181,15 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       if (step.time.front() < clock - 1e-9) problem(where, "starts before the previous step ends");
       clock = step.time.back();
       const auto events = split_events(step.event);
-      const bool released =
-          std::find(events.begin(), events.end(), "tool_released") != events.end();
+      bool released = false, grasped = false;
       for (const auto& e : events) {
-        if (e != "tool_released")
-          problem(where, "unexpected event '" + e + "' putting the tool back");
+        if (e == "tool_released") {
+          released = true;
+        } else if (e == "tool_grasped") {
+          grasped = true;
+        } else {
+          problem(where, "unexpected event '" + e + "' moving the tool");
+        }
       }
       online::Motion motion;
       motion.arm = holder.spec.name;
@@ -183,7 +198,8 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       motion.robot_q = robot_q;
       motion.board_world = board_world;
       motion.tool_in_hand = held;
-      motion.tool_world = scene.tool;
+      motion.tool_world = tool_at;
+      motion.start_in_contact = lifting_tool;
       motion.end_in_contact = released;
       const online::ValidationReport report =
           online::validate_motion(holder_world, holder_data, motion, settings.validator);
@@ -195,19 +211,30 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         problem(where, s.str());
       }
       cell.set_arm(robot_q, holder, step.q.back());
+      lifting_tool = false;
+      const core::Pose handle = tcp_of(holder) * cell.spec().suction.handle_in_tcp;
+      if (grasped) {
+        if (held) problem(where, "grasps a tool it holds");
+        const std::string off = pose_error(handle, tool_at);
+        if (!off.empty()) problem(where, "grasps the tool's handle " + off);
+        held = true;
+        lifting_tool = true;
+        cell.set_jaw(robot_q, holder, cell.spec().suction.handle_width);
+      }
       if (released) {
         if (!held) problem(where, "sets down a tool it does not hold");
-        const std::string off =
-            pose_error(tcp_of(holder) * cell.spec().suction.handle_in_tcp, scene.tool);
-        if (!off.empty()) problem(where, "sets the tool down " + off + " its place");
+        const std::string off = pose_error(handle, *plan.tool_place);
+        if (!off.empty()) problem(where, "sets the tool down " + off + " the plan's place");
         held = false;
+        set_down = true;
+        tool_at = *plan.tool_place;
         cell.set_jaw(robot_q, holder, cell.spec().gripper.jaw_max);
       }
     }
-    if (held) problem(plan.board, "the tool put back first is still in hand");
+    if (held || !set_down) problem(plan.board, "the tool moved first is not set down");
   }
   bool lifting = false;  // the step after a pick starts with the object still on the table
-  for (std::size_t index = put_back; index < plan.steps.size(); ++index) {
+  for (std::size_t index = moving; index < plan.steps.size(); ++index) {
     const online::PlanStep& step = plan.steps[index];
     ++out.steps;
     const std::string where = plan.board + ": " + step.name;
@@ -267,7 +294,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       motion.board_world = board_now();
     }
     motion.tool_in_hand = tool_in_hand;
-    motion.tool_world = scene.tool;
+    motion.tool_world = board_scene.tool;
     motion.start_in_contact = lifting;
     // The tool's foot, or a board set down for a regrasp, meets the table at the last sample.
     motion.end_in_contact =
@@ -290,7 +317,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       if (e == "tool_grasped") {
         if (arm != &suction || tool_in_hand) problem(where, "grasps a tool it cannot");
         const std::string off =
-            pose_error(tcp_of(suction) * cell.spec().suction.handle_in_tcp, scene.tool);
+            pose_error(tcp_of(suction) * cell.spec().suction.handle_in_tcp, board_scene.tool);
         if (!off.empty()) problem(where, "grasps the tool's handle " + off);
         tool_in_hand = true;
         cell.set_jaw(robot_q, suction, cell.spec().suction.handle_width);
@@ -300,7 +327,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
           problem(where, "sets down a tool it does not hold, or the board with it");
         }
         const std::string off =
-            pose_error(tcp_of(suction) * cell.spec().suction.handle_in_tcp, scene.tool);
+            pose_error(tcp_of(suction) * cell.spec().suction.handle_in_tcp, board_scene.tool);
         if (!off.empty()) problem(where, "sets the tool down " + off + " its place");
         tool_in_hand = false;
         cell.set_jaw(robot_q, suction, cell.spec().gripper.jaw_max);

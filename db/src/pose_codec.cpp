@@ -1,6 +1,8 @@
 #include "pose_codec.hpp"
 
+#include <charconv>
 #include <cmath>
+#include <cstdio>
 
 namespace hila::db::detail {
 
@@ -40,6 +42,34 @@ std::optional<core::Pose> decode_pose(const PoseColumns& c) {
   pose.linear() = q.toRotationMatrix();
   pose.translation() = Eigen::Vector3d(c[0], c[1], c[2]);
   return pose;
+}
+
+std::string format_pose_text(const core::Pose& pose) {
+  std::string text;
+  char number[32];
+  for (const double value : encode_pose(pose)) {
+    std::snprintf(number, sizeof(number), "%.17g", value);
+    if (!text.empty()) text += ' ';
+    text += number;
+  }
+  return text;
+}
+
+std::optional<core::Pose> parse_pose_text(const std::string& text) {
+  PoseColumns columns{};
+  const char* at = text.data();
+  const char* const end = text.data() + text.size();
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (i > 0) {
+      if (at == end || *at != ' ') return std::nullopt;
+      ++at;
+    }
+    const auto [next, error] = std::from_chars(at, end, columns[i]);
+    if (error != std::errc()) return std::nullopt;
+    at = next;
+  }
+  if (at != end) return std::nullopt;
+  return decode_pose(columns);
 }
 
 }  // namespace hila::db::detail

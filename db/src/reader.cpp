@@ -161,6 +161,16 @@ Meta parse_meta(const std::string& path, const std::map<std::string, std::string
   // Added in version 3: a file without it (hand-made) reads as "the cell's human only".
   const auto bodies = map.find("human_bodies");
   meta.human_bodies = bodies == map.end() ? std::string() : bodies->second;
+  // Added in hila 0.12: "" or the 7 pose numbers (x y z qw qx qy qz).
+  const auto relay = map.find("tool_relay");
+  if (relay != map.end() && !relay->second.empty()) {
+    meta.tool_relay = detail::parse_pose_text(relay->second);
+    if (!meta.tool_relay) {
+      throw DatabaseError(path, "meta.tool_relay",
+                          "'' or a pose as 7 numbers (x y z qw qx qy qz, a unit quaternion)",
+                          "'" + relay->second + "'", fix);
+    }
+  }
   const std::string& seed = map.at("seed");
   const auto [end, error] = std::from_chars(seed.data(), seed.data() + seed.size(), meta.seed);
   if (seed.empty() || error != std::errc() || end != seed.data() + seed.size()) {

@@ -403,6 +403,8 @@ void DatabaseWriter::write_meta(const Meta& meta) {
     put("cell_file", meta.cell_file);
     put("product_file", meta.product_file);
     put("human_bodies", meta.human_bodies);
+    // Only where there is one: a file without the key (as every file written before) has none.
+    if (meta.tool_relay) put("tool_relay", detail::format_pose_text(*meta.tool_relay));
     m.meta_written = true;
   });
 }

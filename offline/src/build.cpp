@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -283,6 +284,8 @@ std::string settings_hash(const BuildSettings& s) {
        << ' ' << h.table_regrasp.placements << ' ' << h.table_regrasp.yaws << ' '
        << h.table_regrasp.support_tolerance << ' ' << h.swap_roles;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
+  const auto& t = s.tool_relay;
+  text << "\ntool_relay " << t.spacing << ' ' << t.yaw_steps << ' ' << t.clearance;
   const auto& e = s.ergonomics;
   text << "\nergonomics " << e.table_spot_x << ' ' << e.table_spot_y << ' ' << e.flexion_step_deg
        << ' ' << e.candidates_per_step << ' ' << e.ik_attempts << "\nbodies "
@@ -300,24 +303,33 @@ std::string settings_hash(const BuildSettings& s) {
 namespace {
 
 // For a part without goals in the default roles: its goals with the arms' roles swapped. Kept
-// (and `handover` swapped with them) when there are some and the new suction arm reaches the
-// tool on its stand; otherwise the default roles' reason gains what the swap would have needed.
+// (and `handover` swapped with them) when there are some and the new suction arm can get the
+// tool: from its stand, or from the relay (`relay`) where the other arm, which reaches the stand,
+// sets it down; otherwise the default roles' reason gains what the swap would have needed.
 void swap_roles(const core::Cell& cell, const core::ProductSpec& product, std::size_t i,
-                const BoardGrasps& grasps, const HumanComfort& comfort, HandoverSettings& handover,
-                PartResult& r) {
+                const BoardGrasps& grasps, const HumanComfort& comfort,
+                const std::optional<core::Pose>& relay, HandoverSettings& handover, PartResult& r) {
   HandoverSettings swapped = handover;
   std::swap(swapped.suction_arm, swapped.receiving_arm);
   HandoverResult other = plan_handover_goals(cell, product, i, grasps, comfort, swapped);
   if (other.stage.goals == 0) return;
-  if (!reaches_tool_stand(cell, product, i, swapped.suction_arm, handover.exchange_approach,
-                          handover.pick_lift)) {
+  const double approach = handover.exchange_approach, lift = handover.pick_lift;
+  const bool at_stand = reaches_tool_stand(cell, product, i, swapped.suction_arm, approach, lift);
+  const bool by_relay =
+      !at_stand && relay &&
+      reaches_tool_stand(cell, product, i, handover.suction_arm, approach, lift) &&
+      reaches_tool_at(cell, swapped.suction_arm, *relay, core::parts_before(product, i),
+                      core::parts_after(product, i), approach, lift);
+  if (!at_stand && !by_relay) {
     const Eigen::Vector3d at = product.suction_tool_pose.translation();
     r.handover.stage.failure +=
         "; with the " + swapped.suction_arm + " arm picking by suction it would have " +
         std::to_string(other.stage.goals) + " goals, but the " + swapped.suction_arm +
-        " arm does not reach the suction tool on " + "its stand at (" +
-        core::format_number(at.x()) + ", " + core::format_number(at.y()) + ", " +
-        core::format_number(at.z()) + ") m: stand the tool where both arms reach it";
+        " arm does not reach the suction tool on its stand at (" + core::format_number(at.x()) +
+        ", " + core::format_number(at.y()) + ", " + core::format_number(at.z()) + ") m" +
+        (relay ? ", nor at the relay where the other arm would set it down"
+               : ", and no place on the table serves both arms as a relay") +
+        ": stand the tool where both arms reach it";
     return;
   }
   other.seconds += r.handover.seconds;
@@ -404,6 +416,14 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   });
 
   const HumanComfort comfort(*cell, maps, settings.human_bodies);
+  // The tool's relay, for parts whose swapped suction arm does not reach the stand.
+  ToolRelay relay;
+  if (settings.handover.swap_roles) {
+    ToolRelaySettings relay_settings = settings.tool_relay;
+    relay_settings.approach = settings.handover.exchange_approach;
+    relay_settings.lift = settings.handover.pick_lift;
+    relay = find_tool_relay(*cell, product, relay_settings);
+  }
   run_tasks(settings.jobs, n, [&](std::size_t i) {
     PartResult& r = results[i];
     BoardGrasps grasps{r.robot, r.suction, r.human, r.record.mass_properties.com, r.placements};
@@ -412,7 +432,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     handover.seed = part_seed(settings.seed, product.parts[i].name, 4);
     r.handover = plan_handover_goals(*cell, product, i, grasps, comfort, handover);
     if (r.handover.stage.goals == 0 && handover.swap_roles)
-      swap_roles(*cell, product, i, grasps, comfort, handover, r);
+      swap_roles(*cell, product, i, grasps, comfort, relay.handle, handover, r);
     ErgonomicsInputs in;
     in.target = r.record.target;
     in.initial = r.record.initial;
@@ -491,8 +511,10 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
   meta.cell_file = cell_path.substr(cell_path.find_last_of('/') + 1);
   meta.product_file = product_path.substr(product_path.find_last_of('/') + 1);
   meta.human_bodies = format_human_bodies(settings.human_bodies);
+  meta.tool_relay = relay.handle;
   writer.write_meta(meta);
   BuildSummary summary;
+  summary.tool_relay = relay;
   summary.output = output_path;
   std::vector<std::int64_t> roadmap_ids;
   for (const auto& m : roadmaps) {

@@ -1120,39 +1120,4 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   return finish("");
 }
 
-bool reaches_tool_stand(const core::Cell& cell, const core::ProductSpec& product, std::size_t index,
-                        const std::string& arm, double approach, double lift) {
-  const core::Arm& a = cell.arm(arm);
-  const core::Pose& stand = product.suction_tool_pose;
-  const auto finished = core::parts_before(product, index);
-  const auto stacked = core::parts_after(product, index);
-  ArmWorkspace open_hand(cell, arm, arm, nullptr, finished, stacked, &stand);
-  ArmWorkspace holding(cell, arm, arm, nullptr, finished, stacked);
-  const core::Pose base_inv = core::arm_base_in_world(cell, a).inverse();
-  const core::Pose tcp = stand * cell.spec().suction.handle_in_tcp.inverse();
-  const Eigen::Vector3d approach_axis =
-      tcp.linear() * cell.spec().gripper.approach_axis.normalized();
-  core::Pose before = tcp;
-  before.translation() -= approach * approach_axis;
-  core::Pose raised = tcp;
-  raised.translation().z() += lift;
-  // The IK solution nearest `seed` at `pose`, if valid in `workspace`.
-  core::UrIkSolutions near;
-  auto valid_near = [&](const core::Pose& pose, const Eigen::VectorXd& seed,
-                        ArmWorkspace& workspace) {
-    const int m = a.ur_ik->solve(base_inv * pose, seed, near);
-    return m > 0 && workspace.arm_valid(near.q.front());
-  };
-  core::UrIkSolutions ik;
-  const int n = a.ur_ik->solve(base_inv * tcp, a.spec.home, ik);
-  for (int k = 0; k < n; ++k) {
-    const Eigen::VectorXd q = ik.q[static_cast<std::size_t>(k)];
-    if (open_hand.arm_valid(q) && valid_near(before, q, open_hand) &&
-        valid_near(raised, q, holding)) {
-      return true;
-    }
-  }
-  return false;
-}
-
 }  // namespace hila::offline

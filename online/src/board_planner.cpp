@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iomanip>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -15,6 +16,8 @@
 
 #include "hila/core/payload.hpp"
 #include "hila/core/pose.hpp"
+#include "hila/core/stage_scene.hpp"
+#include "hila/core/ur_ik.hpp"
 #include "plan_run.hpp"
 
 namespace hila::online {
@@ -52,9 +55,82 @@ BoardPlanner::BoardPlanner(const PlannerModel& model, const BoardPlanSettings& s
 
 BoardPlanner::~BoardPlanner() = default;
 
+namespace {
+
+// Whether `arm` reaches the suction tool's handle standing at `handle` (world) with an IK
+// solution within its joint limits. Collisions aside: the tool stages check those. An arm
+// without closed-form IK is left to the stages.
+bool reaches_handle(const core::Cell& cell, const std::string& arm, const core::Pose& handle) {
+  const core::Arm& a = cell.arm(arm);
+  if (!a.ur_ik) return true;
+  const core::Pose tcp = handle * cell.spec().suction.handle_in_tcp.inverse();
+  core::UrIkSolutions ik;
+  return a.ur_ik->solve(core::arm_base_in_world(cell, a).inverse() * tcp, a.spec.home, ik) > 0;
+}
+
+}  // namespace
+
 BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                              std::chrono::steady_clock::time_point deadline,
                              const BoardPlanOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  const core::PartSpec* part = nullptr;
+  for (const auto& p : model_.product().parts) {
+    if (p.name == board) part = &p;
+  }
+  const BoardRecords* records = model_.board_records(board);
+  if (part == nullptr || records == nullptr || scene.is_finished(board)) {
+    return plan_here(scene, board, deadline, options);  // says why not
+  }
+  const core::Cell& cell = model_.cell();
+  const std::string suction_arm = model_.suction_arm(board);
+  const std::optional<core::Pose>& relay = model_.tool_relay();
+  // The tool stays in the hand that used it last. Where that is not the board's suction arm, the
+  // holding arm first sets it down where the suction arm takes it (the scene's place, or the
+  // relay where the suction arm does not reach that) and goes home.
+  if (scene.tool_in_hand && scene.tool_arm != suction_arm) {
+    const bool to_relay = relay && !reaches_handle(cell, suction_arm, scene.tool) &&
+                          reaches_handle(cell, suction_arm, *relay);
+    return plan_after_tool_moved(scene, *part, *records, scene.tool_arm,
+                                 to_relay ? *relay : scene.tool, deadline, options, started);
+  }
+  BoardPlan here = plan_here(scene, board, deadline, options);
+  if (here.solved() || here.status != BoardPlanStatus::kNoGoal || scene.tool_in_hand || !relay ||
+      relay->isApprox(scene.tool, 1e-9)) {
+    return here;
+  }
+  // The tool stands where the suction arm does not reach it: the other arm, which does, carries
+  // it to the relay first.
+  std::string mover;
+  for (const auto& arm : cell.arms()) {
+    if (arm.spec.name != suction_arm && mover.empty()) mover = arm.spec.name;
+  }
+  if (mover.empty() || reaches_handle(cell, suction_arm, scene.tool) ||
+      !reaches_handle(cell, suction_arm, *relay) || !reaches_handle(cell, mover, scene.tool)) {
+    return here;
+  }
+  BoardPlan moved =
+      plan_after_tool_moved(scene, *part, *records, mover, *relay, deadline, options, started);
+  if (moved.solved()) {
+    moved.attempts.insert(moved.attempts.begin(), here.attempts.begin(), here.attempts.end());
+    moved.motions_planned += here.motions_planned;
+    moved.rejected_motions += here.rejected_motions;
+    return moved;
+  }
+  here.reason +=
+      "; with the " + mover + " arm carrying the tool to its relay first: " + moved.reason;
+  here.status = moved.status;
+  here.attempts.insert(here.attempts.end(), moved.attempts.begin(), moved.attempts.end());
+  here.motions_planned += moved.motions_planned;
+  here.rejected_motions += moved.rejected_motions;
+  here.planning_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return here;
+}
+
+BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
+                                  std::chrono::steady_clock::time_point deadline,
+                                  const BoardPlanOptions& options) {
   using detail::ArmsState;
   using detail::Run;
   const auto started = std::chrono::steady_clock::now();
@@ -86,13 +162,9 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
   if (records == nullptr) {
     return finish(BoardPlanStatus::kNoGoal, "the database has no board '" + board + "'");
   }
-  // The tool stays in the hand that used it last. Where that is not the board's suction arm, the
-  // holding arm first puts it on its stand and goes home; the board is planned from there.
+  // plan() has the tool in this arm's hand or on the table.
   const std::string suction_arm = model_.suction_arm(board);
   result.suction_arm = suction_arm;
-  if (scene.tool_in_hand && scene.tool_arm != suction_arm) {
-    return plan_after_tool_put_back(scene, *part, *records, deadline, options, started);
-  }
   Run run(model_, settings_, scene, *part, *records, suction_arm, deadline, lazy_prm_);
   running = &run;
   // Payload. The exchange: the suction arm carries the board on the tool, the receiving arm in
@@ -408,40 +480,62 @@ BoardPlan BoardPlanner::plan(const Scene& scene, const std::string& board,
                                                    "(hila inspect DB roadmap)"));
 }
 
-BoardPlan BoardPlanner::plan_after_tool_put_back(const Scene& scene, const core::PartSpec& part,
-                                                 const BoardRecords& records,
-                                                 std::chrono::steady_clock::time_point deadline,
-                                                 const BoardPlanOptions& options,
-                                                 std::chrono::steady_clock::time_point started) {
-  // The holding arm plays the suction arm's part for the put-back: its world carries the tool.
+BoardPlan BoardPlanner::plan_after_tool_moved(const Scene& scene, const core::PartSpec& part,
+                                              const BoardRecords& records, const std::string& mover,
+                                              const core::Pose& place,
+                                              std::chrono::steady_clock::time_point deadline,
+                                              const BoardPlanOptions& options,
+                                              std::chrono::steady_clock::time_point started) {
+  // The moving arm plays the suction arm's part: its world carries the tool. The board lies where
+  // it was detected meanwhile.
   std::vector<PlanStep> steps;
   std::string failure;
   Scene after = scene;
   int motions = 0, rejected = 0;
   PlanTimes times;
-  {
-    detail::Run put_back(model_, settings_, scene, part, records, scene.tool_arm, deadline,
-                         lazy_prm_);
-    detail::ArmsState end = put_back.start();
-    failure = put_back.return_tool(scene.initial_pose(part), steps, end);
-    put_back.stop_validation();
-    motions = put_back.motions_planned();
-    rejected = put_back.rejected_motions();
-    times = put_back.times();
+  auto account = [&](detail::Run& run) {
+    run.stop_validation();
+    motions += run.motions_planned();
+    rejected += run.rejected_motions();
+    const PlanTimes t = run.times();
+    times.motions += t.motions;
+    times.smoothing += t.smoothing;
+    times.validation += t.validation;
+    times.queued_validation += t.queued_validation;
+    times.queued_smoothing += t.queued_smoothing;
+  };
+  if (!scene.tool_in_hand) {
+    after.tool_arm = mover;
+    detail::Run take(model_, settings_, after, part, records, mover, deadline, lazy_prm_);
+    detail::ArmsState end = take.start();
+    failure = take.take_tool(steps, end);
+    account(take);
+    after.tool_in_hand = true;
+    after.robot[mover] = model_.cell().arm_joints(end.robot_q, take.suction_arm());
+  }
+  if (failure.empty()) {
+    after.tool = place;  // where the holder sets it down; it is in hand until then
+    detail::Run put(model_, settings_, after, part, records, mover, deadline, lazy_prm_);
+    detail::ArmsState end = put.start();
+    failure = put.return_tool(scene.initial_pose(part), steps, end);
+    account(put);
     after.tool_in_hand = false;
-    after.robot[scene.tool_arm] = model_.cell().arm_joints(end.robot_q, put_back.suction_arm());
+    after.robot[mover] = model_.cell().arm_joints(end.robot_q, put.suction_arm());
   }
   BoardPlan result;
   if (!failure.empty()) {
     result.board = part.name;
     result.suction_arm = model_.suction_arm(part.name);
     result.status = BoardPlanStatus::kNoGoal;
-    result.reason = "the suction tool is in the " + scene.tool_arm + " arm's hand, and '" +
-                    part.name + "' is the " + result.suction_arm +
-                    " arm's to pick by suction, but the tool cannot be put back on its stand (" +
-                    failure + ")";
+    result.reason =
+        std::string(scene.tool_in_hand
+                        ? "the suction tool is in the " + mover + " arm's hand"
+                        : "the " + result.suction_arm + " arm does not reach the suction tool") +
+        ", and '" + part.name + "' is the " + result.suction_arm +
+        " arm's to pick by suction, but the " + mover +
+        " arm cannot set the tool down where that arm takes it (" + failure + ")";
   } else {
-    result = plan(after, part.name, deadline, options);
+    result = plan_here(after, part.name, deadline, options);
   }
   result.motions_planned += motions;
   result.rejected_motions += rejected;
@@ -460,8 +554,10 @@ BoardPlan BoardPlanner::plan_after_tool_put_back(const Scene& scene, const core:
   for (const PlanStep& s : steps) result.path_length += s.path_length;
   result.duration += clock;
   result.steps.insert(result.steps.begin(), steps.begin(), steps.end());
-  result.tool_put_back_steps = static_cast<int>(steps.size());
-  result.tool_put_back_arm = scene.tool_arm;
+  result.tool_move_steps = static_cast<int>(steps.size());
+  result.tool_move_arm = mover;
+  result.tool_taken_from_table = !scene.tool_in_hand;
+  result.tool_place = place;
   return result;
 }
 

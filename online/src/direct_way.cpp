@@ -81,17 +81,27 @@ void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
   // At the place the tool stands on the table in the open hand (as the tool pick sees it).
   Stage standing = st;
   standing.end.tool_in_hand = false;
-  const auto at = first_valid(standing, suction_planner_, r,
-                              solutions(cell_, suction_, tcp, suction_.spec.home));
-  if (!at) return fail("no valid IK at the tool's place");
-  const auto above = solutions(cell_, suction_, raised, *at);
-  const auto before = solutions(cell_, suction_, pre, *at);
-  if (above.empty() || !first_valid(st, suction_planner_, r, {above.front()})) {
-    return fail("no valid IK above the tool's place");
+  // The first IK branch at the place whose pose above (holding the tool) and way back (the open
+  // hand), each the branch nearest it, are valid too.
+  std::optional<Eigen::VectorXd> at;
+  std::vector<Eigen::VectorXd> above, before;
+  std::string why = "no valid IK at the tool's place";
+  for (const auto& q : solutions(cell_, suction_, tcp, suction_.spec.home)) {
+    if (!first_valid(standing, suction_planner_, r, {q})) continue;
+    above = solutions(cell_, suction_, raised, q);
+    before = solutions(cell_, suction_, pre, q);
+    if (above.empty() || !first_valid(st, suction_planner_, r, {above.front()})) {
+      why = "no valid IK above the tool's place";
+      continue;
+    }
+    if (before.empty() || !first_valid(standing, suction_planner_, r, {before.front()})) {
+      why = "no valid IK to back off from the tool's handle";
+      continue;
+    }
+    at = q;
+    break;
   }
-  if (before.empty() || !first_valid(standing, suction_planner_, r, {before.front()})) {
-    return fail("no valid IK to back off from the tool's handle");
-  }
+  if (!at) return fail(why);
   MotionRequest to = r;
   to.start = arm_q(st, suction_);
   to.goal = above.front();
@@ -118,6 +128,20 @@ void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
   }
 }
 
+namespace {
+
+// The stage's steps appended to `steps` with their times after the last one's, `end` its end.
+void append_after(const Stage& st, std::vector<PlanStep>& steps, ArmsState& end) {
+  const double clock = steps.empty() ? 0.0 : steps.back().time.back();
+  for (PlanStep s : st.steps) {
+    for (double& t : s.time) t += clock;
+    steps.push_back(std::move(s));
+  }
+  end = st.end;
+}
+
+}  // namespace
+
 std::string Run::return_tool(const core::Pose& board_world, std::vector<PlanStep>& steps,
                              ArmsState& end) {
   if (!end.tool_in_hand) return "";
@@ -141,12 +165,16 @@ std::string Run::return_tool(const core::Pose& board_world, std::vector<PlanStep
   });
   const Stage& st = *tool_return_;
   if (!st.ok()) return st.failure;
-  const double clock = steps.empty() ? 0.0 : steps.back().time.back();
-  for (PlanStep s : st.steps) {
-    for (double& t : s.time) t += clock;
-    steps.push_back(std::move(s));
-  }
-  end = st.end;
+  append_after(st, steps, end);
+  return "";
+}
+
+std::string Run::take_tool(std::vector<PlanStep>& steps, ArmsState& end) {
+  const Stage* stages[1] = {};
+  plan_settled(stages, 0, [&] { stages[0] = &tool(); });
+  const Stage& st = *tool_;
+  if (!st.ok()) return st.failure;
+  append_after(st, steps, end);
   return "";
 }
 

@@ -125,21 +125,42 @@ const Stage& Run::tool() {
   const core::Pose pre = shifted(tcp, -settings_.approach * (tcp.linear() * approach_tcp_));
   MotionRequest r;
   r.board_world = board_initial_;
-  const auto at =
-      first_valid(st, suction_planner_, r, solutions(cell_, suction_, tcp, suction_.spec.home));
-  if (!at) return fail("no valid IK at the tool's handle");
-  const auto before = solutions(cell_, suction_, pre, *at);
-  if (before.empty()) return fail("no IK before the handle");
+  // The first IK branch at the handle whose way in (the open hand, the branch nearest it) and
+  // lift (holding the tool, likewise) are valid too.
+  Stage holding = st;
+  holding.end.tool_in_hand = true;
+  cell_.set_jaw(holding.end.robot_q, suction_, cell_.spec().suction.handle_width);
+  const core::Pose up = shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift));
+  std::optional<Eigen::VectorXd> at, before, raised;
+  bool any_at = false;
+  for (const auto& q : solutions(cell_, suction_, tcp, suction_.spec.home)) {
+    if (!first_valid(st, suction_planner_, r, {q})) continue;
+    any_at = true;
+    const auto in = solutions(cell_, suction_, pre, q);
+    const auto lifted = solutions(cell_, suction_, up, q);
+    if (in.empty() || lifted.empty() || !first_valid(st, suction_planner_, r, {in.front()}) ||
+        !first_valid(holding, suction_planner_, r, {lifted.front()})) {
+      continue;
+    }
+    at = q;
+    before = in.front();
+    raised = lifted.front();
+    break;
+  }
+  if (!at) {
+    return fail(any_at ? "no IK branch at the tool's handle with a valid way in and lift"
+                       : "no valid IK at the tool's handle");
+  }
   MotionRequest approach = r;
   approach.start = arm_q(st, suction_);
-  approach.goal = before.front();
+  approach.goal = *before;
   if (auto e = step(st, suction_planner_, suction_, approach, "tool_approach", "", "");
       !e.empty()) {
     st.failure = e;
     return st;
   }
   MotionRequest in = r;
-  in.start = before.front();
+  in.start = *before;
   in.goal = *at;
   if (auto e = step(st, suction_planner_, suction_, in, "tool_grasp", "", "tool_grasped");
       !e.empty()) {
@@ -148,19 +169,16 @@ const Stage& Run::tool() {
   }
   st.end.tool_in_hand = true;
   cell_.set_jaw(st.end.robot_q, suction_, cell_.spec().suction.handle_width);
-  const auto raised =
-      solutions(cell_, suction_, shifted(tcp, Eigen::Vector3d(0.0, 0.0, settings_.lift)), *at);
-  if (raised.empty()) return fail("no IK above the tool's place");
   MotionRequest lift = r;
   lift.start = *at;
-  lift.goal = raised.front();
+  lift.goal = *raised;
   lift.start_in_contact = true;  // the cup still stands on the table
   if (auto e = step(st, suction_planner_, suction_, lift, "tool_lift", "", ""); !e.empty()) {
     st.failure = e;
     return st;
   }
   MotionRequest home = r;
-  home.start = raised.front();
+  home.start = *raised;
   home.goal = suction_.spec.home;
   if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home", "", ""); !e.empty()) {
     st.failure = e;
@@ -263,8 +281,7 @@ std::vector<std::int64_t> Run::stand_in_cups(const db::SuctionGraspRecord& cup) 
   const Eigen::Matrix3d nominal = (part_.initial * cup.cup).linear();
   std::vector<std::pair<double, std::int64_t>> turned;
   for (const auto& [id, other] : suction_grasps_) {
-    if (id == cup.id ||
-        (other.cup.translation() - cup.cup.translation()).norm() > kSameCupPoint ||
+    if (id == cup.id || (other.cup.translation() - cup.cup.translation()).norm() > kSameCupPoint ||
         other.cup.linear().col(2).dot(cup.cup.linear().col(2)) < kSameCupAxis) {
       continue;
     }
@@ -339,8 +356,7 @@ void Run::forget_after_transfer(std::int64_t rr_id) {
   drop(leaves_, first);
 }
 
-std::string Run::transfer_steps(Stage& st, const db::RobotHandoverRecord& rr,
-                                std::int64_t cup_id) {
+std::string Run::transfer_steps(Stage& st, const db::RobotHandoverRecord& rr, std::int64_t cup_id) {
   const db::SuctionGraspRecord& cup = suction_grasps_.at(cup_id);
   const core::Pose rr_tcp = rr.board * cup.cup * world_.stage().cup_in_tcp.inverse();
   const auto stored = stored_edges(

@@ -169,6 +169,11 @@ class Run {
   std::string return_tool(const core::Pose& board_world, std::vector<PlanStep>& steps,
                           ArmsState& end);
 
+  // Where the scene has the tool on the table: the suction arm takes it and goes home with it
+  // (steps tool_approach, tool_grasp, tool_lift, tool_to_home), appended to `steps` as
+  // return_tool's, `end` updated. "" or the failure. Settled before it returns.
+  std::string take_tool(std::vector<PlanStep>& steps, ArmsState& end);
+
   // The whole chain for one goal and shared grasp: the memoised stages in order.
   std::string chain(const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared,
                     std::vector<PlanStep>& steps, ArmsState& end);

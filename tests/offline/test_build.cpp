@@ -181,7 +181,11 @@ TEST(Build, APartOutOfTheSuctionArmsReachIsNamedWithItsPose) {
 
 // The same part with the suction tool standing where both arms reach it: the left arm takes the
 // tool and picks the part by suction, the right arm receives it (the roles swapped).
-TEST(Build, APartOnlyTheLeftArmReachesIsPickedByItsSuctionWhenItReachesTheTool) {
+// back_upper laid on the left, where only the left arm picks it by suction. The left arm does not
+// reach the tool's stand: with no relay (its search off) the part keeps no goal and the reason
+// says what the swap needed; with the relay, or with the stand where both arms reach, the left arm
+// picks it by suction.
+TEST(Build, APartOnlyTheLeftArmReachesIsPickedByItsSuctionWhenItGetsTheTool) {
   const std::string dir = test::temp_dir("build_swap");
   // More candidates than the quick build's: the left arm's side has few comfortable ones.
   offline::BuildSettings settings = quick_settings();
@@ -190,17 +194,32 @@ TEST(Build, APartOnlyTheLeftArmReachesIsPickedByItsSuctionWhenItReachesTheTool) 
   const std::string moved = product_variant(dir, "initial: {xyz: [0.30, -0.30, 1.0965]",
                                             "initial: {xyz: [0.30, 0.30, 1.0965]");
   {
+    offline::BuildSettings no_relay = settings;
+    no_relay.tool_relay.spacing = 0.0;  // no grid: no relay
     const offline::BuildSummary summary =
-        offline::build_database(moved, test::cell_path(), dir + "/rack.hila", settings);
+        offline::build_database(moved, test::cell_path(), dir + "/rack.hila", no_relay);
+    EXPECT_FALSE(summary.tool_relay.handle);
     const auto& last = summary.parts.back();
     EXPECT_EQ(last.goals, 0);
     EXPECT_NE(last.handover_failure.find("with the left arm picking by suction it would have "),
               std::string::npos)
         << last.handover_failure;
     EXPECT_NE(last.handover_failure.find("but the left arm does not reach the suction tool on its "
-                                         "stand at (0.3, -0.72, 1.229) m"),
+                                         "stand at (0.3, -0.72, 1.229) m, and no place on the "
+                                         "table serves both arms as a relay"),
               std::string::npos)
         << last.handover_failure;
+  }
+  {
+    const offline::BuildSummary summary =
+        offline::build_database(moved, test::cell_path(), dir + "/relay.hila", settings);
+    ASSERT_TRUE(summary.tool_relay.handle);
+    const auto& last = summary.parts.back();
+    EXPECT_GT(last.goals, 0) << last.handover_failure;
+    EXPECT_EQ(last.suction_arm, "left");
+    const auto database = db::Database::open(dir + "/relay.hila");
+    ASSERT_TRUE(database.meta().tool_relay);
+    EXPECT_TRUE(database.meta().tool_relay->isApprox(*summary.tool_relay.handle, 1e-12));
   }
   std::string text = test::read_file(moved);
   const std::string rack = "suction_tool_pose: {xyz: [0.30, -0.72, 1.229]";

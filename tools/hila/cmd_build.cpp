@@ -178,6 +178,13 @@ int run_build(const BuildOptions& opt) {
     }
     std::cout << std::setw(8) << std::setprecision(2) << p.regrasp_seconds << "\n";
   }
+  if (const auto& relay = summary.tool_relay.handle) {
+    const Eigen::Vector3d at = relay->translation();
+    std::cout << "  suction tool relay: (" << std::fixed << std::setprecision(3) << at.x() << ", "
+              << at.y() << ", " << at.z() << ") m, both arms take the tool there (of "
+              << summary.tool_relay.places << " places, " << summary.tool_relay.clear
+              << " clear of the parts)\n";
+  }
   if (!settings.human_bodies.empty()) {
     std::cout << "  body set: " << offline::format_human_bodies(settings.human_bodies) << "\n";
     for (const auto& p : summary.parts) {

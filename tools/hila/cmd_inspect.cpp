@@ -28,6 +28,8 @@ double round_to(double v, double unit) {
   return std::round(v / unit) * unit;
 }
 
+nlohmann::json pose_json(const core::Pose& pose);
+
 nlohmann::json summary_json(const db::Database& database) {
   nlohmann::json out;
   const auto& m = database.meta();
@@ -37,6 +39,7 @@ nlohmann::json summary_json(const db::Database& database) {
   out["hila_version"] = m.hila_version;
   out["seed"] = m.seed;
   out["created_at"] = m.created_at;
+  out["tool_relay"] = m.tool_relay ? pose_json(*m.tool_relay) : nlohmann::json();
   out["parts"] = nlohmann::json::array();
   for (const auto& part : database.parts()) {
     const auto robot = database.robot_grasps(part.id);
@@ -340,6 +343,11 @@ int run_inspect(const InspectOptions& opt) {
             << ", schema " << j["schema_version"].get<int>() << ", seed "
             << j["seed"].get<std::uint64_t>() << ", built " << j["created_at"].get<std::string>()
             << "\n";
+  if (const auto& relay = database.meta().tool_relay) {
+    const Eigen::Vector3d at = relay->translation();
+    std::cout << "  suction tool relay (both arms take it there): (" << std::fixed
+              << std::setprecision(3) << at.x() << ", " << at.y() << ", " << at.z() << ") m\n";
+  }
   std::cout << "  #  part            mass  robot  suction  human (1-hand)  theta_c deg\n";
   for (const auto& p : j["parts"]) {
     std::cout << "  " << p["order"].get<int>() << "  " << std::left << std::setw(14)

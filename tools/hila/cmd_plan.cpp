@@ -95,9 +95,12 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
         {"exchanges", exchanges},
         {"delivered_by", plan.delivering_arm},
         {"suction_tool", {{"arm", plan.suction_arm}, {"in_hand_after", plan.tool_in_hand_after}}}};
-    if (plan.tool_put_back_steps > 0) {
-      j["mode"]["suction_tool"]["put_back_first"] = {{"arm", plan.tool_put_back_arm},
-                                                     {"steps", plan.tool_put_back_steps}};
+    if (plan.tool_move_steps > 0 && plan.tool_place) {
+      j["mode"]["suction_tool"]["moved_first"] = {
+          {"arm", plan.tool_move_arm},
+          {"steps", plan.tool_move_steps},
+          {"from", plan.tool_taken_from_table ? "table" : "hand"},
+          {"to", pose_to_json(*plan.tool_place)}};
     }
     if (plan.mode == online::DeliveryMode::kRegrasp) {
       j["mode"]["set_down"] = {{"board", pose_to_json(plan.set_down)},
@@ -175,7 +178,8 @@ int run_plan(const PlanOptions& opt) {
     const std::string& board = boards[k];
     const auto deadline = std::chrono::steady_clock::now() +
                           std::chrono::microseconds(static_cast<long>(opt.deadline_s * 1e6));
-    // Where the tool is in the other arm's hand, the plan begins by putting it back on its stand.
+    // Where the suction arm cannot take the tool where it is, the plan begins with the other arm
+    // setting it down where it can (BoardPlan::tool_place).
     const online::BoardPlan plan = planner.plan(scene, board, deadline);
     out["boards"].push_back(plan_json(plan));
     if (!opt.json) {
@@ -200,6 +204,7 @@ int run_plan(const PlanOptions& opt) {
     if (plan.solved()) {
       scene.tool_in_hand = plan.tool_in_hand_after;
       scene.tool_arm = plan.suction_arm;
+      if (plan.tool_place) scene.tool = *plan.tool_place;
     }
     for (const auto& arm : model->cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
   }

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -291,6 +292,10 @@ struct Meta {
   // The human bodies every handover goal was checked for, "STATURE SEX" joined by "; " (empty:
   // the cell's human only).
   std::string human_bodies;
+  // Where the suction tool may stand besides its stand, taken and set down there by every arm
+  // (offline::find_tool_relay): the handle's pose (world). None: no place serves, or the build did
+  // not look (a file written before hila 0.12, or roles never swapped).
+  std::optional<core::Pose> tool_relay;
 };
 
 }  // namespace hila::db

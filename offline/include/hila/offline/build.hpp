@@ -16,6 +16,7 @@
 #include "hila/offline/regrasp.hpp"
 #include "hila/offline/robot_grasps.hpp"
 #include "hila/offline/suction_grasps.hpp"
+#include "hila/offline/tool_place.hpp"
 
 namespace hila::offline {
 
@@ -30,6 +31,9 @@ struct BuildSettings {
   ErgonomicsSettings ergonomics;
   RoadmapSettings roadmap;  // one per arm; suction_arm follows handover.suction_arm
   RegraspSettings regrasp;  // arms follow handover's
+  // The tool's relay (with handover.swap_roles): approach and lift follow handover's
+  // exchange_approach and pick_lift.
+  ToolRelaySettings tool_relay;
   // Empty: handover goals must be comfortable for the cell's human. Otherwise for every body of
   // the set (statures and sexes, served by the cell human's maps; see HumanComfort).
   std::vector<core::HumanBodySpec> human_bodies;
@@ -93,6 +97,7 @@ struct BuildSummary {
   std::vector<PartBuildSummary> parts;          // in assembly order
   std::vector<ComfortMapSummary> comfort_maps;  // in the cell's human-arm order
   std::vector<RoadmapSummary> roadmaps;         // suction arm, receiving arm
+  ToolRelay tool_relay;                         // where both arms take the tool (meta tool_relay)
   double seconds = 0.0;
   // Boards without a handover goal (the database is still written, with the reasons stored).
   std::vector<std::string> failed_parts() const;

@@ -108,14 +108,6 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                                    std::size_t index, const BoardGrasps& grasps,
                                    const HumanComfort& comfort, const HandoverSettings& settings);
 
-// Whether `arm` can take the suction tool from its stand (product.suction_tool_pose) and put it
-// back, as the online tool stages do: an IK solution with the open hand at the handle, the one
-// nearest it `approach` m back along the gripper's approach (open hand) and the one nearest it
-// `lift` m above (holding the tool), each within the joint limits and clear of the cell and of
-// the parts standing at the stage of product.parts[index].
-bool reaches_tool_stand(const core::Cell& cell, const core::ProductSpec& product, std::size_t index,
-                        const std::string& arm, double approach, double lift);
-
 // Eq. 8 distance between two poses.
 double handover_distance(const core::Pose& a, const core::Pose& b, double rotation_weight);
 // Rotation angle between two orientations, degrees.

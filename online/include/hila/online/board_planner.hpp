@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -164,10 +165,16 @@ struct BoardPlan {
   Eigen::VectorXd robot_q_after;    // the robot when the board has been taken
   bool tool_in_hand_after = false;  // an arm still holds the tool then: suction_arm
   std::string suction_arm;          // the arm that holds the tool in this plan
-  // Where the scene had the tool in the other arm's hand: that arm (tool_put_back_arm) puts it on
-  // its stand and goes home in the plan's first tool_put_back_steps steps, before the board's own.
-  int tool_put_back_steps = 0;
-  std::string tool_put_back_arm;
+  // Where the suction arm could not take the tool where the scene has it (in the other arm's
+  // hand, or standing out of the suction arm's reach): the plan's first tool_move_steps steps are
+  // the other arm (tool_move_arm) taking it from the table (tool_taken_from_table) or already
+  // holding it, setting it down at tool_place (the scene's place, or the relay both arms reach:
+  // PlannerModel::tool_relay) and going home; the board's own steps follow, the tool standing
+  // there, and the next board's scene has it there.
+  int tool_move_steps = 0;
+  std::string tool_move_arm;
+  bool tool_taken_from_table = false;
+  std::optional<core::Pose> tool_place;
   std::string tool_kept;  // why the tool was not put back (BoardPlanOptions::return_tool)
   bool solved() const { return status == BoardPlanStatus::kSolved; }
 };
@@ -202,13 +209,19 @@ class BoardPlanner {
                  const BoardPlanOptions& options = {});
 
  private:
-  // plan() where the scene has the tool in the other arm's hand: that arm puts it on its stand
-  // and goes home, then the board is planned from there; the plan begins with those steps.
-  BoardPlan plan_after_tool_put_back(const Scene& scene, const core::PartSpec& part,
-                                     const BoardRecords& records,
-                                     std::chrono::steady_clock::time_point deadline,
-                                     const BoardPlanOptions& options,
-                                     std::chrono::steady_clock::time_point started);
+  // plan() for a scene where the board's suction arm has the tool in hand or on the table.
+  BoardPlan plan_here(const Scene& scene, const std::string& board,
+                      std::chrono::steady_clock::time_point deadline,
+                      const BoardPlanOptions& options);
+  // `mover` takes the tool (from the table where the scene has it there) and sets it down at
+  // `place`, then goes home; the board is planned from there (plan_here) and the plan begins
+  // with those steps.
+  BoardPlan plan_after_tool_moved(const Scene& scene, const core::PartSpec& part,
+                                  const BoardRecords& records, const std::string& mover,
+                                  const core::Pose& place,
+                                  std::chrono::steady_clock::time_point deadline,
+                                  const BoardPlanOptions& options,
+                                  std::chrono::steady_clock::time_point started);
 
   const PlannerModel& model_;
   BoardPlanSettings settings_;

@@ -4,6 +4,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -68,6 +69,8 @@ class PlannerModel {
   const BoardRecords* board_records(const std::string& board) const;
   // The arm that picks `board` by suction (BoardRecords::suction_arm, else kDefaultSuctionArm).
   std::string suction_arm(const std::string& board) const;
+  // Where both arms take and set down the suction tool besides its stand (db::Meta::tool_relay).
+  const std::optional<core::Pose>& tool_relay() const { return database_.meta().tool_relay; }
 
  private:
   PlannerModel(std::shared_ptr<const core::Cell> cell, core::ProductSpec product,
