@@ -23,63 +23,11 @@ std::chrono::steady_clock::time_point in_seconds(double s) {
   return std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(s * 1e6));
 }
 
-// A 49 x 68 x 25 mm L bracket of 2.4 mm steel (tools/dev/gen_products --seed 1, product 16),
-// lying on its L face on the left of the table; its target in a corner of a crate in front of
-// the human.
-std::string bracket_product(const std::string& dir) {
-  test::write_file(dir, "bracket.obj", R"(o bracket
-v -24.408 -34.080 -12.493
-v 24.408 -34.080 -12.493
-v 24.408 -31.649 -12.493
-v -21.977 -31.649 -12.493
-v -21.977 34.080 -12.493
-v -24.408 34.080 -12.493
-v -24.408 -34.080 12.493
-v 24.408 -34.080 12.493
-v 24.408 -31.649 12.493
-v -21.977 -31.649 12.493
-v -21.977 34.080 12.493
-v -24.408 34.080 12.493
-f 7 8 9
-f 3 2 1
-f 7 9 10
-f 4 3 1
-f 12 7 10
-f 4 1 6
-f 10 11 12
-f 6 5 4
-f 1 2 8
-f 1 8 7
-f 2 3 9
-f 2 9 8
-f 3 4 10
-f 3 10 9
-f 4 5 11
-f 4 11 10
-f 5 6 12
-f 5 12 11
-f 6 1 7
-f 6 7 12
-)");
-  return test::write_file(dir, "product.yaml", R"(name: bracket
-assembly_frame: {xyz: [0.658883, -0.031896, 1.094], rpy_deg: [0, 0, 1.849]}
-suction_tool_pose: {xyz: [0.30, -0.72, 1.229], rpy_deg: [0, 0, 0]}
-parts:
-  - name: bracket
-    order: 1
-    mesh: bracket.obj
-    mesh_unit: mm
-    mass: 0.0546
-    target: {xyz: [-0.052145, -0.133773, 0.05528], rotation: [[0, 0, 1], [1, 0, 0], [0, 1, 0]]}
-    initial: {xyz: [0.43, 0.201716, 1.107993], rotation: [[0.052221916, -0.998635505, 0], [0.998635505, 0.052221916, 0], [0, 0, 1]]}
-)");
-}
-
 }  // namespace
 
 TEST(RegraspWay, ABracketTheGripperCannotDeliverAsItLiesIsSetDownAndTakenAgain) {
   const std::string dir = test::temp_dir("regrasp_way");
-  const std::string product = bracket_product(dir);
+  const std::string product = test::bracket_product(dir);
   offline::BuildSettings settings = test::quick_build_settings(7, 2);
   // Few of the quick build's 60 candidates are comfortable for so small a part.
   settings.handover.candidates = 400;

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -284,6 +285,61 @@ TEST(Cli, SameSeedSameDigestWhateverTheJobs) {
   EXPECT_EQ(run("inspect " + dir + "/b.hila digest").out, digest1.out);
 }
 
+// The manipulation graph of a part served by a regrasp on the table (an L bracket no cup holds,
+// whose grasps where it lies leave the human no room): `inspect graph` lists that way, its
+// set-downs and their edges as `inspect handover` lists the goals' regrasp records.
+TEST(Cli, InspectGraphShowsTheRegraspsOnTheTable) {
+  const std::string dir = test::temp_dir("cli_graph_regrasp");
+  const std::string product = test::bracket_product(dir);
+  const std::string db = dir + "/bracket.hila";
+  const CommandRun built = run(
+      "build " + product + " --cell " + test::cell_path() +
+      " --comfort-samples 20000 --handover-candidates 400 --roadmap-nodes 300 --jobs 2 -o " + db);
+  ASSERT_EQ(built.status, 0) << built.out;
+  const CommandRun handover = run("inspect " + db + " handover --part bracket --json");
+  ASSERT_EQ(handover.status, 0) << handover.out;
+  const auto h = nlohmann::json::parse(json_part(handover.out));
+  std::map<std::int64_t, nlohmann::json> set_downs;  // regrasp id -> its set-down pose
+  int goals_regrasp = 0;
+  for (const auto& goal : h["ranked_goals"]) {
+    goals_regrasp += goal["table_regrasps"].empty() ? 0 : 1;
+    for (const auto& r : goal["table_regrasps"]) set_downs[r["id"]] = r["set_down"];
+  }
+  ASSERT_GT(goals_regrasp, 0) << handover.out;
+
+  const CommandRun graph = run("inspect " + db + " graph --part bracket --json");
+  ASSERT_EQ(graph.status, 0) << graph.out;
+  const auto g = nlohmann::json::parse(json_part(graph.out));
+  EXPECT_EQ(g["summary"]["goals_regrasp"], goals_regrasp);
+  std::size_t way_set_downs = 0;
+  for (const auto& way : g["summary"]["ways"]) {
+    if (way["way"] == "regrasp") way_set_downs += way["set_downs"].size();
+  }
+  EXPECT_EQ(way_set_downs, set_downs.size());
+  std::set<std::string> nodes;
+  int set_down_nodes = 0;
+  for (const auto& n : g["nodes"]) {
+    nodes.insert(n["id"].get<std::string>());
+    if (n["kind"] != "set_down") continue;
+    ++set_down_nodes;
+    const auto& pose = set_downs.at(n["regrasp"].get<std::int64_t>());
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(n["position"][k].get<double>(), pose["xyz"][k].get<double>(), 2e-5);
+    }
+  }
+  EXPECT_EQ(static_cast<std::size_t>(set_down_nodes), set_downs.size());
+  int set_down_edges = 0;
+  for (const auto& e : g["edges"]) {
+    EXPECT_TRUE(nodes.count(e["from"].get<std::string>()) &&
+                nodes.count(e["to"].get<std::string>()))
+        << e.dump();
+    set_down_edges += e["kind"] == "set_down" ? 1 : 0;
+  }
+  EXPECT_EQ(static_cast<std::size_t>(set_down_edges), set_downs.size());
+  const CommandRun text = run("inspect " + db + " graph --part bracket");
+  EXPECT_NE(text.out.find("regrasp on table by "), std::string::npos) << text.out;
+}
+
 // tools/demo's --if-outdated: a database from this hila, the same files, settings and seed is
 // kept untouched; another seed or a file that is not a database is rebuilt, with the reason.
 TEST(Cli, BuildIfOutdatedKeepsACurrentDatabaseAndRebuildsAStaleOne) {
@@ -336,9 +392,10 @@ TEST(Cli, BuildAndInspectBadInputs) {
   EXPECT_NE(run("build " + test::product_path() + " -o " + dir + "/x.hila --jobs 0").status, 0);
   // No board can be comfortable at Q > 0.99: the build finishes every board, writes the database
   // with the reasons, names each failing board and exits 1.
-  const CommandRun strict = run("build " + test::product_path() + " -o " + dir +
-                                "/ok.hila --comfort-samples 20000 --handover-candidates 40 "
-                                "--comfort-threshold 0.99 --comfort-floor 0.99 --roadmap-nodes 200");
+  const CommandRun strict =
+      run("build " + test::product_path() + " -o " + dir +
+          "/ok.hila --comfort-samples 20000 --handover-candidates 40 "
+          "--comfort-threshold 0.99 --comfort-floor 0.99 --roadmap-nodes 200");
   EXPECT_EQ(strict.status, 1) << strict.out;
   EXPECT_NE(strict.out.find("lateral_left: no handover goal: no candidate is comfortable"),
             std::string::npos)
@@ -400,8 +457,7 @@ TEST(Cli, PlanBadInputsGiveClearErrorsAndExitCodeTwo) {
 namespace {
 
 // The build options that keep a build quick, should a refused build run after all.
-const std::string kSmall =
-    " --comfort-samples 1000 --handover-candidates 5 --roadmap-nodes 20";
+const std::string kSmall = " --comfort-samples 1000 --handover-candidates 5 --roadmap-nodes 20";
 
 // The bundled cabinet and cell copied into `dir` (dir/cabinet, dir/cell: the scene's relative
 // paths still hold), so a command that wrongly overwrites an input damages only the copy.
@@ -458,8 +514,9 @@ TEST(Cli, BuildRefusesAnOutputThatIsAnInputBeforeAnyWork) {
   for (const Case& c : cases) {
     const std::string before = test::read_file(c.output);
     const CommandRun r = run(build + c.output);
-    expect_one_line_error(r, "-o: expected an output path that is not an input of the command, got '" +
-                                 c.output + "'");
+    expect_one_line_error(
+        r,
+        "-o: expected an output path that is not an input of the command, got '" + c.output + "'");
     EXPECT_NE(r.out.find(c.role), std::string::npos) << r.out;
     EXPECT_EQ(test::read_file(c.output), before) << c.output;
   }
@@ -561,8 +618,9 @@ TEST(Cli, PlanOnAFullDiskLeavesNoTemporaryFile) {
 
 TEST(Cli, CommandLineErrorsExitTwoOnOneLine) {
   const std::string dir = test::temp_dir("cli_command_line");
-  expect_one_line_error(run("frobnicate"), "expected a subcommand (cell, human, mesh, product, "
-                                           "build, inspect, report, plan, export), got 'frobnicate'");
+  expect_one_line_error(run("frobnicate"),
+                        "expected a subcommand (cell, human, mesh, product, "
+                        "build, inspect, report, plan, export), got 'frobnicate'");
   expect_one_line_error(run(""), "A subcommand is required");
   expect_one_line_error(run("build"), "product is required (hila build --help");
   const std::string build = "build " + test::product_path() + kSmall + " -o " + dir + "/x.hila";
@@ -587,8 +645,8 @@ TEST(Cli, NumericOptionsOutsideTheirRangeAreRefused) {
   // Quick builds but for the option under test, should a value be accepted after all.
   auto build = [&](const std::string& option, const std::string& value) {
     std::string command = "build " + test::product_path() + " -o " + dir + "/x.hila --jobs 2";
-    for (const char* small : {"--comfort-samples 1000", "--handover-candidates 5",
-                              "--roadmap-nodes 20"}) {
+    for (const char* small :
+         {"--comfort-samples 1000", "--handover-candidates 5", "--roadmap-nodes 20"}) {
       if (std::string(small).rfind(option, 0) != 0) command += std::string(" ") + small;
     }
     return run(command + " " + option + " " + value);
@@ -598,17 +656,16 @@ TEST(Cli, NumericOptionsOutsideTheirRangeAreRefused) {
                           std::string("--seed: expected an integer in [0, 2^64), got ") + seed);
   }
   for (const char* threshold : {"nan", "inf", "-0.1", "1.5"}) {
-    expect_one_line_error(build("--comfort-threshold", threshold),
-                          std::string("--comfort-threshold: expected a number in [0, 1], got ") +
-                              threshold);
+    expect_one_line_error(
+        build("--comfort-threshold", threshold),
+        std::string("--comfort-threshold: expected a number in [0, 1], got ") + threshold);
   }
-  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
-           {"--comfort-samples", "0"},
-           {"--handover-candidates", "-5"},
-           {"--roadmap-nodes", "1e9"},
-           {"--comfort-samples", "99999999999"}}) {
-    expect_one_line_error(build(option, value),
-                          option + ": expected an integer in [1, ");
+  for (const auto& [option, value] :
+       std::vector<std::pair<std::string, std::string>>{{"--comfort-samples", "0"},
+                                                        {"--handover-candidates", "-5"},
+                                                        {"--roadmap-nodes", "1e9"},
+                                                        {"--comfort-samples", "99999999999"}}) {
+    expect_one_line_error(build(option, value), option + ": expected an integer in [1, ");
   }
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.hila"));
   const std::string plan = "plan --db x.hila --scene s.yaml --all --deadline ";
@@ -688,9 +745,9 @@ TEST(Cli, ADirectoryGivenAsAnInputFileIsBadInput) {
   expect_one_line_error(
       run("build " + dir + " --cell " + test::cell_path() + kSmall + " -o " + dir + "/x.hila"),
       "expected a YAML file, got a directory");
-  expect_one_line_error(run("build " + test::product_path() + " --cell " + dir + kSmall + " -o " +
-                            dir + "/x.hila"),
-                        "expected a YAML file, got a directory");
+  expect_one_line_error(
+      run("build " + test::product_path() + " --cell " + dir + kSmall + " -o " + dir + "/x.hila"),
+      "expected a YAML file, got a directory");
   EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 
@@ -751,8 +808,8 @@ TEST(Cli, AUrdfThatIsNotXmlIsNamed) {
   const std::string urdf = test::write_file(dir + "/cell", "human.urdf", "human: not a urdf\n");
   expect_one_line_error(run("cell check " + dir + "/cell/cell.yaml"),
                         urdf + ": (file): expected a URDF (XML), got text that is not XML");
-  expect_one_line_error(run("build " + test::product_path() + " --cell " + dir +
-                            "/cell/cell.yaml" + kSmall + " -o " + dir + "/x.hila"),
+  expect_one_line_error(run("build " + test::product_path() + " --cell " + dir + "/cell/cell.yaml" +
+                            kSmall + " -o " + dir + "/x.hila"),
                         urdf + ": (file): expected a URDF (XML)");
 }
 

@@ -33,6 +33,12 @@ std::string read_file(const std::string& path);
 // into `dir` with the URDFs it names; returns the cell file's path.
 std::string cell_variant(const std::string& dir, const std::string& from, const std::string& to);
 
+// A 49 x 68 x 25 mm L bracket of 2.4 mm steel (tools/dev/gen_products --seed 1, product 16)
+// lying on the left of the table, no face for the suction cup, as a one-part product written into
+// `dir` (bracket.obj, product.yaml); returns the product file's path. Its gripper grasps where it
+// lies leave the human no room: a regrasp on the table serves it.
+std::string bracket_product(const std::string& dir);
+
 core::Pose random_pose(std::mt19937_64& rng, double position_range = 1.0);
 
 // Runs `fn`, expects core::InputError whose message contains every fragment.

@@ -162,6 +162,16 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
                         {"slip_pick_deg", round_to(d.inclination_pick_deg, 0.01)},
                         {"slip_rh_deg", round_to(d.inclination_rh_deg, 0.01)}});
     }
+    // Regrasps on the table: the grasp the arm picks it with, where it sets it down, the grasp it
+    // takes it again with and delivers.
+    nlohmann::json regrasps = nlohmann::json::array();
+    for (const auto& r : database.table_regrasps(c.id)) {
+      regrasps.push_back({{"id", r.id},
+                          {"arm", r.arm},
+                          {"pick_grasp", r.pick_grasp_id},
+                          {"robot_grasp", r.robot_grasp_id},
+                          {"set_down", pose_json(r.placement)}});
+    }
     nlohmann::json g = {{"rank", c.rank},
                         {"candidate", c.id},
                         {"distance", round_to(c.distance, 1e-5)},
@@ -171,7 +181,8 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
                         {"pose", pose_json(c.board)},
                         {"human_posture_solved", c.human_joints.size() > 0},
                         {"shared_grasps", shared},
-                        {"direct_grasps", direct}};
+                        {"direct_grasps", direct},
+                        {"table_regrasps", regrasps}};
     if (!c.second_arm.empty()) {
       g["second_arm"] = c.second_arm;
       g["second_grasp"] = c.second_grasp_id;

@@ -1,5 +1,6 @@
 #include "cmd_inspect_graph.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -13,18 +14,30 @@
 #include <vector>
 
 #include "hila/core/error.hpp"
+#include "hila/core/pose.hpp"
 
 namespace hila::tools {
 
 namespace {
 
 using Id = std::int64_t;
-using RrGrasp = std::pair<Id, Id>;                   // (robot handover, robot grasp)
-using RrGraspGoal = std::tuple<Id, Id, Id>;          // (robot handover, robot grasp, candidate)
-using WayKey = std::pair<std::string, std::string>;  // (suction arm, "" for direct; delivering arm)
+using RrGrasp = std::pair<Id, Id>;           // (robot handover, robot grasp)
+using RrGraspGoal = std::tuple<Id, Id, Id>;  // (robot handover, robot grasp, candidate)
+// (suction arm, "" for direct, "table" for a regrasp on the table; delivering arm)
+using WayKey = std::pair<std::string, std::string>;
 
 double round_to(double v, double unit) {
   return std::round(v / unit) * unit;
+}
+
+// A pose as {"xyz": [m], "quaternion_wxyz": [...]}, rounded to 1e-6.
+nlohmann::json pose_values(const core::Pose& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d& t = pose.translation();
+  return {{"xyz", {round_to(t.x(), 1e-6), round_to(t.y(), 1e-6), round_to(t.z(), 1e-6)}},
+          {"quaternion_wxyz",
+           {round_to(q.w(), 1e-6), round_to(q.x(), 1e-6), round_to(q.y(), 1e-6),
+            round_to(q.z(), 1e-6)}}};
 }
 
 // The regrasp-graph edges standing for one edge of the manipulation graph (one per IK branch,
@@ -117,20 +130,37 @@ struct Goal {
   db::HandoverCandidateRecord candidate;
   std::vector<db::SharedGraspRecord> shared;
   std::vector<db::DirectGraspRecord> direct;
+  std::vector<db::TableRegraspRecord> regrasps;
 };
 
-// One way to the human: a direct pick by `arm`, or an exchange from `suction_arm`'s cup to
-// `arm`'s gripper.
+// One way to the human: a direct pick by `arm`, a regrasp on the table by `arm` (its gripper
+// picks, sets the part down elsewhere, takes it again), or an exchange from `suction_arm`'s cup
+// to `arm`'s gripper. The online planner tries them in that order within a goal.
 struct Way {
-  std::string suction_arm;  // "" for direct
+  enum class Kind { kDirect, kRegrasp, kExchange };
+  Kind kind = Kind::kDirect;
+  std::string suction_arm;  // the exchange's
   std::string arm;          // the arm that delivers
   std::set<int> ranks;      // goals served
   std::set<int> connected;  // goals whose chain the regrasp graph connects (exchange)
   std::set<Id> gripper_grasps, suction_grasps, robot_handovers;
+  std::set<Id> set_downs;  // table regrasp records (regrasp)
 
-  bool direct() const { return suction_arm.empty(); }
+  bool direct() const { return kind == Kind::kDirect; }
+  bool exchange() const { return kind == Kind::kExchange; }
+  const char* kind_name() const {
+    return kind == Kind::kDirect ? "direct" : kind == Kind::kRegrasp ? "regrasp" : "exchange";
+  }
   std::string name() const {
-    return direct() ? "direct by " + arm : "exchange " + suction_arm + " -> " + arm;
+    switch (kind) {
+      case Kind::kDirect:
+        return "direct by " + arm;
+      case Kind::kRegrasp:
+        return "regrasp on table by " + arm;
+      case Kind::kExchange:
+        break;
+    }
+    return "exchange " + suction_arm + " -> " + arm;
   }
 };
 
@@ -142,6 +172,12 @@ std::string cup_node(const std::string& arm, Id suction_grasp) {
 }
 std::string received_node(const std::string& arm, Id rr, Id grasp) {
   return "received:" + arm + ":" + std::to_string(rr) + ":" + std::to_string(grasp);
+}
+std::string set_down_node(const std::string& arm, Id regrasp) {
+  return "set_down:" + arm + ":" + std::to_string(regrasp);
+}
+std::string taken_again_node(const std::string& arm, Id regrasp) {
+  return "taken_again:" + arm + ":" + std::to_string(regrasp);
 }
 
 // "1 goal", "2 goals".
@@ -195,17 +231,19 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
   Graph g{{}, {}, {}, {}, {regrasp_nodes, database.regrasp_edges(part.id)}};
   for (const auto& r : database.robot_handovers(part.id)) g.robot_handovers[r.id] = r;
   for (const auto& c : database.handover_goals(part.id)) {
-    g.goals.push_back({c, database.shared_grasps(c.id), database.direct_grasps(c.id)});
+    g.goals.push_back({c, database.shared_grasps(c.id), database.direct_grasps(c.id),
+                       database.table_regrasps(c.id)});
   }
 
   std::map<WayKey, Way> ways;
   std::map<std::string, std::set<Id>> picked;          // arm -> its direct grasps over every goal
   std::set<std::tuple<std::string, Id, Id>> received;  // (receiving arm, rr, grasp)
-  int goals_direct = 0, goals_exchange = 0;
+  int goals_direct = 0, goals_regrasp = 0, goals_exchange = 0;
   std::set<int> goals_connected;
   for (const auto& goal : g.goals) {
     const int rank = goal.candidate.rank;
     goals_direct += goal.direct.empty() ? 0 : 1;
+    goals_regrasp += goal.regrasps.empty() ? 0 : 1;
     goals_exchange += goal.shared.empty() ? 0 : 1;
     for (const auto& d : goal.direct) {
       Way& w = ways[{"", d.arm}];
@@ -214,9 +252,20 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
       w.gripper_grasps.insert(d.robot_grasp_id);
       picked[d.arm].insert(d.robot_grasp_id);
     }
+    for (const auto& r : goal.regrasps) {
+      Way& w = ways[{"table", r.arm}];
+      w.kind = Way::Kind::kRegrasp;
+      w.arm = r.arm;
+      w.ranks.insert(rank);
+      w.gripper_grasps.insert(r.pick_grasp_id);
+      w.gripper_grasps.insert(r.robot_grasp_id);
+      w.set_downs.insert(r.id);
+      picked[r.arm].insert(r.pick_grasp_id);
+    }
     for (const auto& s : goal.shared) {
       const auto& rr = g.robot_handovers.at(s.robot_handover_id);
       Way& w = ways[{rr.arm, s.arm}];
+      w.kind = Way::Kind::kExchange;
       w.suction_arm = rr.arm;
       w.arm = s.arm;
       w.ranks.insert(rank);
@@ -230,12 +279,11 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
       }
     }
   }
-  // Direct ways first: within a goal the online planner tries them first.
-  for (auto& [key, w] : ways) {
-    if (w.direct()) g.ways.push_back(w);
-  }
-  for (auto& [key, w] : ways) {
-    if (!w.direct()) g.ways.push_back(w);
+  // In the order the online planner tries them within a goal.
+  for (const auto kind : {Way::Kind::kDirect, Way::Kind::kRegrasp, Way::Kind::kExchange}) {
+    for (auto& [key, w] : ways) {
+      if (w.kind == kind) g.ways.push_back(w);
+    }
   }
 
   nlohmann::json nodes = nlohmann::json::array();
@@ -252,6 +300,35 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
                      {"grasps", grasps}});
     edges.push_back(edge_json("table", "picked:" + arm, "gripper_pick", "direct", arm, "gripper",
                               grasps, "online", nullptr, nullptr));
+  }
+  // Regrasps on the table: from the pick, set down at the record's pose and taken again.
+  std::set<Id> regrasp_listed;
+  for (const auto& goal : g.goals) {
+    for (const auto& r : goal.regrasps) {
+      if (!regrasp_listed.insert(r.id).second) continue;
+      const std::string down = set_down_node(r.arm, r.id);
+      const std::string again = taken_again_node(r.arm, r.id);
+      const Eigen::Vector3d at = r.placement.translation();
+      nodes.push_back(
+          {{"id", down},
+           {"kind", "set_down"},
+           {"arm", nullptr},
+           {"label", "set down on the table by the " + r.arm + " arm (regrasp " +
+                         std::to_string(r.id) + ")"},
+           {"regrasp", r.id},
+           {"position", {round_to(at.x(), 1e-5), round_to(at.y(), 1e-5), round_to(at.z(), 1e-5)}}});
+      nodes.push_back({{"id", again},
+                       {"kind", "taken_again"},
+                       {"arm", r.arm},
+                       {"label", "in the " + r.arm + " gripper again, grasp " +
+                                     std::to_string(r.robot_grasp_id)},
+                       {"regrasp", r.id},
+                       {"grasp", r.robot_grasp_id}});
+      edges.push_back(edge_json("picked:" + r.arm, down, "set_down", "regrasp", r.arm, "gripper",
+                                {r.pick_grasp_id}, "online", nullptr, nullptr));
+      edges.push_back(edge_json(down, again, "gripper_pick", "regrasp", r.arm, "gripper",
+                                {r.robot_grasp_id}, "online", nullptr, nullptr));
+    }
   }
   std::set<std::pair<std::string, Id>> cups;
   for (const auto& [id, rr] : g.robot_handovers) {
@@ -302,6 +379,7 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
     for (const auto& d : goal.direct) direct[d.arm].insert(d.robot_grasp_id);
     std::set<std::string> arms;
     for (const auto& [arm, grasps] : direct) arms.insert(arm);
+    for (const auto& r : goal.regrasps) arms.insert(r.arm);
     for (const auto& s : goal.shared) arms.insert(s.arm);
     for (const auto& arm : arms) {
       nodes.push_back(
@@ -317,6 +395,11 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
     for (const auto& [arm, grasps] : direct) {
       edges.push_back(edge_json("picked:" + arm, goal_node(c.rank, arm), "transfer", "direct", arm,
                                 "gripper", grasps, "online", nullptr, nullptr));
+    }
+    for (const auto& r : goal.regrasps) {
+      edges.push_back(edge_json(taken_again_node(r.arm, r.id), goal_node(c.rank, r.arm), "transfer",
+                                "regrasp", r.arm, "gripper", {r.robot_grasp_id}, "online", nullptr,
+                                nullptr));
     }
     for (const auto& s : goal.shared) {
       const Stored* transfer =
@@ -337,25 +420,30 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
   nlohmann::json ways_json = nlohmann::json::array();
   for (const auto& w : g.ways) {
     ways_json.push_back(
-        {{"way", w.direct() ? "direct" : "exchange"},
+        {{"way", w.kind_name()},
          {"name", w.name()},
          {"arm", w.arm},
-         {"suction_arm", w.direct() ? nlohmann::json(nullptr) : nlohmann::json(w.suction_arm)},
+         {"suction_arm", w.exchange() ? nlohmann::json(w.suction_arm) : nlohmann::json(nullptr)},
          {"goals", w.ranks.size()},
          {"best_rank", *w.ranks.begin()},
          {"gripper_grasps", w.gripper_grasps},
          {"suction_grasps", w.suction_grasps},
          {"robot_handovers", w.robot_handovers},
+         {"set_downs", w.set_downs},
          {"goals_connected_offline",
-          w.direct() ? nlohmann::json(nullptr) : nlohmann::json(w.connected.size())}});
+          w.exchange() ? nlohmann::json(w.connected.size()) : nlohmann::json(nullptr)}});
   }
   g.json = {{"part", part.name},
             {"order", part.assembly_order},
             {"failure", stage.failure},
             {"regrasp_stored", regrasp_stored},
+            {"suction_tool_relay", database.meta().tool_relay
+                                       ? nlohmann::json(pose_values(*database.meta().tool_relay))
+                                       : nlohmann::json(nullptr)},
             {"summary",
              {{"goals", g.goals.size()},
               {"goals_direct", goals_direct},
+              {"goals_regrasp", goals_regrasp},
               {"goals_exchange", goals_exchange},
               {"goals_connected_offline", goals_connected.size()},
               {"robot_handovers", g.robot_handovers.size()},
@@ -370,14 +458,24 @@ void print_text(const Graph& g, int shown_goals) {
   const auto& summary = j["summary"];
   std::cout << "graph of " << j["part"].get<std::string>() << " (order " << j["order"]
             << "): " << count(g.goals.size(), "goal") << ", " << summary["goals_exchange"]
-            << " by exchange, " << summary["goals_direct"] << " direct; "
+            << " by exchange, " << summary["goals_direct"] << " direct, "
+            << summary["goals_regrasp"] << " by a regrasp on the table; "
             << count(g.robot_handovers.size(), "robot-robot pose") << "\n";
+  if (!j["suction_tool_relay"].is_null()) {
+    const auto& xyz = j["suction_tool_relay"]["xyz"];
+    std::cout << "  suction tool relay (where the arm that reaches the stand sets the tool down "
+                 "for the other): ("
+              << xyz[0].get<double>() << ", " << xyz[1].get<double>() << ", "
+              << xyz[2].get<double>() << ") m\n";
+  }
   if (!g.ways.empty()) {
     std::cout << "  way                       goals  best rank  grasps\n";
   }
   for (const auto& w : g.ways) {
     std::string grasps = std::to_string(w.gripper_grasps.size()) + " gripper";
-    if (!w.direct()) {
+    if (w.kind == Way::Kind::kRegrasp) {
+      grasps += " at " + count(w.set_downs.size(), "set-down");
+    } else if (w.exchange()) {
       grasps += ", " + std::to_string(w.suction_grasps.size()) + " suction at " +
                 count(w.robot_handovers.size(), "robot-robot pose");
     }
@@ -385,7 +483,7 @@ void print_text(const Graph& g, int shown_goals) {
               << w.ranks.size() << std::setw(11) << *w.ranks.begin() << "  " << grasps << "\n";
   }
   for (const auto& w : g.ways) {
-    if (w.direct()) {
+    if (!w.exchange()) {
       std::cout << "  " << w.name()
                 << ": no stored path (the online planner plans it through the arm's roadmap)\n";
     } else if (!j["regrasp_stored"].get<bool>()) {
@@ -427,6 +525,18 @@ void print_text(const Graph& g, int shown_goals) {
     for (const auto& [arm, grasps] : direct) {
       std::cout << "    direct by " << arm << ": " << count(grasps.size(), "gripper grasp") << " "
                 << id_list(grasps) << " (planned online)\n";
+    }
+    std::map<std::string, std::vector<const db::TableRegraspRecord*>> regrasps;  // by arm
+    for (const auto& r : goal.regrasps) regrasps[r.arm].push_back(&r);
+    for (const auto& [arm, list] : regrasps) {
+      std::string pairs;
+      for (std::size_t i = 0; i < list.size() && i < 4; ++i) {
+        pairs += (i == 0 ? "" : ", ") + std::to_string(list[i]->pick_grasp_id) + " -> " +
+                 std::to_string(list[i]->robot_grasp_id);
+      }
+      if (list.size() > 4) pairs += ", ...";
+      std::cout << "    regrasp on table by " << arm << ": " << count(list.size(), "set-down")
+                << " (grasps picked -> taken again: " << pairs << "; planned online)\n";
     }
     // Exchange ways, each by robot-robot pose: the suction arm's pick and transfer to it, the
     // receiving arm's way in, and its best stored transfer to the goal over the grasps there.
