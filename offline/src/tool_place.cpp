@@ -141,6 +141,9 @@ ToolRelay find_tool_relay(const core::Cell& cell, const core::ProductSpec& produ
         place.translation() = at;
         ++relay.places;
         core::set_robot_pose(data, tool, poses, place * handle_in_tool.inverse());
+        // Contact first: FCL's distance query between touching shapes runs its penetration
+        // (EPA) code, which asserts on some mesh pairs.
+        if (core::in_collision(model, data, tool_bodies)) continue;
         const double distance = core::min_distance(model, data);
         if (!(distance > 0.0)) continue;
         const bool roomy = distance >= settings.clearance;

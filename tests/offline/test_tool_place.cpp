@@ -109,3 +109,16 @@ TEST(ToolPlace, AStandOffTheTableHasNoRelay) {
   EXPECT_FALSE(relay.handle);
   EXPECT_EQ(relay.places, 0);
 }
+
+// A generated product (tools/dev/gen_products --seed 1, product 19, copied to tests/data) whose
+// rail, a dowel-like prism, touches the standing tool at some grid places: FCL's distance query on
+// touching shapes runs its penetration code, which asserted (and aborted the build) there. Contact
+// is tested first; the search completes and finds a relay clear of every part.
+TEST(ToolPlace, PlacesWhereTheToolTouchesAPartAreLeftOutBeforeTheDistance) {
+  const auto cell = test::reference_cell();
+  const core::ProductSpec product =
+      core::load_product(std::string(HILA_TEST_DATA_DIR) + "/gen1_p19_stand/product.yaml");
+  const offline::ToolRelay relay = offline::find_tool_relay(*cell, product, relay_settings());
+  ASSERT_TRUE(relay.handle);
+  EXPECT_LT(relay.clear, relay.places);
+}
