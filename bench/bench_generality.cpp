@@ -299,7 +299,7 @@ struct PartResult {
 std::string most_frequent_outcome(const online::BoardPlan& plan) {
   std::map<std::string, int> count;
   for (const auto& a : plan.attempts) {
-    if (a.outcome != "planned" && a.outcome.find("deadline") == std::string::npos) {
+    if (a.result == online::AttemptResult::kFailed) {
       ++count[outcome_key(a.outcome)];
     }
   }

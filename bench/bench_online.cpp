@@ -207,7 +207,7 @@ std::string outcome_key(const std::string& outcome) {
 std::string why_failed(const online::BoardPlan& plan) {
   std::map<std::string, int> count;
   for (const auto& a : plan.attempts) {
-    if (a.outcome != "planned" && a.outcome.find("deadline") == std::string::npos) {
+    if (a.result == online::AttemptResult::kFailed) {
       ++count[outcome_key(a.outcome)];
     }
   }

@@ -34,6 +34,18 @@ const char* to_string(DeliveryMode mode) {
   return "?";
 }
 
+const char* to_string(AttemptResult result) {
+  switch (result) {
+    case AttemptResult::kPlanned:
+      return "planned";
+    case AttemptResult::kFailed:
+      return "failed";
+    case AttemptResult::kDeadline:
+      return "deadline";
+  }
+  return "unknown";
+}
+
 const char* to_string(BoardPlanStatus status) {
   switch (status) {
     case BoardPlanStatus::kSolved:
@@ -56,6 +68,23 @@ BoardPlanner::BoardPlanner(const PlannerModel& model, const BoardPlanSettings& s
 BoardPlanner::~BoardPlanner() = default;
 
 namespace {
+
+// An attempt's end from its chain's failure ("" when planned). A Run's failures begin with the
+// step or stage they stopped at ("receiving_grasp: no path ..."), and a step checks the deadline
+// before anything else, so a chain that failed after the deadline was cut short by it.
+void record(GoalAttempt& attempt, const std::string& round, const std::string& failure,
+            std::chrono::steady_clock::time_point deadline) {
+  attempt.larger_bridges = !round.empty();
+  if (failure.empty()) {
+    attempt.result = AttemptResult::kPlanned;
+    attempt.outcome = "planned";
+    return;
+  }
+  attempt.result = std::chrono::steady_clock::now() >= deadline ? AttemptResult::kDeadline
+                                                                : AttemptResult::kFailed;
+  attempt.step = failure.substr(0, failure.find(':'));
+  attempt.outcome = round + failure;
+}
 
 // Whether `arm` reaches the suction tool's handle standing at `handle` (world) with an IK
 // solution within its joint limits. Collisions aside: the tool stages check those. An arm
@@ -313,7 +342,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     std::vector<PlanStep> steps;
     ArmsState end;
     const std::string failure = run.direct_chain(goal, d, steps, end);
-    attempt.outcome = failure.empty() ? "planned" : round + failure;
+    record(attempt, round, failure, deadline);
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
     planned(goal, d.robot_grasp_id, steps, end);
@@ -335,7 +364,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     std::vector<PlanStep> steps;
     ArmsState end;
     const std::string failure = run.regrasp_chain(goal, r, steps, end);
-    attempt.outcome = failure.empty() ? "planned" : round + failure;
+    record(attempt, round, failure, deadline);
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
     planned(goal, r.robot_grasp_id, steps, end);
@@ -361,7 +390,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     std::vector<PlanStep> steps;
     ArmsState end;
     const std::string failure = run.chain(goal, s, steps, end);
-    attempt.outcome = failure.empty() ? "planned" : round + failure;
+    record(attempt, round, failure, deadline);
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
     const auto& rr = run.handovers().at(s.robot_handover_id);

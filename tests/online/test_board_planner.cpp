@@ -37,6 +37,17 @@ void expect_plan_well_formed(const online::PlannerModel& model, const online::Sc
             plan.planning_seconds);
   ASSERT_FALSE(plan.attempts.empty());
   EXPECT_EQ(plan.attempts.back().outcome, "planned");
+  EXPECT_EQ(plan.attempts.back().result, online::AttemptResult::kPlanned);
+  EXPECT_TRUE(plan.attempts.back().step.empty());
+  // Every attempt before it failed at a named step, within the deadline: the outcome, after its
+  // round, begins with that step.
+  for (std::size_t i = 0; i + 1 < plan.attempts.size(); ++i) {
+    const online::GoalAttempt& a = plan.attempts[i];
+    EXPECT_EQ(a.result, online::AttemptResult::kFailed) << a.outcome;
+    ASSERT_FALSE(a.step.empty()) << a.outcome;
+    const std::string round = a.larger_bridges ? "(larger bridges) " : "";
+    EXPECT_EQ(a.outcome.rfind(round + a.step + ": ", 0), 0u) << a.outcome;
+  }
   EXPECT_LE(plan.theta_c_deg, 90.0);
   std::map<std::string, Eigen::VectorXd> at;  // each arm's joints as the plan goes
   for (const auto& [arm, q] : scene.robot) at[arm] = q;
@@ -53,8 +64,8 @@ void expect_plan_well_formed(const online::PlannerModel& model, const online::Sc
   }
   const std::vector<std::string> order =
       plan.mode == online::DeliveryMode::kExchange
-          ? std::vector<std::string>{"suction_on", "gripper_close", "suction_off",
-                                     "wait_for_human", "gripper_open"}
+          ? std::vector<std::string>{"suction_on", "gripper_close", "suction_off", "wait_for_human",
+                                     "gripper_open"}
           : std::vector<std::string>{"gripper_close", "wait_for_human", "gripper_open"};
   std::size_t from = 0;
   for (const auto& e : order) {
@@ -84,11 +95,11 @@ int expect_failed_receives_tried_last(const online::PlannerModel& model, const s
   int came_back = 0;
   const auto& at = plan.attempts;
   for (std::size_t k = 0; k < at.size(); ++k) {
-    if (at[k].outcome.rfind("(larger bridges)", 0) == 0) break;
+    if (at[k].larger_bridges) break;
     // The receives that failed before attempt k (in any goal: a stage is planned once a run).
     std::vector<const online::GoalAttempt*> failed;
     for (std::size_t i = 0; i < k; ++i) {
-      if (at[i].outcome.rfind("receiving_", 0) == 0) failed.push_back(&at[i]);
+      if (at[i].step.rfind("receiving_", 0) == 0) failed.push_back(&at[i]);
     }
     const auto failed_like = [&](std::int64_t grasp, std::int64_t rr) {
       return std::any_of(failed.begin(), failed.end(), [&](const auto* f) {

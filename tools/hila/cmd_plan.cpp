@@ -48,6 +48,9 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                         {"arm", a.arm},
                         {"robot_grasp", a.robot_grasp_id},
                         {"robot_handover", a.robot_handover_id},
+                        {"result", online::to_string(a.result)},
+                        {"larger_bridges", a.larger_bridges},
+                        {"step", a.step},
                         {"outcome", a.outcome}});
   }
   nlohmann::json steps = nlohmann::json::array();

@@ -82,6 +82,11 @@ enum class DeliveryMode { kExchange, kDirect, kRegrasp };
 const char* to_string(DeliveryMode mode);
 
 // A handover goal tried by one way, and why it was left.
+// How one chain of a goal ended: planned, failed at a step (the scene or the stored records
+// allow no valid motion there), or cut short by the deadline.
+enum class AttemptResult { kPlanned, kFailed, kDeadline };
+const char* to_string(AttemptResult result);
+
 struct GoalAttempt {
   int rank = -1;
   std::int64_t candidate_id = 0;
@@ -89,7 +94,12 @@ struct GoalAttempt {
   std::string arm;  // the delivering arm
   std::int64_t robot_grasp_id = 0;
   std::int64_t robot_handover_id = 0;  // 0 for a direct pick
-  std::string outcome;                 // "planned" or the reason
+  AttemptResult result = AttemptResult::kFailed;
+  bool larger_bridges = false;  // tried in the second round (MotionSettings escalated budgets)
+  // The step the chain stopped at (a PlanStep name such as "receiving_grasp", or a stage such as
+  // "tool_pick" or "suction_pick"); "" when planned.
+  std::string step;
+  std::string outcome;  // "planned" or the whole reason, for people ("(larger bridges) " first)
 };
 
 // kHumanOutOfReach: the scene's human can take the board at none of its stored goals (where they
