@@ -427,6 +427,14 @@ Limit limit_of(const PartResult& r) {
   if (has("out of both arms' reach")) {
     return {true, "physical: out of both arms' reach where the human takes it comfortably"};
   }
+  // Both roles tried: neither arm's cup picks it where it lies (the swapped roles' reason says
+  // so in its own words), and no gripper takes it there.
+  const auto swapped = r.build_failure.find("with the roles swapped");
+  if (no_gripper && swapped != std::string::npos &&
+      r.build_failure.find("cannot pick the part by suction") < swapped &&
+      r.build_failure.find("cannot pick the part by suction", swapped) != std::string::npos) {
+    return {true, "physical: neither arm's cup nor any gripper takes it where it lies"};
+  }
   if (no_gripper && has("cannot pick the part by suction")) {
     return {false,
             "hila: the tool's arm cannot pick it by suction, no gripper takes it where it lies "

@@ -312,7 +312,13 @@ void swap_roles(const core::Cell& cell, const core::ProductSpec& product, std::s
   HandoverSettings swapped = handover;
   std::swap(swapped.suction_arm, swapped.receiving_arm);
   HandoverResult other = plan_handover_goals(cell, product, i, grasps, comfort, swapped);
-  if (other.stage.goals == 0) return;
+  if (other.stage.goals == 0) {
+    // Why the swap serves no goal either: the other arm's checks, in its own words.
+    r.handover.stage.failure += "; with the roles swapped (the " + swapped.suction_arm +
+                                " arm picking by suction, the " + swapped.receiving_arm +
+                                " arm receiving): " + other.stage.failure;
+    return;
+  }
   const double approach = handover.exchange_approach, lift = handover.pick_lift;
   const bool at_stand = reaches_tool_stand(cell, product, i, swapped.suction_arm, approach, lift);
   const bool by_relay =
