@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "hila/core/error.hpp"
+#include "hila/core/pose.hpp"
+#include "hila/core/robot_model.hpp"
 
 namespace hila::core {
 
@@ -283,6 +286,105 @@ const char* reba_risk_level(int reba_score) {
   if (reba_score <= 7) return "medium";
   if (reba_score <= 10) return "high";
   return "very high";
+}
+
+// ---- From the human model ------------------------------------------------------------------
+
+HumanArmAngles human_arm_angles(const RobotModel& human, const Eigen::VectorXd& q,
+                                const std::string& side) {
+  if (side != "left" && side != "right") {
+    throw InputError("human posture", "side", "\"left\" or \"right\"", "\"" + side + "\"");
+  }
+  if (q.size() != human.num_variables() || !q.allFinite()) {
+    throw InputError(human.source(), "human configuration",
+                     std::to_string(human.num_variables()) + " finite joint values",
+                     q.allFinite() ? std::to_string(q.size()) + " values" : "a non-finite value");
+  }
+  const auto value = [&](const std::string& joint) {
+    return human.joint_value(q, human.joint_index(joint, "human joint"));
+  };
+  const std::string p = side + "_";
+  const double flexion = value(p + "shoulder_flexion");
+  const double abduction = value(p + "shoulder_abduction");
+
+  HumanArmAngles a;
+  a.trunk_flexion = rad_to_deg(value("torso_flexion"));
+  // generate_human_urdf: flexion about the torso's -y, then abduction about +-x (mirrored so
+  // that positive moves the arm away from the body). The hanging arm (0, 0, -1) then points
+  // along (cos(ab) sin(fl), +-sin(ab), -cos(ab) cos(fl)) in the torso frame.
+  const double forward = std::cos(abduction) * std::sin(flexion);
+  const double outward = std::sin(abduction);
+  const double down = std::cos(abduction) * std::cos(flexion);
+  const double elevation = rad_to_deg(std::atan2(std::hypot(forward, outward), down));
+  a.upper_arm_elevation = forward < 0.0 && down > 0.0 ? -elevation : elevation;
+  a.upper_arm_abduction = rad_to_deg(std::asin(std::clamp(outward, -1.0, 1.0)));
+  a.shoulder_rotation = rad_to_deg(value(p + "shoulder_rotation"));
+  a.elbow_flexion = rad_to_deg(value(p + "elbow_flexion"));
+  const int pronation = human.joint_index(p + "forearm_pronation", "human joint");
+  const double rotation = human.joint_value(q, pronation);
+  a.forearm_rotation = rad_to_deg(rotation);
+  const Joint& forearm = human.joints()[pronation];
+  a.forearm_rotation_near_end =
+      (forearm.upper > 0.0 && rotation > kTwistNearEndFraction * forearm.upper) ||
+      (forearm.lower < 0.0 && rotation < kTwistNearEndFraction * forearm.lower);
+  a.wrist_flexion = rad_to_deg(value(p + "wrist_flexion"));
+  a.wrist_deviation = rad_to_deg(value(p + "wrist_deviation"));
+
+  // Where the wrist is, across the body, in the torso frame (y toward the left arm).
+  std::vector<Pose> poses;
+  human.link_poses(q, poses);
+  const Pose torso_inv = poses[human.link_index("torso", "human link")].inverse();
+  const double mirror = side == "left" ? 1.0 : -1.0;
+  const auto lateral = [&](const std::string& link) {
+    return mirror * (torso_inv * poses[human.link_index(link, "human link")].translation()).y();
+  };
+  a.shoulder_lateral_of_midline = lateral(p + "shoulder_flexion_link");
+  a.wrist_lateral_of_midline = lateral(p + "wrist_link");
+  a.wrist_lateral_of_shoulder = a.wrist_lateral_of_midline - a.shoulder_lateral_of_midline;
+  return a;
+}
+
+namespace {
+
+bool across_or_out(const HumanArmAngles& a) {
+  return a.wrist_lateral_of_midline < 0.0 ||
+         a.wrist_lateral_of_shoulder > kOutToSideFraction * a.shoulder_lateral_of_midline;
+}
+
+}  // namespace
+
+RulaInputs rula_inputs_from_posture(const RobotModel& human, const Eigen::VectorXd& q,
+                                    const std::string& side, double load_kg, bool two_hands) {
+  check_load("RULA posture", load_kg);
+  const HumanArmAngles a = human_arm_angles(human, q, side);
+  RulaInputs in;
+  in.upper_arm_flexion_deg = a.upper_arm_elevation;
+  in.upper_arm_abducted = a.upper_arm_abduction > kAbductedDeg;
+  in.lower_arm_flexion_deg = a.elbow_flexion;
+  in.arm_across_midline_or_out_to_side = across_or_out(a);
+  in.wrist_flexion_deg = a.wrist_flexion;
+  in.wrist_deviated = std::abs(a.wrist_deviation) > kNeutralBandDeg;
+  in.wrist_twist_near_end = a.forearm_rotation_near_end;
+  in.trunk_flexion_deg = a.trunk_flexion;
+  in.load_kg = two_hands ? load_kg / 2.0 : load_kg;
+  return in;
+}
+
+RebaInputs reba_inputs_from_posture(const RobotModel& human, const Eigen::VectorXd& q,
+                                    const std::string& side, double load_kg) {
+  check_load("REBA posture", load_kg);
+  const HumanArmAngles a = human_arm_angles(human, q, side);
+  RebaInputs in;
+  in.trunk_flexion_deg = a.trunk_flexion;
+  in.load_kg = load_kg;
+  in.upper_arm_flexion_deg = a.upper_arm_elevation;
+  in.upper_arm_abducted_or_rotated =
+      a.upper_arm_abduction > kAbductedDeg || std::abs(a.shoulder_rotation) > kArmRotatedDeg;
+  in.lower_arm_flexion_deg = a.elbow_flexion;
+  in.wrist_flexion_deg = a.wrist_flexion;
+  in.wrist_deviated_or_twisted =
+      std::abs(a.wrist_deviation) > kNeutralBandDeg || a.forearm_rotation_near_end;
+  return in;
 }
 
 }  // namespace hila::core

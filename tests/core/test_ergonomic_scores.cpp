@@ -8,10 +8,15 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "hila/core/cell.hpp"
 #include "hila/core/ergonomic_scores.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/human_model.hpp"
+#include "hila/core/pose.hpp"
+#include "hila/core/robot_model.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -528,4 +533,236 @@ TEST(ErgonomicScores, OutOfDomainInputsAreInputErrors) {
       {"REBA inputs", "load_kg", "got nan"});
   test::expect_input_error([] { core::reba_risk_level(16); }, {"REBA", "score", "got 16"});
   test::expect_input_error([] { core::rula_action_level(0); }, {"RULA", "grand score", "got 0"});
+}
+
+// ---- From hila's human model --------------------------------------------------------------------
+
+namespace {
+
+struct Body {
+  core::RobotModel model;
+  Eigen::VectorXd neutral;
+};
+
+Body body(const core::HumanBodySpec& spec) {
+  auto model = core::RobotModel::load_urdf_string(core::generate_human_urdf(spec), "human");
+  Eigen::VectorXd neutral = core::human_neutral_configuration(model);
+  return {std::move(model), std::move(neutral)};
+}
+
+// The reference cell's human in its neutral posture (arms hanging) with some joints set (deg).
+Eigen::VectorXd posed(const core::Cell& cell,
+                      std::initializer_list<std::pair<std::string, double>> joint_deg) {
+  const core::RobotModel& human = cell.human();
+  Eigen::VectorXd q = cell.human_neutral();
+  for (const auto& [joint, deg] : joint_deg) {
+    q[human.joints()[human.joint_index(joint)].variable] = core::deg_to_rad(deg);
+  }
+  return q;
+}
+
+core::RulaScore rula_at(const core::Cell& cell, const Eigen::VectorXd& q, const std::string& side) {
+  return core::rula(core::rula_inputs_from_posture(cell.human(), q, side, 0.0, false));
+}
+
+core::RebaScore reba_at(const core::Cell& cell, const Eigen::VectorXd& q, const std::string& side) {
+  return core::reba(core::reba_inputs_from_posture(cell.human(), q, side, 0.0));
+}
+
+const std::string kSides[] = {"left", "right"};
+
+}  // namespace
+
+// The cell's human at its neutral posture (arms hanging) scores the lowest upper-arm, trunk and
+// wrist scores on both sides; the 1.50 m woman's shoulders abduct by about a degree to clear her
+// hips and still count as not abducted.
+TEST(ErgonomicScores, NeutralPostureScoresTheMinimumUpperArmScore) {
+  const auto cell = test::reference_cell();
+  std::vector<Body> bodies;
+  bodies.push_back({cell->human(), cell->human_neutral()});
+  bodies.push_back(body({core::kFemaleStatureP5, core::Sex::Female}));
+  for (const Body& b : bodies) {
+    for (const std::string& side : kSides) {
+      SCOPED_TRACE(side);
+      const core::HumanArmAngles a = core::human_arm_angles(b.model, b.neutral, side);
+      EXPECT_LT(std::abs(a.upper_arm_elevation), 2.0);
+      EXPECT_FALSE(a.forearm_rotation_near_end);
+      const core::RulaInputs in =
+          core::rula_inputs_from_posture(b.model, b.neutral, side, 0.0, false);
+      EXPECT_FALSE(in.upper_arm_abducted);
+      EXPECT_FALSE(in.arm_across_midline_or_out_to_side);
+      // Elbow straight: outside 60-100 deg (2); no neck or leg joints: upright, both feet (1).
+      // Table A (1, 2, 1, 1) = 2, Table B (1, 1, 1) = 1, Table C (2, 1) = 2.
+      expect_rula(in, "upper arm 1, lower arm 2, wrist 1, neck 1, trunk 1, legs 1, grand 2");
+      // REBA Table B (1, 2, 1) = 1, Table A (1, 1, 1) = 1: the lowest score.
+      expect_reba(core::reba_inputs_from_posture(b.model, b.neutral, side, 0.0),
+                  "trunk 1, upper arm 1, REBA 1");
+    }
+  }
+  // The woman's hanging arm is off the vertical (0.5-1 deg), the man's is not.
+  EXPECT_GT(core::human_arm_angles(bodies[1].model, bodies[1].neutral, "left").upper_arm_elevation,
+            0.4);
+  EXPECT_EQ(core::human_arm_angles(bodies[0].model, bodies[0].neutral, "left").upper_arm_elevation,
+            0.0);
+}
+
+TEST(ErgonomicScores, ShoulderFlexionAndTorsoFlexionGiveTheirBands) {
+  const auto cell = test::reference_cell();
+  for (const std::string& side : kSides) {
+    SCOPED_TRACE(side);
+    const std::string shoulder = side + "_shoulder_";
+    const Eigen::VectorXd raised = posed(*cell, {{shoulder + "flexion", 100.0}});
+    EXPECT_NEAR(core::human_arm_angles(cell->human(), raised, side).upper_arm_elevation, 100.0,
+                1e-9);
+    EXPECT_EQ(rula_at(*cell, raised, side).upper_arm, 4);  // > 90 deg
+    EXPECT_EQ(reba_at(*cell, raised, side).upper_arm, 4);
+    // Extension: the arm swung back 30 degrees scores "beyond 20 deg extension".
+    const Eigen::VectorXd back = posed(*cell, {{shoulder + "flexion", -30.0}});
+    EXPECT_NEAR(core::human_arm_angles(cell->human(), back, side).upper_arm_elevation, -30.0, 1e-9);
+    EXPECT_EQ(rula_at(*cell, back, side).upper_arm, 2);
+    // Abduction of 60 deg: raised 60 deg from the torso (3) and abducted (+1).
+    const Eigen::VectorXd wide = posed(*cell, {{shoulder + "abduction", 60.0}});
+    const core::HumanArmAngles a = core::human_arm_angles(cell->human(), wide, side);
+    EXPECT_NEAR(a.upper_arm_elevation, 60.0, 1e-9);
+    EXPECT_NEAR(a.upper_arm_abduction, 60.0, 1e-9);
+    EXPECT_EQ(rula_at(*cell, wide, side).upper_arm, 4);
+
+    const Eigen::VectorXd bent = posed(*cell, {{"torso_flexion", 30.0}});
+    EXPECT_NEAR(core::human_arm_angles(cell->human(), bent, side).trunk_flexion, 30.0, 1e-9);
+    EXPECT_EQ(rula_at(*cell, bent, side).trunk, 3);  // 20-60 deg
+    EXPECT_EQ(reba_at(*cell, bent, side).trunk, 3);
+    // Bending at the hip carries the hanging arms with the torso: relative to it they still hang.
+    EXPECT_EQ(rula_at(*cell, bent, side).upper_arm, 1);
+  }
+}
+
+// The upper-arm angle of the mapping (from the shoulder joints' values, closed form) against
+// forward kinematics: the angle between the upper arm (shoulder to elbow, from RobotModel link
+// poses) and the torso's downward axis, for random arm postures within the joint limits and a
+// random torso flexion (fixed seed), on three bodies; extension where the elbow is behind the
+// torso's frontal plane and below the shoulder.
+TEST(ErgonomicScores, UpperArmAngleMatchesForwardKinematics) {
+  std::mt19937_64 rng(4242);
+  int extensions = 0;
+  for (const core::HumanBodySpec spec :
+       {core::HumanBodySpec{}, core::HumanBodySpec{core::kFemaleStatureP5, core::Sex::Female},
+        core::HumanBodySpec{core::kTallStature, core::Sex::Male}}) {
+    const Body b = body(spec);
+    const core::RobotModel& human = b.model;
+    const Eigen::VectorXd lo = human.lower_limits(), hi = human.upper_limits();
+    const int torso_variable = human.joints()[human.joint_index("torso_flexion")].variable;
+    std::vector<core::Pose> poses;
+    for (int trial = 0; trial < 400; ++trial) {
+      Eigen::VectorXd q(human.num_variables());
+      for (int i = 0; i < q.size(); ++i) {
+        q[i] = std::uniform_real_distribution<double>(lo[i], hi[i])(rng);
+      }
+      human.link_poses(q, poses);
+      const core::Pose& torso = poses[human.link_index("torso")];
+      for (const std::string& side : kSides) {
+        const Eigen::Vector3d shoulder =
+            poses[human.link_index(side + "_shoulder_flexion_link")].translation();
+        const Eigen::Vector3d elbow = poses[human.link_index(side + "_elbow_link")].translation();
+        const Eigen::Vector3d arm = torso.linear().transpose() * (elbow - shoulder).normalized();
+        const double fk_deg = core::rad_to_deg(std::acos(std::clamp(-arm.z(), -1.0, 1.0)));
+        const bool fk_extension = arm.x() < 0.0 && arm.z() < 0.0;
+        extensions += fk_extension;
+        const core::HumanArmAngles a = core::human_arm_angles(human, q, side);
+        SCOPED_TRACE(side + " trial " + std::to_string(trial));
+        EXPECT_NEAR(std::abs(a.upper_arm_elevation), fk_deg, 1e-6);
+        EXPECT_EQ(a.upper_arm_elevation < 0.0, fk_extension && fk_deg > 1e-9);
+        EXPECT_NEAR(a.trunk_flexion, core::rad_to_deg(q[torso_variable]), 1e-9);
+        // The score follows the FK angle's band.
+        const double signed_fk = fk_extension ? -fk_deg : fk_deg;
+        const int band = signed_fk < -20   ? 2
+                         : signed_fk <= 20 ? 1
+                         : signed_fk <= 45 ? 2
+                         : signed_fk <= 90 ? 3
+                                           : 4;
+        EXPECT_EQ(core::rula(core::rula_inputs_from_posture(human, q, side, 0.0, false)).upper_arm,
+                  band + (a.upper_arm_abduction > core::kAbductedDeg));
+      }
+    }
+  }
+  EXPECT_GT(extensions, 20);  // the sample reaches the extension branch
+}
+
+// Upper arm forward and elbow bent 90 deg: the forearm points up in front of the shoulder (no
+// lower-arm point); turned about the upper arm by 90 deg either way it points across the body or
+// out to the side (+1), one direction each, and REBA counts the shoulder as rotated.
+TEST(ErgonomicScores, ForearmAcrossTheBodyOrOutToTheSide) {
+  const auto cell = test::reference_cell();
+  for (const std::string& side : kSides) {
+    SCOPED_TRACE(side);
+    const auto reach = [&](double rotation_deg) {
+      return posed(*cell, {{side + "_shoulder_flexion", 90.0},
+                           {side + "_elbow_flexion", 90.0},
+                           {side + "_shoulder_rotation", rotation_deg}});
+    };
+    const core::HumanArmAngles up = core::human_arm_angles(cell->human(), reach(0.0), side);
+    EXPECT_NEAR(up.wrist_lateral_of_shoulder, 0.0, 0.02);
+    EXPECT_EQ(rula_at(*cell, reach(0.0), side).lower_arm, 1);
+    int across = 0, out = 0;
+    for (const double rotation : {-90.0, 90.0}) {
+      const core::HumanArmAngles a = core::human_arm_angles(cell->human(), reach(rotation), side);
+      across += a.wrist_lateral_of_midline < 0.0;
+      out += a.wrist_lateral_of_shoulder > core::kOutToSideFraction * a.shoulder_lateral_of_midline;
+      EXPECT_EQ(rula_at(*cell, reach(rotation), side).lower_arm, 2);  // 90 deg elbow (1) + 1
+      EXPECT_TRUE(core::reba_inputs_from_posture(cell->human(), reach(rotation), side, 0.0)
+                      .upper_arm_abducted_or_rotated);
+    }
+    EXPECT_EQ(across, 1);
+    EXPECT_EQ(out, 1);
+  }
+}
+
+// Wrist, forearm and load: flexion and deviation read off their joints, the forearm near the end
+// of its pronation range, half the load per hand for RULA's arm and the whole load for REBA.
+TEST(ErgonomicScores, WristForearmAndLoadFromThePosture) {
+  const auto cell = test::reference_cell();
+  const core::RobotModel& human = cell->human();
+  const Eigen::VectorXd q = posed(*cell, {{"right_wrist_flexion", 20.0},
+                                          {"right_wrist_deviation", -10.0},
+                                          {"right_forearm_pronation", 70.0}});  // limit 80
+  const core::RulaInputs r = core::rula_inputs_from_posture(human, q, "right", 6.0, true);
+  EXPECT_NEAR(r.wrist_flexion_deg, 20.0, 1e-9);
+  EXPECT_TRUE(r.wrist_deviated);
+  EXPECT_TRUE(r.wrist_twist_near_end);  // beyond 3/4 of the limit
+  EXPECT_DOUBLE_EQ(r.load_kg, 3.0);
+  expect_rula(r, "wrist 4, wrist twist 2, force/load 1");  // 3 kg intermittent
+  EXPECT_DOUBLE_EQ(core::rula_inputs_from_posture(human, q, "right", 6.0, false).load_kg, 6.0);
+  const core::RebaInputs b = core::reba_inputs_from_posture(human, q, "right", 6.0);
+  EXPECT_DOUBLE_EQ(b.load_kg, 6.0);
+  EXPECT_TRUE(b.wrist_deviated_or_twisted);
+  expect_reba(b, "load/force 1");
+  // The other arm is untouched.
+  const core::RulaInputs left = core::rula_inputs_from_posture(human, q, "left", 6.0, true);
+  EXPECT_FALSE(left.wrist_deviated);
+  EXPECT_FALSE(left.wrist_twist_near_end);
+  const Eigen::VectorXd mid = posed(*cell, {{"right_forearm_pronation", 40.0}});
+  EXPECT_FALSE(
+      core::rula_inputs_from_posture(human, mid, "right", 0.0, false).wrist_twist_near_end);
+}
+
+TEST(ErgonomicScores, PostureMappingRejectsBadInput) {
+  const auto cell = test::reference_cell();
+  const core::RobotModel& human = cell->human();
+  const Eigen::VectorXd q = cell->human_neutral();
+  test::expect_input_error([&] { core::human_arm_angles(human, q, "middle"); },
+                           {"side", "\"left\" or \"right\"", "got \"middle\""});
+  test::expect_input_error([&] { core::human_arm_angles(human, q.head(3), "left"); },
+                           {"human configuration", "15 finite joint values", "got 3 values"});
+  Eigen::VectorXd bad = q;
+  bad[0] = std::nan("");
+  test::expect_input_error([&] { core::rula_inputs_from_posture(human, bad, "left", 1.0, false); },
+                           {"human configuration", "got a non-finite value"});
+  test::expect_input_error([&] { core::rula_inputs_from_posture(human, q, "left", -2.0, false); },
+                           {"load_kg", "expected a load in kg >= 0", "got -2"});
+  test::expect_input_error([&] { core::reba_inputs_from_posture(human, q, "left", std::nan("")); },
+                           {"load_kg", "got nan"});
+  // A model without the generated human's joints (the robot's).
+  const core::RobotModel& robot = cell->robot();
+  test::expect_input_error(
+      [&] { core::human_arm_angles(robot, Eigen::VectorXd::Zero(robot.num_variables()), "left"); },
+      {"human joint", "'left_shoulder_flexion'"});
 }

@@ -1,11 +1,17 @@
 #pragma once
 
+#include <Eigen/Core>
+#include <string>
+
 namespace hila::core {
+
+class RobotModel;
 
 // RULA (McAtamney & Corlett 1993, Applied Ergonomics 24(2):91-99) and REBA (Hignett & McAtamney
 // 2000, Applied Ergonomics 31:201-205): the observational posture scores ergonomists use, from
 // body-part angles and a few yes/no observations, through the methods' lookup tables, to RULA's
-// grand score (1-7) and the REBA score (1-15).
+// grand score (1-7) and the REBA score (1-15). docs/ergonomic_scores.md describes both and the
+// posture mapping below.
 //
 // Angles are in degrees, measured from the neutral posture of the part: standing upright, arms
 // hanging, elbows straight, wrists straight. Flexion (forward, toward the palm) is positive,
@@ -151,5 +157,65 @@ int rula_table_c(int score_c, int score_d);
 int reba_table_a(int trunk, int neck, int legs);
 int reba_table_b(int upper_arm, int lower_arm, int wrist);
 int reba_table_c(int score_a, int score_b);
+
+// ---- From hila's human model -------------------------------------------------------------------
+//
+// The posture of one arm of a human model built by generate_human_urdf (its joint names and
+// axes), from a configuration in the model's variable order (what cell.human() and
+// cell.human_neutral() use). Angles in degrees.
+struct HumanArmAngles {
+  double trunk_flexion = 0.0;  // torso_flexion: + forward bend
+  // Angle between the upper arm and the torso's downward axis (0-180), negative when the arm
+  // points behind the torso's frontal plane below shoulder height (extension). From the
+  // shoulder joints: cos(elevation) = cos(flexion) cos(abduction).
+  double upper_arm_elevation = 0.0;
+  // Angle of the upper arm out of the sagittal plane through the shoulder, away from the body
+  // positive (-90 to 90).
+  double upper_arm_abduction = 0.0;
+  double shoulder_rotation = 0.0;  // about the upper arm
+  double elbow_flexion = 0.0;      // 0 straight
+  double forearm_rotation = 0.0;   // forearm_pronation: + pronation
+  double wrist_flexion = 0.0;      // + toward the palm
+  double wrist_deviation = 0.0;    // + radial (toward the thumb)
+  // The wrist's distance from the shoulder's sagittal plane, outward positive, and from the
+  // body's midline (the torso's sagittal plane), toward this arm's side positive; metres, from
+  // forward kinematics.
+  double wrist_lateral_of_shoulder = 0.0;
+  double wrist_lateral_of_midline = 0.0;
+  double shoulder_lateral_of_midline = 0.0;
+  bool forearm_rotation_near_end = false;  // beyond kTwistNearEndFraction of its joint limit
+};
+
+// Thresholds where RULA or REBA name a posture but give no angle.
+inline constexpr double kAbductedDeg = 20.0;    // upper arm out to the side (the +-20 deg band)
+inline constexpr double kArmRotatedDeg = 45.0;  // REBA "rotated": shoulder rotation
+inline constexpr double kTwistNearEndFraction = 0.75;  // forearm rotation near its range's end
+// "Out to the side": the wrist lateral of the shoulder by more than this fraction of the
+// shoulder's distance from the midline.
+inline constexpr double kOutToSideFraction = 0.5;
+
+// Throws InputError (the model's source, the joint) when a joint of generate_human_urdf is
+// missing, and InputError when `side` is not "left" or "right" or `q` is not a finite vector of
+// the model's variables.
+HumanArmAngles human_arm_angles(const RobotModel& human, const Eigen::VectorXd& q,
+                                const std::string& side);
+
+// RULA inputs for one arm holding `load_kg` (>= 0), its share when two hands hold it (half).
+// Mapping: upper arm = upper_arm_elevation, abducted beyond kAbductedDeg; lower arm = elbow
+// flexion, across the midline when the wrist crosses the body's midline, out to the side by
+// kOutToSideFraction; wrist = wrist flexion, deviated beyond kNeutralBandDeg; wrist twist near
+// the end by kTwistNearEndFraction; trunk = torso flexion. The model has no joint for the neck,
+// the shoulder girdle, trunk twist or side bend, or the legs: neck upright and straight,
+// shoulders not raised, trunk not twisted or side-bent, standing balanced on both feet. The arm
+// is not supported; muscle use, load pattern and shock keep their defaults (set them on the
+// result).
+RulaInputs rula_inputs_from_posture(const RobotModel& human, const Eigen::VectorXd& q,
+                                    const std::string& side, double load_kg, bool two_hands);
+
+// REBA inputs likewise, with the whole load (REBA's load score is the body's, group A): upper
+// arm abducted or rotated beyond kAbductedDeg or kArmRotatedDeg, wrist deviated or twisted as
+// for RULA, knees straight, both feet bearing weight; coupling and activity keep their defaults.
+RebaInputs reba_inputs_from_posture(const RobotModel& human, const Eigen::VectorXd& q,
+                                    const std::string& side, double load_kg);
 
 }  // namespace hila::core
