@@ -5,9 +5,13 @@
 #include <assimp/scene.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 
 #include "hila/core/error.hpp"
@@ -49,6 +53,66 @@ void append_node(const aiScene* scene, const aiNode* node, const aiMatrix4x4& pa
     append_node(scene, node->mChildren[c], transform, scale, out);
   }
 }
+
+std::string lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+// Whether a line of `text` starts with `word` (after blanks) followed by a blank or its end.
+bool has_line_starting_with(const std::string& text, const std::string& word) {
+  for (std::size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1)) {
+    const std::size_t line = text.find_last_of('\n', at);
+    const std::size_t first =
+        text.find_first_not_of(" \t", line == std::string::npos ? 0 : line + 1);
+    const std::size_t end = at + word.size();
+    if (first == at &&
+        (end == text.size() || std::isspace(static_cast<unsigned char>(text[end])))) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// assimp 5.2 (Debian 12) reads a PLY header without its closing `end_header` line forever (a
+// file cut short in its header; found by fuzz/fuzz_mesh). A file assimp reads as PLY, by its
+// extension or, for an extension assimp does not know, its leading "ply", must have one.
+void check_ply_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t start = text.find_first_not_of(" \t\r\n");
+  const bool ply = lower(std::filesystem::path(path).extension().string()) == ".ply" ||
+                   (start != std::string::npos && lower(text.substr(start, 3)) == "ply");
+  if (ply && !has_line_starting_with(text, "end_header")) {
+    throw InputError(path, "(file)", "a PLY header that ends with an end_header line",
+                     "no end_header line (a file cut short?)");
+  }
+}
+
+// assimp 5.2's triangulation aborts the process (ai_assert) on a mesh marked as holding polygons
+// that has none, which its PLY importer writes for a face list with an empty face (found by
+// fuzz/fuzz_mesh). A face without corners is refused here, and each mesh's primitive types are
+// set from its faces before the post-processing.
+void check_faces(const std::string& path, const aiScene* read) {
+  for (unsigned m = 0; m < read->mNumMeshes; ++m) {
+    aiMesh* mesh = read->mMeshes[m];  // the importer's scene, not yet post-processed
+    unsigned types = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const unsigned n = mesh->mFaces[f].mNumIndices;
+      if (n == 0) {
+        throw InputError(path, "mesh " + std::to_string(m) + " face " + std::to_string(f),
+                         "a face with corners", "an empty face");
+      }
+      types |= n == 1   ? aiPrimitiveType_POINT
+               : n == 2 ? aiPrimitiveType_LINE
+               : n == 3 ? aiPrimitiveType_TRIANGLE
+                        : aiPrimitiveType_POLYGON;
+    }
+    if (types != 0) mesh->mPrimitiveTypes = types;  // a mesh without faces keeps its own
+  }
+}
+
 }  // namespace
 
 TriangleMesh load_mesh(const std::string& path, double unit_scale) {
@@ -62,19 +126,25 @@ TriangleMesh load_mesh(const std::string& path, double unit_scale) {
   if (std::filesystem::is_directory(path)) {
     throw InputError(path, "(file)", "a mesh file", "a directory");
   }
+  check_ply_header(path);
   Assimp::Importer importer;
   // Drop normals, colours and texture coordinates first so that vertices weld by position alone
   // (an STL repeats every corner once per face).
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
                               aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                   aiComponent_COLORS | aiComponent_TEXCOORDS);
+  const auto refuse_unless = [&](const aiScene* read) {
+    if (read == nullptr || read->mRootNode == nullptr) {
+      throw InputError(path, "(file)", "a mesh readable by assimp",
+                       std::string("'") + importer.GetErrorString() + "'");
+    }
+  };
+  refuse_unless(importer.ReadFile(path, 0));
+  check_faces(path, importer.GetScene());
   const aiScene* scene =
-      importer.ReadFile(path, aiProcess_RemoveComponent | aiProcess_Triangulate |
-                                  aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
-  if (scene == nullptr || scene->mRootNode == nullptr) {
-    throw InputError(path, "(file)", "a mesh readable by assimp",
-                     std::string("'") + importer.GetErrorString() + "'");
-  }
+      importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
+                                   aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  refuse_unless(scene);
   TriangleMesh mesh;
   append_node(scene, scene->mRootNode, aiMatrix4x4(), unit_scale, mesh);
   if (mesh.triangles.empty()) {

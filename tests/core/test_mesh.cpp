@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <random>
 #include <string>
@@ -218,4 +220,53 @@ TEST(Mesh, WriteToUnwritablePathThrows) {
   const std::string path = dir + "/no/such/folder/box.stl";
   expect_input_error([&] { write_mesh(make_box_mesh(Eigen::Vector3d(1, 1, 1)), path, "stlb"); },
                      {path});
+}
+
+namespace {
+
+// A tetrahedron's corners, a triangle and a face without corners.
+const char* const kPlyWithAnEmptyFace =
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+    "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n0\n";
+
+// Loads `path` in a child process that an alarm ends after 10 s; passes when load_mesh refuses
+// the file with an InputError containing `fragment`. assimp alone hangs or aborts on these files
+// (found by fuzz/fuzz_mesh): without hila's checks the test fails instead of hanging or crashing.
+void expect_refused_in_child(const std::string& path, const std::string& fragment) {
+  EXPECT_EXIT(
+      {
+        alarm(10);
+        try {
+          load_mesh(path, 1.0);
+        } catch (const InputError& e) {
+          std::exit(std::string(e.what()).find(fragment) != std::string::npos ? 0 : 1);
+        }
+        std::exit(2);
+      },
+      ::testing::ExitedWithCode(0), "")
+      << path;
+}
+
+}  // namespace
+
+TEST(Mesh, PlyHeaderWithoutEndHeaderIsRefused) {
+  const std::string dir = temp_dir("mesh_ply_header");
+  const std::string cut = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\n";
+  // Cut short in the header; by extension, and by its leading "ply" for an unknown extension.
+  expect_refused_in_child(write_file(dir, "cut.ply", cut), "no end_header line");
+  expect_refused_in_child(write_file(dir, "cut.bin", cut), "no end_header line");
+  // end_header within a line does not end the header.
+  expect_refused_in_child(write_file(dir, "mid_line.ply", cut + "comment x end_header\n"),
+                          "no end_header line");
+  // A complete header still reads (an empty mesh: no faces).
+  const std::string path =
+      write_file(dir, "complete.ply", cut + "  end_header\n0\n0\n0\n0\n0\n0\n0\n0\n");
+  expect_input_error([&] { load_mesh(path, 1.0); }, {path, "at least one triangle"});
+}
+
+TEST(Mesh, PlyEmptyFaceIsRefused) {
+  const std::string path =
+      write_file(temp_dir("mesh_ply_empty_face"), "empty_face.ply", kPlyWithAnEmptyFace);
+  expect_refused_in_child(path, "mesh 0 face 1: expected a face with corners, got an empty face");
 }
