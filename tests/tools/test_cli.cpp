@@ -1,5 +1,6 @@
 // End-to-end tests of the `hila` command: real process, real files, exit codes and JSON.
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -338,6 +339,31 @@ TEST(Cli, InspectGraphShowsTheRegraspsOnTheTable) {
   EXPECT_EQ(static_cast<std::size_t>(set_down_edges), set_downs.size());
   const CommandRun text = run("inspect " + db + " graph --part bracket");
   EXPECT_NE(text.out.find("regrasp on table by "), std::string::npos) << text.out;
+}
+
+// `inspect digest` answers only for a database the loader opens: one another hila built (its
+// meta edited as an older build would have it) is refused with exit status 2 and the rebuild
+// command, as `plan` refuses it, not digested.
+TEST(Cli, InspectDigestRefusesADatabaseTheLoaderRefuses) {
+  const std::string dir = test::temp_dir("cli_digest_refused");
+  const std::string db = dir + "/bracket.hila";
+  const CommandRun built =
+      run("build " + test::bracket_product(dir) + " --cell " + test::cell_path() +
+          " --comfort-samples 1000 --handover-candidates 5 "
+          "--roadmap-nodes 20 -o " +
+          db);
+  ASSERT_LE(built.status, 1) << built.out;
+  ASSERT_EQ(run("inspect " + db + " digest").status, 0);
+  sqlite3* handle = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &handle), SQLITE_OK);
+  EXPECT_EQ(sqlite3_exec(handle, "UPDATE meta SET value = '0.6.0' WHERE key = 'hila_version'",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(handle);
+  const CommandRun digest = run("inspect " + db + " digest");
+  EXPECT_EQ(digest.status, 2) << digest.out;
+  EXPECT_NE(digest.out.find("meta.hila_version"), std::string::npos) << digest.out;
+  EXPECT_NE(digest.out.find("hila build"), std::string::npos) << digest.out;
 }
 
 // tools/demo's --if-outdated: a database from this hila, the same files, settings and seed is
