@@ -133,8 +133,8 @@ TEST(Build, AHumanStanceInsideTheTableIsRejectedBeforeAnyWork) {
 }
 
 // With the UR3's datasheet payload (3.0 kg, the reference cell's allowance of 3.5 kg taken out),
-// the 1.8 kg laterals on the suction tool are over it: the build gives them no goals and says
-// why; the lighter boards are unaffected.
+// the 1.8 kg laterals on the suction tool are over it on either arm: the build gives them no goals
+// and says why for both roles; the lighter boards are unaffected.
 TEST(Build, APartOverThePayloadGetsNoGoalAndTheReason) {
   const std::string dir = test::temp_dir("build_payload");
   const std::string path = test::cell_variant(dir, "        allowed_kg: 3.5\n", "");
@@ -144,9 +144,12 @@ TEST(Build, APartOverThePayloadGetsNoGoalAndTheReason) {
     SCOPED_TRACE(part.name);
     if (part.mass > 1.45) {
       EXPECT_EQ(part.goals, 0);
+      // Both roles are tried, and each arm's payload is named.
       EXPECT_EQ(part.handover_failure,
                 "over the payload: part 1.80 kg + tooling 1.30 kg + suction tool 0.25 kg = 3.35 kg "
-                "> 3.00 kg allowed at arm 'right'");
+                "> 3.00 kg allowed at arm 'right'; with the roles swapped (the left arm picking by "
+                "suction, the right arm receiving): over the payload: part 1.80 kg + tooling "
+                "1.30 kg + suction tool 0.25 kg = 3.35 kg > 3.00 kg allowed at arm 'left'");
     } else {
       EXPECT_EQ(part.handover_failure.find("payload"), std::string::npos);
     }
