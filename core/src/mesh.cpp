@@ -90,19 +90,26 @@ void check_ply_header(const std::string& path) {
   }
 }
 
-// assimp 5.2's triangulation aborts the process (ai_assert) on a mesh marked as holding polygons
-// that has none, which its PLY importer writes for a face list with an empty face (found by
-// fuzz/fuzz_mesh). A face without corners is refused here, and each mesh's primitive types are
-// set from its faces before the post-processing.
+// assimp 5.2's post-processing aborts the process (an ai_assert in the triangulation) on a mesh
+// marked as holding polygons that has none, which its PLY importer writes for a face list with
+// an empty face, and reads out of bounds (SIGSEGV) for a face with a corner past the vertices
+// (found by fuzz/fuzz_mesh). Both faces are refused here, and each mesh's primitive types are set
+// from its faces before the post-processing.
 void check_faces(const std::string& path, const aiScene* read) {
   for (unsigned m = 0; m < read->mNumMeshes; ++m) {
     aiMesh* mesh = read->mMeshes[m];  // the importer's scene, not yet post-processed
     unsigned types = 0;
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const unsigned n = mesh->mFaces[f].mNumIndices;
-      if (n == 0) {
-        throw InputError(path, "mesh " + std::to_string(m) + " face " + std::to_string(f),
-                         "a face with corners", "an empty face");
+      const std::string field = "mesh " + std::to_string(m) + " face " + std::to_string(f);
+      if (n == 0) throw InputError(path, field, "a face with corners", "an empty face");
+      for (unsigned k = 0; k < n; ++k) {
+        const unsigned corner = mesh->mFaces[f].mIndices[k];
+        if (corner >= mesh->mNumVertices) {
+          throw InputError(path, field,
+                           "vertex indices below " + std::to_string(mesh->mNumVertices),
+                           std::to_string(corner));
+        }
       }
       types |= n == 1   ? aiPrimitiveType_POINT
                : n == 2 ? aiPrimitiveType_LINE

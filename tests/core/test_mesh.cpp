@@ -224,11 +224,13 @@ TEST(Mesh, WriteToUnwritablePathThrows) {
 
 namespace {
 
-// A tetrahedron's corners, a triangle and a face without corners.
-const char* const kPlyWithAnEmptyFace =
-    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-    "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
-    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n0\n";
+// A tetrahedron's corners, a triangle and then `face`.
+std::string ply_with_second_face(const std::string& face) {
+  return "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n" +
+         face + "\n";
+}
 
 // Loads `path` in a child process that an alarm ends after 10 s; passes when load_mesh refuses
 // the file with an InputError containing `fragment`. assimp alone hangs or aborts on these files
@@ -265,8 +267,10 @@ TEST(Mesh, PlyHeaderWithoutEndHeaderIsRefused) {
   expect_input_error([&] { load_mesh(path, 1.0); }, {path, "at least one triangle"});
 }
 
-TEST(Mesh, PlyEmptyFaceIsRefused) {
-  const std::string path =
-      write_file(temp_dir("mesh_ply_empty_face"), "empty_face.ply", kPlyWithAnEmptyFace);
-  expect_refused_in_child(path, "mesh 0 face 1: expected a face with corners, got an empty face");
+TEST(Mesh, PlyEmptyFaceOrCornerPastTheVerticesIsRefused) {
+  const std::string dir = temp_dir("mesh_ply_faces");
+  expect_refused_in_child(write_file(dir, "empty_face.ply", ply_with_second_face("0")),
+                          "mesh 0 face 1: expected a face with corners, got an empty face");
+  expect_refused_in_child(write_file(dir, "past.ply", ply_with_second_face("3 0 1 7")),
+                          "mesh 0 face 1: expected vertex indices below 4, got 7");
 }
