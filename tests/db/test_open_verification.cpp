@@ -8,14 +8,12 @@
 #include <sqlite3.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <optional>
 #include <stdexcept>
 #include <tuple>
@@ -553,26 +551,4 @@ TEST(OpenVerification, Version6FileIsMigratedWithItsDigests) {
   expect_input_error([&] { Database::open(path); },
                      {path + ": placements: expected the content digest stored when it was "
                              "written"});
-}
-
-// Not an assertion: how long Database::open takes on a real database, as `hila plan` opens it
-// (without the comfort maps) and with them. Run with HILA_OPEN_TIMING_DB=FILE.
-TEST(OpenVerification, TimingPrintout) {
-  const char* path = std::getenv("HILA_OPEN_TIMING_DB");
-  if (!path) GTEST_SKIP() << "set HILA_OPEN_TIMING_DB to a database to time its open";
-  for (const bool maps : {false, true}) {
-    OpenOptions options;
-    options.comfort_maps = maps;
-    std::vector<double> ms;
-    for (int run = 0; run < 7; ++run) {
-      const auto start = std::chrono::steady_clock::now();
-      const Database db = Database::open(path, options);
-      ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-              .count());
-    }
-    std::sort(ms.begin(), ms.end());
-    std::cout << path << (maps ? " with" : " without") << " comfort maps: median of 7 opens "
-              << ms[3] << " ms (fastest " << ms.front() << ", slowest " << ms.back() << ")\n";
-  }
 }
