@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <string_view>
 
 #include "hila/core/error.hpp"
 
@@ -60,15 +61,16 @@ std::string lower(std::string text) {
   return text;
 }
 
-// Whether a line of `text` starts with `word` (after blanks) followed by a blank or its end.
+// Whether a line of `text` starts with `word` (after blanks) followed by a blank, a line end or
+// the end of the text, as assimp's PLY header reader reads a keyword (not '\v', say).
 bool has_line_starting_with(const std::string& text, const std::string& word) {
   for (std::size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1)) {
     const std::size_t line = text.find_last_of('\n', at);
     const std::size_t first =
         text.find_first_not_of(" \t", line == std::string::npos ? 0 : line + 1);
     const std::size_t end = at + word.size();
-    if (first == at &&
-        (end == text.size() || std::isspace(static_cast<unsigned char>(text[end])))) {
+    constexpr std::string_view kAfter(" \t\r\n\f\0", 6);  // what may follow the word
+    if (first == at && (end == text.size() || kAfter.find(text[end]) != std::string_view::npos)) {
       return true;
     }
   }

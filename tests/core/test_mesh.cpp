@@ -258,8 +258,11 @@ TEST(Mesh, PlyHeaderWithoutEndHeaderIsRefused) {
   // Cut short in the header; by extension, and by its leading "ply" for an unknown extension.
   expect_refused_in_child(write_file(dir, "cut.ply", cut), "no end_header line");
   expect_refused_in_child(write_file(dir, "cut.bin", cut), "no end_header line");
-  // end_header within a line does not end the header.
+  // end_header within a line, or followed by a character assimp takes for part of the word,
+  // does not end the header.
   expect_refused_in_child(write_file(dir, "mid_line.ply", cut + "comment x end_header\n"),
+                          "no end_header line");
+  expect_refused_in_child(write_file(dir, "vtab.ply", cut + "end_header\v1\n"),
                           "no end_header line");
   // A complete header still reads (an empty mesh: no faces).
   const std::string path =
