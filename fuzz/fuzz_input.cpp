@@ -29,12 +29,18 @@ void remove_created_dir() {
 std::string work_dir(const std::string& data_folder,
                      std::initializer_list<const char*> extensions) {
   if (!created_dir().empty()) std::abort();  // one per process
-  const char* tmp = std::getenv("TMPDIR");
-  std::string dir =
-      std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/hila_fuzz_XXXXXX";
-  if (mkdtemp(dir.data()) == nullptr) {
-    std::perror(dir.c_str());
-    std::abort();
+  std::string dir;
+  if (const char* fixed = std::getenv("HILA_FUZZ_DIR"); fixed != nullptr && *fixed != '\0') {
+    dir = fixed;  // the same path on every run (fuzz/run --runs)
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  } else {
+    const char* tmp = std::getenv("TMPDIR");
+    dir = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/hila_fuzz_XXXXXX";
+    if (mkdtemp(dir.data()) == nullptr) {
+      std::perror(dir.c_str());
+      std::abort();
+    }
   }
   created_dir() = dir;
   std::atexit(remove_created_dir);

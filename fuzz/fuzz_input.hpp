@@ -11,7 +11,10 @@
 
 namespace hila::fuzz {
 
-// A new folder under $TMPDIR (default /tmp), removed when the process exits normally. It holds a
+// A new folder under $TMPDIR (default /tmp), or the folder $HILA_FUZZ_DIR (emptied) when set,
+// removed when the process exits normally. A fixed folder makes a run with a fixed seed
+// repeatable: the path is in every error message, and libFuzzer learns from the strings the
+// target compares. It holds a
 // symbolic link to each file of meshes/`data_folder` whose extension is one of `extensions`
 // (".stl"), so that the input can name the bundled meshes or URDFs by a relative path. Call once
 // per process.
