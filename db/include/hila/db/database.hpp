@@ -86,6 +86,9 @@ class DatabaseWriter {
   // candidate_id, pick_grasp_id and robot_grasp_id are taken from each record and must name
   // written records; arm must be non-empty, the placement and joints finite (schema version 6).
   void add_table_regrasps(const std::vector<TableRegraspRecord>& regrasps);
+  // candidate_id and suction_grasp_id are taken from each record and must name written records;
+  // arm must be non-empty, joints_rh finite (schema version 8).
+  void add_suction_deliveries(const std::vector<SuctionDeliveryRecord>& deliveries);
   // method must be "hila", "table" or "alone", at most one row per part and method (DatabaseError:
   // CHECK / UNIQUE constraint failed).
   void add_ergonomics(std::int64_t part_id, const std::vector<ErgonomicsRecord>& rows);
@@ -197,6 +200,7 @@ class Database {
   std::vector<SharedGraspRecord> shared_grasps(std::int64_t candidate_id) const;    // id order
   std::vector<DirectGraspRecord> direct_grasps(std::int64_t candidate_id) const;    // id order
   std::vector<TableRegraspRecord> table_regrasps(std::int64_t candidate_id) const;  // id order
+  std::vector<SuctionDeliveryRecord> suction_deliveries(std::int64_t candidate_id) const;  // id order
   std::vector<ErgonomicsRecord> ergonomics(std::int64_t part_id) const;  // id (write) order
 
   // Roadmaps and the regrasp graph (schema version 4). The arm's roadmap, or nullptr when the

@@ -189,6 +189,18 @@ struct TableRegraspRecord {
   double inclination_rh_deg = 0.0;
 };
 
+// A suction delivery (schema version 8): the arm holding the suction tool picks the part by
+// suction where it lies (any of its suction grasps the stack allows, chosen online) and presents
+// it on its cup at a goal's robot-human pose; the human takes it from the cup. For a part whose
+// comfortable goals no gripper serves after an exchange: no exchange, no gripper.
+struct SuctionDeliveryRecord {
+  std::int64_t id = 0;
+  std::int64_t candidate_id = 0;      // a "goal" candidate
+  std::int64_t suction_grasp_id = 0;  // the cup on the part
+  std::string arm;                    // the arm holding the tool
+  Eigen::VectorXd joints_rh;          // at the robot-human pose, rad
+};
+
 // One way of getting a board to the human, as the human's body experiences it (the paper's
 // Table 2 in numbers). Method: "hila" (the first goal), "table" (laid flat on the table in front
 // of the human), "alone" (the human takes it from the stack).
