@@ -693,6 +693,15 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.inclination_repick_deg = s.next_double();
         r.inclination_rh_deg = s.next_double();
       });
+  db.suction_deliveries_ = load_rows<SuctionDeliveryRecord>(
+      *connection, "suction_deliveries", "candidate_id, suction_grasp_id, arm, joints_rh", fix,
+      verify, [&](detail::Statement& s, std::int64_t id, SuctionDeliveryRecord& r) {
+        r.id = id;
+        r.candidate_id = s.next_int64();
+        r.suction_grasp_id = s.next_int64();
+        r.arm = s.next_text();
+        r.joints_rh = read_joints(s, path, "suction_deliveries", "joints_rh", id, fix);
+      });
   db.ergonomics_ = load_rows<ErgonomicsRecord>(
       *connection, "ergonomics",
       "part_id, method, reachable, torso_flexion_deg, shoulder_elevated, reach, "
@@ -879,6 +888,13 @@ std::vector<TableRegraspRecord> Database::table_regrasps(std::int64_t candidate_
   std::vector<TableRegraspRecord> selected;
   std::copy_if(table_regrasps_.begin(), table_regrasps_.end(), std::back_inserter(selected),
                [&](const TableRegraspRecord& g) { return g.candidate_id == candidate_id; });
+  return selected;
+}
+
+std::vector<SuctionDeliveryRecord> Database::suction_deliveries(std::int64_t candidate_id) const {
+  std::vector<SuctionDeliveryRecord> selected;
+  std::copy_if(suction_deliveries_.begin(), suction_deliveries_.end(), std::back_inserter(selected),
+               [&](const SuctionDeliveryRecord& d) { return d.candidate_id == candidate_id; });
   return selected;
 }
 

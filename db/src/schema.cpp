@@ -19,7 +19,7 @@ std::string hila_version() {
 
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 7;
+  return 8;
 }
 
 namespace detail {
@@ -297,12 +297,28 @@ CREATE TABLE table_regrasps (
 CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);
 )sql";
 
+// The suction_deliveries table as schema version 8 defines it (with its index): deliveries by the
+// arm holding the suction tool, the board on its cup (records::SuctionDeliveryRecord). Created by
+// schema_sql() and by the 7 -> 8 step from this text. joints_rh is a joint vector as in the
+// version 3 tables.
+constexpr const char* kCreateSuctionDeliveriesV8 = R"sql(
+CREATE TABLE suction_deliveries (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  suction_grasp_id INTEGER NOT NULL REFERENCES suction_grasps(id),
+  arm TEXT NOT NULL,
+  joints_rh BLOB NOT NULL
+);
+CREATE INDEX suction_deliveries_candidate_id ON suction_deliveries(candidate_id);
+)sql";
+
 }  // namespace
 
 // Written out in full (not generated) so this file is the readable reference of the schema (the
 // comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
 // kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones, the
-// direct_grasps table kCreateDirectGraspsV5, the table_regrasps table kCreateTableRegraspsV6).
+// direct_grasps table kCreateDirectGraspsV5, the table_regrasps table kCreateTableRegraspsV6, the
+// suction_deliveries table kCreateSuctionDeliveriesV8).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
@@ -384,7 +400,7 @@ CREATE TABLE human_grasps (
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql" + std::string(kCreateComfortMapsV2) +
                                  create_tables_v3() + create_tables_v4() + kCreateDirectGraspsV5 +
-                                 kCreateTableRegraspsV6;
+                                 kCreateTableRegraspsV6 + kCreateSuctionDeliveriesV8;
   return sql;
 }
 
@@ -411,6 +427,9 @@ const std::vector<MigrationStep>& migration_steps() {
       // cannot hash, so the migration itself writes them after its last step, for the content the
       // file then holds; the step only drops any the file already had.
       {6, "DELETE FROM meta WHERE key GLOB 'digest.*';\n"},
+      // 7 -> 8: suction deliveries (a new table, empty in a migrated file until it is rebuilt; the
+      // old tables are unchanged). The migration rewrites every table's digest after its last step.
+      {7, kCreateSuctionDeliveriesV8},
   };
   return steps;
 }

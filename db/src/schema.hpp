@@ -15,7 +15,7 @@ struct TableInfo {
   const char* name;
   int since_version;  // the schema version that added the table
 };
-inline constexpr std::array<TableInfo, 18> kTables = {{{"meta", 1},
+inline constexpr std::array<TableInfo, 19> kTables = {{{"meta", 1},
                                                        {"parts", 1},
                                                        {"placements", 1},
                                                        {"robot_grasps", 1},
@@ -32,7 +32,8 @@ inline constexpr std::array<TableInfo, 18> kTables = {{{"meta", 1},
                                                        {"regrasp_nodes", 4},
                                                        {"regrasp_edges", 4},
                                                        {"direct_grasps", 5},
-                                                       {"table_regrasps", 6}}};
+                                                       {"table_regrasps", 6},
+                                                       {"suction_deliveries", 8}}};
 
 // The meta keys every database carries. Keys added later are optional when reading: the writer
 // always writes human_bodies (since version 3), the reader takes a missing one as "".

@@ -146,9 +146,9 @@ struct DatabaseWriter::Impl {
   // Prepared once, reused for every row; destroyed before the connection closes.
   std::optional<detail::Statement> insert_meta, insert_part, insert_placement, insert_robot,
       insert_suction, insert_human, insert_comfort, insert_stage, insert_robot_handover,
-      insert_candidate, insert_shared, insert_direct, insert_regrasp, insert_ergonomics,
-      insert_roadmap, insert_filter, insert_regrasp_node, insert_regrasp_edge, select_robot_grasp,
-      select_suction_grasp;
+      insert_candidate, insert_shared, insert_direct, insert_regrasp, insert_suction_delivery,
+      insert_ergonomics, insert_roadmap, insert_filter, insert_regrasp_node, insert_regrasp_edge,
+      select_robot_grasp, select_suction_grasp;
   std::map<std::int64_t, RoadmapShape> roadmaps;  // by id
   bool meta_written = false;
   bool committed = false;
@@ -195,6 +195,7 @@ struct DatabaseWriter::Impl {
     insert_shared.reset();
     insert_direct.reset();
     insert_regrasp.reset();
+    insert_suction_delivery.reset();
     insert_ergonomics.reset();
     insert_roadmap.reset();
     insert_filter.reset();
@@ -328,6 +329,10 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
                        "inclination_pick_deg, inclination_place_deg, inclination_repick_deg, "
                        "inclination_rh_deg"),
         m.context("table_regrasps"));
+    m.insert_suction_delivery.emplace(
+        *m.connection,
+        insert_sql("suction_deliveries", "candidate_id, suction_grasp_id, arm, joints_rh"),
+        m.context("suction_deliveries"));
     m.insert_ergonomics.emplace(
         *m.connection,
         insert_sql("ergonomics",
@@ -756,6 +761,35 @@ void DatabaseWriter::add_table_regrasps(const std::vector<TableRegraspRecord>& r
       s.bind_next(g.inclination_place_deg);
       s.bind_next(g.inclination_repick_deg);
       s.bind_next(g.inclination_rh_deg);
+      s.run();
+    }
+  });
+}
+
+void DatabaseWriter::add_suction_deliveries(const std::vector<SuctionDeliveryRecord>& deliveries) {
+  Impl& m = *impl_;
+  m.guarded("add_suction_deliveries", [&] {
+    FiniteCheck check("add_suction_deliveries", "suction_deliveries");
+    for (std::size_t i = 0; i < deliveries.size(); ++i) {
+      const auto& d = deliveries[i];
+      const std::string record =
+          record_label(i, deliveries.size(), "candidate id " + std::to_string(d.candidate_id));
+      if (d.arm.empty()) {
+        refuse("add_suction_deliveries", "suction_deliveries.arm", record,
+               "SuctionDeliveryRecord::arm is empty, expected an arm name");
+      }
+      check.set_record(record);
+      check.joints("joints_rh", d.joints_rh);
+    }
+    detail::Statement& s = *m.insert_suction_delivery;
+    for (const auto& d : deliveries) {
+      s.set_context(m.context("suction_deliveries (candidate id " + std::to_string(d.candidate_id) +
+                              ", suction grasp id " + std::to_string(d.suction_grasp_id) +
+                              ", arm '" + d.arm + "')"));
+      s.bind_next(d.candidate_id);
+      s.bind_next(d.suction_grasp_id);
+      s.bind_next(d.arm);
+      bind_joints(s, d.joints_rh);
       s.run();
     }
   });

@@ -228,6 +228,7 @@ class Database {
   std::vector<SharedGraspRecord> shared_grasps_;
   std::vector<DirectGraspRecord> direct_grasps_;
   std::vector<TableRegraspRecord> table_regrasps_;
+  std::vector<SuctionDeliveryRecord> suction_deliveries_;
   std::vector<ErgonomicsRecord> ergonomics_;
   std::vector<RoadmapRecord> roadmaps_;
   std::vector<RoadmapFilterRecord> roadmap_filters_;  // id order: roadmap_filter() bisects
