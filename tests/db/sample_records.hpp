@@ -46,6 +46,9 @@ struct SamplePart {
   // Schema version 6. id, candidate_id, pick_grasp_id and robot_grasp_id are the ones
   // write_sample's writer assigns.
   std::vector<TableRegraspRecord> table_regrasps;  // of this part's candidates
+  // Schema version 8. id, candidate_id and suction_grasp_id are the ones write_sample's writer
+  // assigns.
+  std::vector<SuctionDeliveryRecord> suction_deliveries;  // of this part's candidates
 };
 
 struct Sample {
@@ -530,11 +533,40 @@ inline void add_table_regrasps(Sample& s, std::uint64_t seed) {
   p.table_regrasps[1].placement = half_turn;
 }
 
+// Suction deliveries of part 1's goals (part 2 has no suction grasps, so none), written with the
+// candidates interleaved (4, 5, 4, 2, 5), so that one candidate's deliveries are not consecutive
+// ids: both suction grasps, both arms, a non-ASCII arm name, a delivery without a stored
+// robot-human solution (empty joints_rh), a 7-joint arm, -0.0 and a subnormal in a joint blob.
+// From an RNG of its own, so that every other record of the sample keeps the values it had before
+// the table.
+inline void add_suction_deliveries(Sample& s, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  SamplePart& p = s.parts[0];
+  std::vector<std::int64_t> goals;  // candidate ids in id order
+  for (const auto& c : p.handover_candidates) {
+    if (c.status == "goal") goals.push_back(c.id);
+  }
+  const std::size_t goal_of[] = {1, 2, 1, 0, 2};
+  const auto grasps = static_cast<std::int64_t>(p.suction_grasps.size());
+  std::int64_t id = 0;
+  for (std::size_t i = 0; i < std::size(goal_of); ++i) {
+    SuctionDeliveryRecord d;
+    d.id = ++id;
+    d.candidate_id = goals.at(goal_of[i]);
+    d.suction_grasp_id = 1 + static_cast<std::int64_t>(i) % grasps;
+    d.arm = i == 4 ? "right ✋" : i % 3 == 0 ? "right" : "left";
+    if (i != 2) d.joints_rh = random_joints(rng, i == 3 ? 7 : 6);
+    p.suction_deliveries.push_back(d);
+  }
+  p.suction_deliveries[0].joints_rh[1] = -0.0;
+  p.suction_deliveries[4].joints_rh[5] = std::numeric_limits<double>::denorm_min();
+}
+
 // Two parts with different record counts (part 2 has no suction grasps), values that are
 // negative, tiny, huge, subnormal and infinite, a non-ASCII part name, handover records (see
 // add_handover_records), two comfort maps, roadmaps with the regrasp graph (see
-// add_roadmap_records), direct grasps (see add_direct_grasps) and table regrasps (see
-// add_table_regrasps).
+// add_roadmap_records), direct grasps (see add_direct_grasps), table regrasps (see
+// add_table_regrasps) and suction deliveries (see add_suction_deliveries).
 inline Sample make_sample(std::uint64_t seed = 7) {
   std::mt19937_64 rng(seed);
   Sample s;
@@ -617,16 +649,17 @@ inline Sample make_sample(std::uint64_t seed = 7) {
   add_roadmap_records(s, rng);
   add_direct_grasps(s, seed + 3);
   add_table_regrasps(s, seed + 4);
+  add_suction_deliveries(s, seed + 5);
   return s;
 }
 
 // Writes `sample` to `path` through DatabaseWriter and returns the part ids in order: first each
-// part with its placements and grasps, then each part's handover, direct grasp, table regrasp and
-// ergonomics records (so they may refer to grasps of any part), then the comfort maps, the roadmaps
-// and each part's roadmap filters, regrasp nodes and regrasp edges. The candidate, robot handover,
-// roadmap, filter and node ids the records refer to are translated from the sample's ids to the
-// ones the writer returns (the same unless a test reorders the sample's parts); grasp ids are
-// written as given.
+// part with its placements and grasps, then each part's handover, direct grasp, table regrasp,
+// suction delivery and ergonomics records (so they may refer to grasps of any part), then the
+// comfort maps, the roadmaps and each part's roadmap filters, regrasp nodes and regrasp edges. The
+// candidate, robot handover, roadmap, filter and node ids the records refer to are translated from
+// the sample's ids to the ones the writer returns (the same unless a test reorders the sample's
+// parts); grasp ids are written as given.
 inline std::vector<std::int64_t> write_sample(const std::string& path, const Sample& sample) {
   DatabaseWriter writer(path);
   writer.write_meta(sample.meta);
@@ -672,6 +705,9 @@ inline std::vector<std::int64_t> write_sample(const std::string& path, const Sam
     std::vector<TableRegraspRecord> regrasps = p.table_regrasps;
     for (auto& r : regrasps) r.candidate_id = translate(candidate_ids, r.candidate_id);
     writer.add_table_regrasps(regrasps);
+    std::vector<SuctionDeliveryRecord> deliveries = p.suction_deliveries;
+    for (auto& d : deliveries) d.candidate_id = translate(candidate_ids, d.candidate_id);
+    writer.add_suction_deliveries(deliveries);
     writer.add_ergonomics(ids[k], p.ergonomics);
   }
   for (const auto& map : sample.comfort_maps) writer.add_comfort_map(map);

@@ -262,6 +262,29 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
       [](Sample& s) { std::swap(s.parts[0].table_regrasps[0], s.parts[0].table_regrasps[2]); });
   add("a table regrasp less", [](Sample& s) { s.parts[0].table_regrasps.pop_back(); });
   add("no table regrasps", [](Sample& s) { s.parts[0].table_regrasps.clear(); });
+  // Schema version 8: suction deliveries.
+  add("suction delivery candidate",
+      [](Sample& s) { s.parts[0].suction_deliveries[3].candidate_id = 4; });
+  add("suction delivery suction grasp",
+      [](Sample& s) { s.parts[0].suction_deliveries[1].suction_grasp_id = 1; });
+  add("suction delivery arm", [](Sample& s) { s.parts[0].suction_deliveries[4].arm = "right"; });
+  add("suction delivery joint ulp", [](Sample& s) {
+    double& q = s.parts[0].suction_deliveries[3].joints_rh[6];
+    q = std::nextafter(q, 10.0);
+  });
+  add("suction delivery joint -0.0 to +0.0",
+      [](Sample& s) { s.parts[0].suction_deliveries[0].joints_rh[1] = 0.0; });
+  add("suction delivery joint subnormal to 0",
+      [](Sample& s) { s.parts[0].suction_deliveries[4].joints_rh[5] = 0.0; });
+  add("suction delivery empty joints get one joint",
+      [](Sample& s) { s.parts[0].suction_deliveries[2].joints_rh = Eigen::VectorXd::Zero(1); });
+  add("suction delivery a joint less",
+      [](Sample& s) { s.parts[0].suction_deliveries[3].joints_rh.conservativeResize(6); });
+  add("suction deliveries reordered", [](Sample& s) {
+    std::swap(s.parts[0].suction_deliveries[0], s.parts[0].suction_deliveries[1]);
+  });
+  add("a suction delivery less", [](Sample& s) { s.parts[0].suction_deliveries.pop_back(); });
+  add("no suction deliveries", [](Sample& s) { s.parts[0].suction_deliveries.clear(); });
   for (const auto& [name, sample] : variants) {
     const std::string path = dir + "/variant.db";
     write_sample(path, sample);

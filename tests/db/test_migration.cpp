@@ -19,11 +19,12 @@ namespace {
 
 // A "version 0" database: what schema 1 would look like if robot_grasps had no theta_c_deg yet
 // (and, as in schema 1, there were no comfort maps, handover, ergonomics, roadmap, regrasp,
-// direct grasp or table regrasp tables).
+// direct grasp, table regrasp or suction delivery tables).
 std::string write_v0(const std::string& dir) {
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
   execute_script(path,
+                 "DROP TABLE suction_deliveries;"
                  "DROP TABLE table_regrasps;"
                  "DROP TABLE direct_grasps;"
                  "DROP TABLE regrasp_edges;"
@@ -331,6 +332,30 @@ CREATE TABLE direct_grasps (
 CREATE INDEX direct_grasps_candidate_id ON direct_grasps(candidate_id);
 )sql";
 
+// What schema version 6 added to version 5, exactly as hila (schema 6) wrote it, frozen here like
+// kSchemaV1. (Version 7 added no table, only the digests in meta.)
+const char* const kSchemaV6Additions = R"sql(
+CREATE TABLE table_regrasps (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  pick_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  arm TEXT NOT NULL,
+  placement_x REAL NOT NULL, placement_y REAL NOT NULL, placement_z REAL NOT NULL,
+  placement_qw REAL NOT NULL, placement_qx REAL NOT NULL, placement_qy REAL NOT NULL,
+  placement_qz REAL NOT NULL,
+  joints_pick BLOB NOT NULL,
+  joints_place BLOB NOT NULL,
+  joints_repick BLOB NOT NULL,
+  joints_rh BLOB NOT NULL,
+  inclination_pick_deg REAL NOT NULL,
+  inclination_place_deg REAL NOT NULL,
+  inclination_repick_deg REAL NOT NULL,
+  inclination_rh_deg REAL NOT NULL
+);
+CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);
+)sql";
+
 // Meta and one part with a placement and one grasp of each kind, as rows of the version 1 tables
 // (meta without schema_version). Values are exact in binary so the writer would store the same
 // bits.
@@ -430,15 +455,35 @@ std::string write_v5(const std::string& dir) {
   return path;
 }
 
+// One table regrasp of the goal of kV3Rows (set down at (0.5, -0.25, 0.75) unturned; joints_pick
+// (0.5), no joints_place, joints_repick (-2.0) and joints_rh (0.5, 1.0), as in the kV3Rows blobs),
+// as a row of the version 6 table; the version set to 6.
+const char* const kV6Rows = R"sql(
+UPDATE meta SET value = '6' WHERE key = 'schema_version';
+INSERT INTO table_regrasps VALUES (1, 1, 1, 1, 'left', 0.5, -0.25, 0.75, 1.0, 0.0, 0.0, 0.0,
+  x'000000000000e03f', x'', x'00000000000000c0', x'000000000000e03f000000000000f03f',
+  10.5, 20.5, 30.5, 40.5);
+)sql";
+
+// A version 6 file made by hand: kV1Rows, kV3Rows, kV4Rows, kV5Rows and kV6Rows.
+std::string write_v6(const std::string& dir) {
+  const std::string path = dir + "/v6.db";
+  execute_script(path, std::string(kSchemaV1) + kSchemaV2Additions + kSchemaV3Additions +
+                           kSchemaV4Additions + kSchemaV5Additions + kSchemaV6Additions + kV1Rows +
+                           kV3Rows + kV4Rows + kV5Rows + kV6Rows);
+  return path;
+}
+
 // The same content written by this hila's DatabaseWriter (no handover or ergonomics records, an
 // empty meta.human_bodies), with the comfort map of write_v2 when `with_comfort_map`, with the
 // version 3 records (and meta.human_bodies) of write_v3 when `with_handover_records`, with the
-// version 4 records of write_v4 when `with_roadmap_records` (which needs the version 3 ones), and
-// with the version 5 record of write_v5 when `with_direct_grasp_records` (which needs the version 3
-// ones).
+// version 4 records of write_v4 when `with_roadmap_records` (which needs the version 3 ones), with
+// the version 5 record of write_v5 when `with_direct_grasp_records` (which needs the version 3
+// ones), and with the version 6 record of write_v6 when `with_table_regrasp_records` (likewise).
 void write_reference_content(const std::string& path, bool with_comfort_map,
                              bool with_handover_records = false, bool with_roadmap_records = false,
-                             bool with_direct_grasp_records = false) {
+                             bool with_direct_grasp_records = false,
+                             bool with_table_regrasp_records = false) {
   Meta meta;
   meta.hila_version = "0.1.0";
   meta.product_name = "cabinet";
@@ -582,6 +627,22 @@ void write_reference_content(const std::string& path, bool with_comfort_map,
     direct.inclination_rh_deg = 67.5;
     writer.add_direct_grasps({direct});
   }
+  if (with_table_regrasp_records) {
+    TableRegraspRecord regrasp;
+    regrasp.candidate_id = 1;
+    regrasp.pick_grasp_id = 1;
+    regrasp.robot_grasp_id = 1;
+    regrasp.arm = "left";
+    regrasp.placement.translation() = Eigen::Vector3d(0.5, -0.25, 0.75);
+    regrasp.joints_pick = Eigen::VectorXd::Constant(1, 0.5);
+    regrasp.joints_repick = Eigen::VectorXd::Constant(1, -2.0);
+    regrasp.joints_rh = Eigen::Vector2d(0.5, 1.0);
+    regrasp.inclination_pick_deg = 10.5;
+    regrasp.inclination_place_deg = 20.5;
+    regrasp.inclination_repick_deg = 30.5;
+    regrasp.inclination_rh_deg = 40.5;
+    writer.add_table_regrasps({regrasp});
+  }
   writer.commit();
 }
 
@@ -640,15 +701,21 @@ Database open_migrated(const std::string& path) {
 }
 
 // After rows were added by SQL, the per-table digests of the file as it now is, written the only
-// way outside the writer: set back to version 6 (which has none), a migration to 7 writes them.
+// way outside the writer, by a migration: set back to version 7, a step to 8 that changes no table
+// (the real one would create suction_deliveries again), after which the migration writes them.
 void reseal(const std::string& path) {
-  execute_script(path, "UPDATE meta SET value = '6' WHERE key = 'schema_version'");
-  migrate_in_place(path);
+  execute_script(path, "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  migrate_with_steps(path, {{7, "DELETE FROM meta WHERE key GLOB 'digest.*';"}}, 8);
 }
 
 // A migrated file has the version 6 table, empty.
 void expect_no_table_regrasps(const Database& db) {
   EXPECT_TRUE(db.table_regrasps(1).empty());
+}
+
+// A migrated file has the version 8 table, empty.
+void expect_no_suction_deliveries(const Database& db) {
+  EXPECT_TRUE(db.suction_deliveries(1).empty());
 }
 
 }  // namespace
@@ -662,7 +729,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v1 = content_digest(path);  // an old file still has a digest
 
-  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7
+  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8
 
   // Readable now, but still what hila 0.1.0 built: refused unless any hila version is accepted.
   expect_input_error([&] { Database::open(path); },
@@ -670,7 +737,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                           hila_version() + "), got one built by hila 0.1.0 (an older hila",
                       "rebuild with: hila build product.yaml -o " + path});
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 7);
+  EXPECT_EQ(db.meta().schema_version, 8);
   EXPECT_EQ(db.meta().product_name, "cabinet");
   EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
@@ -682,6 +749,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
   expect_no_table_regrasps(db);
+  expect_no_suction_deliveries(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v1.db"}) << "no temporary copy left";
 
   // The migrated file holds exactly what this hila writes for the same records: same tables,
@@ -704,16 +772,16 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
        "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_THROW(Database::open(path), DatabaseError);
   const std::string digest_v2 = content_digest(path);
 
-  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6 -> 7
+  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 7);
+  EXPECT_EQ(db.meta().schema_version, 8);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   expect_v1_records(db);
   ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
@@ -724,6 +792,7 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
   expect_no_table_regrasps(db);
+  expect_no_suction_deliveries(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v2.db"}) << "no temporary copy left";
 
   // Same content as this hila writes: the new tables (empty) and meta.human_bodies ("") included.
@@ -744,15 +813,15 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
        "written by schema version 3 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v3 = content_digest(path);
 
-  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6 -> 7
+  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6 -> 7 -> 8
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 7);
+  EXPECT_EQ(db.meta().schema_version, 8);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -773,10 +842,11 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(db.shared_grasps(1)[0].inclination_rh_deg, 45.0);
   ASSERT_EQ(db.ergonomics(1).size(), 1u);
   EXPECT_EQ(db.ergonomics(1)[0].torso_flexion_deg, 17.25);
-  // The version 4, 5 and 6 tables exist, empty.
+  // The version 4, 5, 6 and 8 tables exist, empty.
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
   expect_no_table_regrasps(db);
+  expect_no_suction_deliveries(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v3.db"}) << "no temporary copy left";
 
   // Same content as this hila writes for the same records: the new tables (empty) included.
@@ -833,15 +903,15 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
        "written by schema version 4 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v4 = content_digest(path);
 
-  migrate_in_place(path);  // 4 -> 5 -> 6 -> 7
+  migrate_in_place(path);  // 4 -> 5 -> 6 -> 7 -> 8
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 7);
+  EXPECT_EQ(db.meta().schema_version, 8);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -857,9 +927,10 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(db.regrasp_nodes(1)[0].candidate_id, 1);
   ASSERT_EQ(db.regrasp_nodes(1)[0].solutions.size(), 1u);
   EXPECT_EQ(db.regrasp_nodes(1)[0].solutions[0], Eigen::Vector2d(0.5, 1.0));
-  // The version 5 and 6 tables exist, empty.
+  // The version 5, 6 and 8 tables exist, empty.
   expect_no_direct_grasps(db);
   expect_no_table_regrasps(db);
+  expect_no_suction_deliveries(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v4.db"}) << "no temporary copy left";
 
   // Same content as this hila writes for the same records: the new tables (empty) included.
@@ -915,15 +986,15 @@ TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
        "written by schema version 5 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v5 = content_digest(path);
 
-  migrate_in_place(path);  // 5 -> 6 -> 7
+  migrate_in_place(path);  // 5 -> 6 -> 7 -> 8
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 7);
+  EXPECT_EQ(db.meta().schema_version, 8);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -958,8 +1029,9 @@ TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(direct[0].joints_rh[0], -2.0);
   EXPECT_EQ(direct[0].inclination_pick_deg, 22.5);
   EXPECT_EQ(direct[0].inclination_rh_deg, 67.5);
-  // The version 6 table exists, empty.
+  // The version 6 and 8 tables exist, empty.
   expect_no_table_regrasps(db);
+  expect_no_suction_deliveries(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"v5.db"}) << "no temporary copy left";
 
   // Same content as this hila writes for the same records: the new table (empty) included.
@@ -1028,6 +1100,144 @@ TEST(Migration, Version5FileThatAlreadyHasTheNewTableFailsCleanly) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
+TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
+  const std::string dir = temp_dir("db_migration_v6");
+  const std::string path = write_v6(dir);
+  // Unmigrated, the file is refused as outdated, with the way out.
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
+       "written by schema version 6 (an older hila); rebuild with: hila build product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  const std::string digest_v6 = content_digest(path);
+
+  migrate_in_place(path);  // 6 -> 7 -> 8
+
+  const Database db = open_migrated(path);
+  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
+  EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
+  expect_v1_records(db);
+  ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
+  // The version 3, 4 and 5 records are kept.
+  ASSERT_EQ(db.handover_goals(1).size(), 1u);
+  ASSERT_EQ(db.shared_grasps(1).size(), 1u);
+  ASSERT_NE(db.roadmap("left"), nullptr);
+  ASSERT_EQ(db.regrasp_nodes(1).size(), 1u);
+  ASSERT_EQ(db.direct_grasps(1).size(), 1u);
+  EXPECT_EQ(db.direct_grasps(1)[0].inclination_rh_deg, 67.5);
+  // The version 6 record is kept, every field.
+  const auto regrasps = db.table_regrasps(1);
+  ASSERT_EQ(regrasps.size(), 1u);
+  EXPECT_EQ(regrasps[0].id, 1);
+  EXPECT_EQ(regrasps[0].candidate_id, 1);
+  EXPECT_EQ(regrasps[0].pick_grasp_id, 1);
+  EXPECT_EQ(regrasps[0].robot_grasp_id, 1);
+  EXPECT_EQ(regrasps[0].arm, "left");
+  EXPECT_EQ(regrasps[0].placement.translation(), Eigen::Vector3d(0.5, -0.25, 0.75));
+  EXPECT_EQ(regrasps[0].placement.linear(), Eigen::Matrix3d::Identity());
+  EXPECT_EQ(regrasps[0].joints_pick, Eigen::VectorXd::Constant(1, 0.5));
+  EXPECT_EQ(regrasps[0].joints_place.size(), 0);
+  EXPECT_EQ(regrasps[0].joints_repick, Eigen::VectorXd::Constant(1, -2.0));
+  EXPECT_EQ(regrasps[0].joints_rh, Eigen::Vector2d(0.5, 1.0));
+  EXPECT_EQ(regrasps[0].inclination_pick_deg, 10.5);
+  EXPECT_EQ(regrasps[0].inclination_place_deg, 20.5);
+  EXPECT_EQ(regrasps[0].inclination_repick_deg, 30.5);
+  EXPECT_EQ(regrasps[0].inclination_rh_deg, 40.5);
+  // The version 8 table exists, empty.
+  expect_no_suction_deliveries(db);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"v6.db"}) << "no temporary copy left";
+
+  // Same content as this hila writes for the same records: the new table (empty) included.
+  const std::string fresh = dir + "/fresh.db";
+  write_reference_content(fresh, true, true, true, true, true);
+  EXPECT_EQ(content_digest(path), content_digest(fresh));
+  EXPECT_NE(content_digest(path), digest_v6);
+  // Without the table regrasp the content differs: the comparison sees the version 6 rows.
+  const std::string without = dir + "/without.db";
+  write_reference_content(without, true, true, true, true, false);
+  EXPECT_NE(content_digest(path), content_digest(without));
+
+  // The migrated file takes suction deliveries like a fresh one (the table and its foreign keys
+  // are there): a row by SQL, read back, then one whose suction grasp does not exist.
+  execute_script(path,
+                 "INSERT INTO suction_deliveries VALUES (1, 1, 1, 'right', "
+                 "x'000000000000e03f000000000000f03f');");
+  // An edit after the migration is refused like any other.
+  expect_input_error([&] { open_migrated(path); },
+                     {path + ": suction_deliveries: expected the content digest stored when it "
+                             "was written"});
+  reseal(path);
+  const auto deliveries = open_migrated(path).suction_deliveries(1);
+  ASSERT_EQ(deliveries.size(), 1u);
+  EXPECT_EQ(deliveries[0].id, 1);
+  EXPECT_EQ(deliveries[0].candidate_id, 1);
+  EXPECT_EQ(deliveries[0].suction_grasp_id, 1);
+  EXPECT_EQ(deliveries[0].arm, "right");
+  EXPECT_EQ(deliveries[0].joints_rh, Eigen::Vector2d(0.5, 1.0));
+  EXPECT_EQ(open_migrated(path).table_regrasps(1).size(), 1u) << "a table of its own";
+  expect_input_error(
+      [&] {
+        execute_script(path, "INSERT INTO suction_deliveries VALUES (2, 1, 2, 'right', x'');");
+      },
+      {"FOREIGN KEY constraint failed"});
+
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after) << "migrating a current file is a no-op";
+}
+
+TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
+  // A version 7 file as this hila's writer would have made it: no suction_deliveries table, and a
+  // stored digest for every other table. The step adds the table, the migration the digests of
+  // all of them, the new one included.
+  const std::string dir = temp_dir("db_migration_v7");
+  Sample sample = make_sample();
+  sample.parts[0].suction_deliveries.clear();  // a version 7 file cannot hold any
+  const std::string written = dir + "/written.db";
+  write_sample(written, sample);
+  const std::string path = dir + "/v7.db";
+  write_sample(path, sample);
+  execute_script(path,
+                 "DROP TABLE suction_deliveries;"
+                 "DELETE FROM meta WHERE key = 'digest.suction_deliveries';"
+                 "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": meta.schema_version", "written by schema version 7 (an older hila)",
+                      "(or migrate it in place with hila::db::migrate_in_place)"});
+  const std::string digest_v7 = content_digest(path);
+
+  migrate_in_place(path);  // 7 -> 8
+
+  // Built by this hila: opens with the default options, every stored digest checked.
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 8);
+  for (const auto& c : db.handover_candidates(1)) {
+    EXPECT_TRUE(db.suction_deliveries(c.id).empty()) << c.id;
+  }
+  std::size_t regrasps = 0;
+  for (const auto& c : db.handover_candidates(1)) regrasps += db.table_regrasps(c.id).size();
+  EXPECT_EQ(regrasps, sample.parts[0].table_regrasps.size()) << "the version 6 rows are kept";
+  EXPECT_EQ(content_digest(path), content_digest(written));
+  EXPECT_NE(content_digest(path), digest_v7);
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"v7.db", "written.db"}));
+}
+
+TEST(Migration, Version7FileThatAlreadyHasTheNewTableFailsCleanly) {
+  // Version 8 content with the version number set back: the 7 -> 8 step's CREATE TABLE fails and
+  // the file is left as it was.
+  const std::string dir = temp_dir("db_migration_v7_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 7 -> 8", "table suction_deliveries already exists"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
+}
+
 TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
   // A hand-made version 2 file that already has the key: the step does not overwrite it.
   const std::string dir = temp_dir("db_migration_v2_bodies");
@@ -1060,7 +1270,7 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
 
   // Made from the sample, which this hila wrote: it opens with the default options.
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 7);
+  EXPECT_EQ(db.meta().schema_version, 8);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -1075,22 +1285,26 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
   expect_no_roadmap_records(db);
   expect_no_direct_grasps(db);
   expect_no_table_regrasps(db);
+  expect_no_suction_deliveries(db);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"}) << "no temporary copy left";
 }
 
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 7 -> 8 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
-  // 4 -> 5 and 5 -> 6 create; listed first to prove ordering.
-  std::vector<MigrationStep> steps = {{7,
-                                       "INSERT INTO notes (text) VALUES ('from step 7');"
-                                       "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
-                                       "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
-                                       "INSERT INTO notes (text) SELECT arm FROM roadmaps;"
-                                       "INSERT INTO notes (text) SELECT arm FROM direct_grasps;"
-                                       "INSERT INTO notes (text) SELECT arm FROM table_regrasps;"}};
+  // Step 8 -> 9 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
+  // 4 -> 5, 5 -> 6 and 7 -> 8 create; listed first to prove ordering.
+  std::vector<MigrationStep> steps = {
+      {8,
+       "INSERT INTO notes (text) VALUES ('from step 8');"
+       "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
+       "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
+       "INSERT INTO notes (text) SELECT arm FROM roadmaps;"
+       "INSERT INTO notes (text) SELECT arm FROM direct_grasps;"
+       "INSERT INTO notes (text) SELECT arm FROM table_regrasps;"
+       "INSERT INTO notes (text) SELECT arm FROM suction_deliveries;"}};
   steps.push_back(migration_steps().at(1));
+  steps.push_back(migration_steps().at(6));
   steps.push_back(migration_steps().at(5));
   steps.push_back(migration_steps().at(4));
   steps.push_back(migration_steps().at(3));
@@ -1099,13 +1313,13 @@ TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 8));
-  migrate_with_steps(path, steps, 8);
-  // The file is now version 8: this hila (7) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 8"});
-  // Migrating to 8 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 9));
+  migrate_with_steps(path, steps, 9);
+  // The file is now version 9: this hila (8) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 9"});
+  // Migrating to 9 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 8);
+  migrate_with_steps(path, steps, 9);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -1144,6 +1358,11 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
                    migration_steps().at(3), migration_steps().at(4)},
                   1, 7))
       << "1 -> 2 -> 3 -> 4 -> 5 -> 6 does not reach 7";
+  EXPECT_FALSE(
+      can_migrate({migration_steps().at(0), migration_steps().at(1), migration_steps().at(2),
+                   migration_steps().at(3), migration_steps().at(4), migration_steps().at(5)},
+                  1, 8))
+      << "1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 does not reach 8";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },
@@ -1188,9 +1407,9 @@ TEST(Migration, NewerDatabaseIsRefused) {
   const std::string dir = temp_dir("db_migration_newer");
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
-  execute_script(path, "UPDATE meta SET value = '8' WHERE key = 'schema_version'");
+  execute_script(path, "UPDATE meta SET value = '9' WHERE key = 'schema_version'");
   expect_input_error([&] { migrate_in_place(path); },
-                     {path, "written by schema version 8 (a newer hila)", "upgrade hila"});
+                     {path, "written by schema version 9 (a newer hila)", "upgrade hila"});
 }
 
 TEST(Migration, ForeignFilesAreRefused) {

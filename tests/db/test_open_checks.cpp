@@ -123,7 +123,7 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   const std::string path = write_small(temp_dir("db_open_older"));
   detail::execute_script(path, "UPDATE meta SET value = '0' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "this hila reads (schema version 7)",
+                     {path + ": meta.schema_version", "this hila reads (schema version 8)",
                       "written by schema version 0 (an older hila)",
                       "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
   // There is no step from version 0, so the message must not offer one.
@@ -134,9 +134,10 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   }
 }
 
-// SQL that drops the tables schema versions 6 and 5 added and the ones version 4 added
-// (regrasp_edges first: it refers to the others); table_regrasps and direct_grasps go before
-// handover_candidates, which they refer to.
+// SQL that drops the tables schema versions 8, 6 and 5 added and the ones version 4 added
+// (regrasp_edges first: it refers to the others); suction_deliveries, table_regrasps and
+// direct_grasps go before handover_candidates, which they refer to.
+const char* const kDropVersion8Tables = "DROP TABLE suction_deliveries;";
 const char* const kDropVersion6Tables = "DROP TABLE table_regrasps;";
 const char* const kDropVersion5Tables = "DROP TABLE direct_grasps;";
 const char* const kDropVersion4Tables =
@@ -145,8 +146,8 @@ const char* const kDropVersion4Tables =
 
 TEST(OpenChecks, Version1OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v1"));
-  detail::execute_script(path, std::string(kDropVersion6Tables) + kDropVersion5Tables +
-                                   kDropVersion4Tables +
+  detail::execute_script(path, std::string(kDropVersion8Tables) + kDropVersion6Tables +
+                                   kDropVersion5Tables + kDropVersion4Tables +
                                    "DROP TABLE shared_grasps; DROP TABLE handover_candidates;"
                                    "DROP TABLE robot_handovers; DROP TABLE handover_stages;"
                                    "DROP TABLE ergonomics; DROP TABLE comfort_maps;"
@@ -154,7 +155,7 @@ TEST(OpenChecks, Version1OffersMigration) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), "
        "got one written by schema version 1 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -163,7 +164,8 @@ TEST(OpenChecks, Version1OffersMigration) {
 TEST(OpenChecks, Version2OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v2"));
   detail::execute_script(
-      path, std::string(kDropVersion6Tables) + kDropVersion5Tables + kDropVersion4Tables +
+      path, std::string(kDropVersion8Tables) + kDropVersion6Tables + kDropVersion5Tables +
+                kDropVersion4Tables +
                 "DROP TABLE shared_grasps; DROP TABLE handover_candidates;"
                 "DROP TABLE robot_handovers; DROP TABLE handover_stages;"
                 "DROP TABLE ergonomics; DELETE FROM meta WHERE key = 'human_bodies';"
@@ -171,7 +173,7 @@ TEST(OpenChecks, Version2OffersMigration) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), "
        "got one written by schema version 2 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -182,13 +184,13 @@ TEST(OpenChecks, Version2OffersMigration) {
 TEST(OpenChecks, Version3OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v3"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, std::string(kDropVersion6Tables) + kDropVersion5Tables +
-                                   kDropVersion4Tables +
+  detail::execute_script(path, std::string(kDropVersion8Tables) + kDropVersion6Tables +
+                                   kDropVersion5Tables + kDropVersion4Tables +
                                    "UPDATE meta SET value = '3' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), "
        "got one written by schema version 3 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -201,12 +203,13 @@ TEST(OpenChecks, Version3OffersMigration) {
 TEST(OpenChecks, Version4OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v4"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, std::string(kDropVersion6Tables) + kDropVersion5Tables +
+  detail::execute_script(path, std::string(kDropVersion8Tables) + kDropVersion6Tables +
+                                   kDropVersion5Tables +
                                    "UPDATE meta SET value = '4' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), "
        "got one written by schema version 4 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -219,12 +222,12 @@ TEST(OpenChecks, Version4OffersMigration) {
 TEST(OpenChecks, Version5OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v5"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, std::string(kDropVersion6Tables) +
+  detail::execute_script(path, std::string(kDropVersion8Tables) + kDropVersion6Tables +
                                    "UPDATE meta SET value = '5' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 7), "
+       ": meta.schema_version: expected a database this hila reads (schema version 8), "
        "got one written by schema version 5 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -234,11 +237,31 @@ TEST(OpenChecks, Version5OffersMigration) {
   EXPECT_NE(digest_v5, digest_current);
 }
 
+TEST(OpenChecks, Version7OffersMigration) {
+  const std::string path = write_small(temp_dir("db_open_v7"));
+  const std::string digest_current = content_digest(path);
+  detail::execute_script(path, std::string(kDropVersion8Tables) +
+                                   "DELETE FROM meta WHERE key = 'digest.suction_deliveries';"
+                                   "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 8), "
+       "got one written by schema version 7 (an older hila); rebuild with: hila build "
+       "meshes/cabinet/product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  // The digest still reads it (a version 7 file has no suction_deliveries table to hash), and
+  // differs.
+  const std::string digest_v7 = content_digest(path);
+  EXPECT_EQ(digest_v7.size(), 64u);
+  EXPECT_NE(digest_v7, digest_current);
+}
+
 TEST(OpenChecks, NewerSchemaVersion) {
   const std::string path = write_small(temp_dir("db_open_newer"));
-  detail::execute_script(path, "UPDATE meta SET value = '8' WHERE key = 'schema_version'");
+  detail::execute_script(path, "UPDATE meta SET value = '9' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "written by schema version 8 (a newer hila)",
+                     {path + ": meta.schema_version", "written by schema version 9 (a newer hila)",
                       "upgrade hila, or rebuild with: hila build"});
 }
 

@@ -381,6 +381,60 @@ TEST(OpenVerification, GraspIdThatNamesNoGrasp) {
                       rebuild(path)});
 }
 
+// The suction_deliveries table (schema version 8) is verified like the others: its references,
+// its storage classes and its content digest.
+TEST(OpenVerification, SuctionDeliveriesAreVerified) {
+  const std::string path = write_small(temp_dir("db_verify_suction_deliveries"));
+  const std::string pristine = read_file(path);
+  const auto reset = [&] { std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine; };
+  ASSERT_EQ(query_int(path, "SELECT count(*) FROM suction_deliveries"), 5);
+  edit(path, "UPDATE suction_deliveries SET suction_grasp_id = 999 WHERE id = 3");
+  expect_input_error([&] { Database::open(path); },
+                     {path +
+                      ": suction_deliveries.suction_grasp_id (id 3): expected the id of a "
+                      "suction_grasps row, got 999, which names none (the only reference "
+                      "PRAGMA foreign_key_check finds broken); " +
+                      rebuild(path)});
+  reset();
+  edit(path, "UPDATE suction_deliveries SET candidate_id = 99 WHERE id IN (1, 4)");
+  expect_input_error([&] { Database::open(path); },
+                     {path +
+                      ": suction_deliveries.candidate_id (id 1): expected the id of a "
+                      "handover_candidates row, got 99, which names none (one of 2 references "
+                      "PRAGMA foreign_key_check finds broken); " +
+                      rebuild(path)});
+  reset();
+  edit(path, "UPDATE suction_deliveries SET joints_rh = 0.5 WHERE id = 2");
+  expect_input_error([&] { Database::open(path); },
+                     {path +
+                      ": suction_deliveries.joints_rh (id 2): expected a BLOB (the column is "
+                      "BLOB NOT NULL), got the REAL 0.5; " +
+                      rebuild(path)});
+  reset();
+  edit(path, "UPDATE suction_deliveries SET suction_grasp_id = 'one' WHERE id = 2");
+  expect_input_error([&] { Database::open(path); },
+                     {path +
+                      ": suction_deliveries.suction_grasp_id (id 2): expected an INTEGER "
+                      "(the column is INTEGER NOT NULL), got the TEXT 'one'; " +
+                      rebuild(path)});
+  reset();
+  flip_blob_bit(path, "suction_deliveries", "joints_rh", 5);
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": suction_deliveries: expected the content digest stored when it "
+                             "was written (meta.digest.suction_deliveries = ",
+                      "its rows changed since (a damaged or edited file); " + rebuild(path)});
+  reset();
+  edit(path, "DELETE FROM meta WHERE key = 'digest.suction_deliveries'");
+  expect_input_error([&] { Database::open(path); },
+                     {path +
+                      ": meta.digest.suction_deliveries: expected the content digest of table "
+                      "suction_deliveries (a database of schema version 7 or later holds one per "
+                      "table, written with it), got no such key; " +
+                      rebuild(path)});
+  reset();
+  EXPECT_NO_THROW(Database::open(path));
+}
+
 TEST(OpenVerification, WrongStorageClassesAndColumns) {
   const std::string path = write_small(temp_dir("db_verify_types"));
   const std::string pristine = read_file(path);
@@ -408,7 +462,7 @@ TEST(OpenVerification, WrongStorageClassesAndColumns) {
           {path + ": meta.value (key 'product_name'): expected a TEXT (the column is TEXT NOT "
                   "NULL), got a BLOB of 1 byte"});
   refused("ALTER TABLE robot_grasps ADD COLUMN note TEXT",
-          {path + ": robot_grasps: expected the 26 columns of schema version 7, got 27 columns "
+          {path + ": robot_grasps: expected the 26 columns of schema version 8, got 27 columns "
                   "(column 27 is 'note', expected none)"});
 }
 
@@ -526,21 +580,24 @@ TEST(OpenVerification, DigestsAreDeterministicAndOutsideTheContentDigest) {
   EXPECT_EQ(content_digest(dir + "/a.db"), before);
 }
 
-// A version 6 file (the same tables, no digests): refused with the way out; migrated, it holds
-// the digests the writer gives the same content, and opens.
+// A version 6 file (the same tables but suction_deliveries, no digests): refused with the way out;
+// migrated, it holds the digests the writer gives the same content, and opens.
 TEST(OpenVerification, Version6FileIsMigratedWithItsDigests) {
   const std::string dir = temp_dir("db_verify_v6");
   const std::string written = dir + "/written.db";
-  write_sample(written, make_sample());
+  Sample sample = make_sample();
+  sample.parts[0].suction_deliveries.clear();  // a version 6 file cannot hold any
+  write_sample(written, sample);
   const std::string path = dir + "/v6.db";
   fs::copy_file(written, path);
   edit(path,
+       "DROP TABLE suction_deliveries;"
        "DELETE FROM meta WHERE key GLOB 'digest.*';"
        "UPDATE meta SET value = '6' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
                      {path +
                       ": meta.schema_version: expected a database this hila reads (schema "
-                      "version 7), got one written by schema version 6 (an older hila); " +
+                      "version 8), got one written by schema version 6 (an older hila); " +
                       rebuild(path) + " (or migrate it in place with hila::db::migrate_in_place)"});
   migrate_in_place(path);
   EXPECT_NO_THROW(Database::open(path)) << "built by this hila: opens with the default options";

@@ -191,7 +191,7 @@ class RoadmapRoundTrip : public ::testing::Test {
 };
 
 TEST_F(RoadmapRoundTrip, SchemaVersion) {
-  EXPECT_EQ(Database::open(path_).meta().schema_version, 7);
+  EXPECT_EQ(Database::open(path_).meta().schema_version, 8);
 }
 
 TEST_F(RoadmapRoundTrip, RoadmapsBitForBitInIdOrder) {

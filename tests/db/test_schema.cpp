@@ -34,21 +34,23 @@ std::vector<std::string> create_statements(const std::string& sql) {
 
 }  // namespace
 
-TEST(Schema, VersionIsSevenWithStepsFromOneToSix) {
-  EXPECT_EQ(current_schema_version(), 7);
-  ASSERT_EQ(migration_steps().size(), 6u);
+TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
+  EXPECT_EQ(current_schema_version(), 8);
+  ASSERT_EQ(migration_steps().size(), 7u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
   EXPECT_EQ(migration_steps()[1].from_version, 2);
   EXPECT_EQ(migration_steps()[2].from_version, 3);
   EXPECT_EQ(migration_steps()[3].from_version, 4);
   EXPECT_EQ(migration_steps()[4].from_version, 5);
   EXPECT_EQ(migration_steps()[5].from_version, 6);
+  EXPECT_EQ(migration_steps()[6].from_version, 7);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 3, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 4, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 5, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 6, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 7, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
   // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
@@ -104,6 +106,19 @@ TEST(Schema, VersionIsSevenWithStepsFromOneToSix) {
   EXPECT_TRUE(create_statements(migration_steps()[5].sql).empty());
   EXPECT_EQ(migration_steps()[5].sql, "DELETE FROM meta WHERE key GLOB 'digest.*';\n");
   EXPECT_EQ(kTableDigestsSince, 7);
+  // 7 -> 8: the suction_deliveries table and its index, as a fresh database has them, and nothing
+  // else.
+  const auto created_v8 = create_statements(migration_steps()[6].sql);
+  ASSERT_EQ(created_v8.size(), 2u) << "1 table, 1 index";
+  EXPECT_EQ(created_v8[0].rfind("CREATE TABLE suction_deliveries (", 0), 0u) << created_v8[0];
+  EXPECT_EQ(created_v8[1],
+            "CREATE INDEX suction_deliveries_candidate_id ON suction_deliveries(candidate_id);");
+  for (const auto& statement : created_v8) {
+    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  EXPECT_EQ(migration_steps()[6].sql.find("INSERT"), std::string::npos);
+  EXPECT_EQ(migration_steps()[6].sql.find("digest"), std::string::npos)
+      << "the migration, not the step, writes the digests";
 }
 
 // The column specs the checks at open compare values with come from schema_sql() itself.
@@ -151,7 +166,7 @@ TEST(Schema, ColumnListHelpers) {
 }
 
 TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
-  ASSERT_EQ(kTables.size(), 18u);
+  ASSERT_EQ(kTables.size(), 19u);
   EXPECT_STREQ(kTables[0].name, "meta");
   EXPECT_STREQ(kTables[1].name, "parts");
   EXPECT_STREQ(kTables[6].name, "comfort_maps");
@@ -172,6 +187,8 @@ TEST(Schema, TablesInDigestOrderAllExistInTheSql) {
   EXPECT_EQ(kTables[16].since_version, 5);
   EXPECT_STREQ(kTables[17].name, "table_regrasps");
   EXPECT_EQ(kTables[17].since_version, 6);
+  EXPECT_STREQ(kTables[18].name, "suction_deliveries");
+  EXPECT_EQ(kTables[18].since_version, 8) << "version 7 added no table";
   for (const auto& table : kTables) {
     EXPECT_NE(schema_sql().find(std::string("CREATE TABLE ") + table.name + " ("),
               std::string::npos)
@@ -325,6 +342,34 @@ TEST(Schema, TableRegraspColumnsAreDeclared) {
             ");");
 }
 
+TEST(Schema, SuctionDeliveryColumnsAreDeclared) {
+  // The table's own text, so a column of another table cannot stand in for one of these.
+  const std::string& sql = schema_sql();
+  const std::size_t start = sql.find("CREATE TABLE suction_deliveries (");
+  ASSERT_NE(start, std::string::npos);
+  const std::string table = sql.substr(start, sql.find(");", start) + 2 - start);
+  EXPECT_EQ(table,
+            "CREATE TABLE suction_deliveries (\n"
+            "  id INTEGER PRIMARY KEY,\n"
+            "  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),\n"
+            "  suction_grasp_id INTEGER NOT NULL REFERENCES suction_grasps(id),\n"
+            "  arm TEXT NOT NULL,\n"
+            "  joints_rh BLOB NOT NULL\n"
+            ");");
+  // And the column specs the checks at open use say the same.
+  const auto& columns = schema_columns("suction_deliveries");
+  ASSERT_EQ(columns.size(), 5u);
+  EXPECT_EQ(columns[1].name, "candidate_id");
+  EXPECT_EQ(columns[1].storage_class, SQLITE_INTEGER);
+  EXPECT_EQ(columns[2].name, "suction_grasp_id");
+  EXPECT_EQ(columns[2].storage_class, SQLITE_INTEGER);
+  EXPECT_EQ(columns[3].name, "arm");
+  EXPECT_EQ(columns[3].storage_class, SQLITE_TEXT);
+  EXPECT_EQ(columns[4].name, "joints_rh");
+  EXPECT_EQ(columns[4].storage_class, SQLITE_BLOB);
+  for (const auto& c : columns) EXPECT_FALSE(c.nullable) << c.name;
+}
+
 TEST(Schema, ComfortMapColumnsAreDeclaredNotNull) {
   const std::string& sql = schema_sql();
   for (const std::string column :
@@ -367,7 +412,8 @@ TEST(Schema, SqlRunsOnAnEmptyFileAndCreatesThePartIdIndexes) {
         },
         {path, "already exists"});
   }
-  for (const std::string table : {"shared_grasps", "direct_grasps", "table_regrasps"}) {
+  for (const std::string table :
+       {"shared_grasps", "direct_grasps", "table_regrasps", "suction_deliveries"}) {
     expect_input_error(
         [&] {
           execute_script(path,

@@ -87,7 +87,7 @@ TEST(TableRegrasps, EveryFieldRoundTripsPerCandidateInIdOrder) {
   const Sample sample = make_sample();
   write_sample(path, sample);
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 7);
+  EXPECT_EQ(db.meta().schema_version, 8);
 
   const auto& written = sample.parts[0].table_regrasps;
   ASSERT_EQ(written.size(), 5u);
