@@ -435,7 +435,8 @@ Limit limit_of(const PartResult& r) {
       r.build_failure.find("cannot pick the part by suction", swapped) != std::string::npos) {
     return {true, "physical: neither arm's cup nor any gripper takes it where it lies"};
   }
-  if (no_gripper && has("cannot pick the part by suction")) {
+  // In the roles the build kept (the swapped roles' reason comes after theirs).
+  if (no_gripper && r.build_failure.find("cannot pick the part by suction") < swapped) {
     return {false,
             "hila: the tool's arm cannot pick it by suction, no gripper takes it where it lies "
             "(the other arm would need the tool)"};

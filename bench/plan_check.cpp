@@ -82,11 +82,17 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     }
   }
   const bool exchange = plan.mode == online::DeliveryMode::kExchange;
-  if (!grasp || (exchange && !cup) || (regrasp && !first_grasp)) {
+  // The suction way: the board on the cup from the pick to the human, no gripper.
+  const bool on_cup_only = plan.mode == online::DeliveryMode::kSuction;
+  if ((!grasp && !on_cup_only) || ((exchange || on_cup_only) && !cup) ||
+      (regrasp && !first_grasp)) {
     problem(plan.board, "the plan's robot or suction grasp is not in the database");
     return out;
   }
-  if (std::abs(grasp->theta_c_deg - plan.theta_c_deg) > 1e-9) {
+  if (on_cup_only && plan.theta_c_deg != 90.0) {
+    problem(plan.board, "a suction delivery with a slip limit (the cup has none)");
+  }
+  if (grasp && std::abs(grasp->theta_c_deg - plan.theta_c_deg) > 1e-9) {
     problem(plan.board, "the plan's theta_c is not its grasp's");
   }
 
@@ -125,7 +131,8 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
     h.jaw = std::min(cell.spec().gripper.jaw_max, g.jaw_width + settings.jaw_margin);
     return h;
   };
-  GripperHold hold = hold_of(regrasp ? *first_grasp : *grasp);
+  GripperHold hold;
+  if (grasp) hold = hold_of(regrasp ? *first_grasp : *grasp);
   bool set_down = false;  // the regrasp's set-down happened
 
   // The cell at the scene's start.
@@ -165,7 +172,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       return out;
     }
     core::Pose tool_at = scene.tool;  // while on the table
-    bool lifting_tool = false, set_down = false;
+    bool lifting_tool = false, tool_set_down = false;
     for (std::size_t i = 0; i < moving; ++i) {
       const online::PlanStep& step = plan.steps[i];
       ++out.steps;
@@ -226,12 +233,12 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         const std::string off = pose_error(handle, *plan.tool_place);
         if (!off.empty()) problem(where, "sets the tool down " + off + " the plan's place");
         held = false;
-        set_down = true;
+        tool_set_down = true;
         tool_at = *plan.tool_place;
         cell.set_jaw(robot_q, holder, cell.spec().gripper.jaw_max);
       }
     }
-    if (held || !set_down) problem(plan.board, "the tool moved first is not set down");
+    if (held || !tool_set_down) problem(plan.board, "the tool moved first is not set down");
   }
   bool lifting = false;  // the step after a pick starts with the object still on the table
   for (std::size_t index = moving; index < plan.steps.size(); ++index) {
@@ -259,6 +266,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         if (arm != &suction || !on_cup) problem(where, "suction off without the cup on the board");
         board_world = board_now();
         on_cup = false;
+        if (on_cup_only) handed_over = true;  // the human holds it
       } else if (e == "gripper_open") {
         if (arm != in_gripper) problem(where, "gripper opens without the board");
         board_world = board_now();
@@ -358,7 +366,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
           const std::string at = pose_error(board_now(), plan.robot_handover);
           if (!at.empty()) problem(where, "the exchange is " + at + " the plan's robot-robot pose");
         } else {  // a direct pick where the board lies
-          if (exchange || in_gripper != nullptr || handed_over) {
+          if (exchange || on_cup_only || in_gripper != nullptr || handed_over) {
             problem(where,
                     "closes on a board that is not standing where it was detected or set "
                     "down");
@@ -369,7 +377,9 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
         in_gripper = arm;
         cell.set_jaw(robot_q, *arm, hold.jaw);
       } else if (e == "wait_for_human") {
-        if (in_gripper != arm || on_cup) problem(where, "waits for the human without the board");
+        const bool holding = on_cup_only ? (arm == &suction && on_cup && in_gripper == nullptr)
+                                         : (in_gripper == arm && !on_cup);
+        if (!holding) problem(where, "waits for the human without the board");
         const std::string at = pose_error(board_now(), plan.human_handover);
         if (!at.empty()) problem(where, "presents the board " + at + " the robot-human pose");
       } else {

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <limits>
 
 #include "hila/core/error.hpp"
@@ -545,7 +546,14 @@ bool distance_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, voi
   fcl::DistanceRequestd request;
   request.enable_signed_distance = true;
   fcl::DistanceResultd result;
-  const double d = fcl::distance(o1, o2, request, result);
+  double d = 0.0;
+  try {
+    d = fcl::distance(o1, o2, request, result);
+  } catch (const std::exception&) {
+    // FCL's signed distance (libccd's EPA) throws on some pairs that touch exactly ("the origin is
+    // outside of the polytope"): they are at contact, distance 0.
+    d = 0.0;
+  }
   if (d < ctx->min_distance) {
     ctx->min_distance = d;
     if (ctx->pair) *ctx->pair = {std::min(a, b), std::max(a, b), d};

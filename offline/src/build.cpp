@@ -196,6 +196,12 @@ HandoverIds write_handover(db::DatabaseWriter& writer, std::int64_t part_id,
     r.robot_grasp_id = id_of(robot_ids, r.robot_grasp_id);
   }
   writer.add_table_regrasps(regrasps);
+  std::vector<db::SuctionDeliveryRecord> deliveries = h.suction_deliveries;
+  for (auto& d : deliveries) {
+    d.candidate_id = id_of(candidate_ids, d.candidate_id);
+    d.suction_grasp_id = id_of(suction_ids, d.suction_grasp_id);
+  }
+  writer.add_suction_deliveries(deliveries);
   return {rr_ids, candidate_ids};
 }
 
@@ -282,7 +288,7 @@ std::string settings_hash(const BuildSettings& s) {
        << h.direct_stored << ' ' << h.pick_lift << ' ' << h.pick_resolution << ' '
        << h.exchange_approach << ' ' << h.exchange_resolution << ' ' << h.table_regrasp.enabled
        << ' ' << h.table_regrasp.placements << ' ' << h.table_regrasp.yaws << ' '
-       << h.table_regrasp.support_tolerance << ' ' << h.swap_roles;
+       << h.table_regrasp.support_tolerance << ' ' << h.swap_roles << ' ' << h.suction_delivery;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& t = s.tool_relay;
   text << "\ntool_relay " << t.spacing << ' ' << t.yaw_steps << ' ' << t.clearance;

@@ -381,6 +381,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // jaws. A direct pick: the picking arm in its jaws. A way whose arm would be over its payload
   // is not searched; with none left the part has no goal.
   std::string exchange_failure, over_payload;
+  // The suction delivery carries the part on the tool alone.
+  const bool suction_within_payload =
+      core::check_payload(settings.suction_arm, cell.arm(settings.suction_arm).spec.payload,
+                          part.mass, core::CarryMode::kSuction, cell.spec().suction.mass)
+          .within_allowed();
   for (const auto& check :
        {core::check_payload(settings.suction_arm, cell.arm(settings.suction_arm).spec.payload,
                             part.mass, core::CarryMode::kSuction, cell.spec().suction.mass),
@@ -404,7 +409,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       }
     }
   }
-  if (!exchange_failure.empty() && direct_candidates.empty()) return finish(over_payload);
+  if (!exchange_failure.empty() && direct_candidates.empty() &&
+      !(settings.suction_delivery && suction_within_payload)) {
+    return finish(over_payload);
+  }
   sample_candidates(settings.candidates);
   // Nothing to search for: no candidate, or none the human takes even at the comfort floor.
   if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates &&
@@ -663,7 +671,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                        "or the approach, or the lift blocked; place the part within the " +
                        suction_arm.spec.name + " arm's reach, clear of the parts around it";
   }
-  if (!exchange_failure.empty() && direct_arms.empty()) {
+  // Suction deliveries need a suction grasp the arm picks the part with where it lies.
+  const bool suction_deliverable = settings.suction_delivery && suction_within_payload &&
+                                   std::count(pickable.begin(), pickable.end(), 1) > 0;
+  if (!exchange_failure.empty() && direct_arms.empty() && !suction_deliverable) {
     return finish(exchange_failure + "; " + direct_failure);
   }
   std::vector<int> favoured, spread;
@@ -838,7 +849,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     return why;
   };
-  if (!exchange_failure.empty() && direct_arms.empty()) {
+  if (!exchange_failure.empty() && direct_arms.empty() && !suction_deliverable) {
     return finish(exchange_failure + "; " + direct_failure + reach_census());
   }
 
@@ -985,7 +996,32 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         }
         reset_state();
       }
-      if (shared == 0 && direct == 0 && regrasps == 0) continue;
+      int on_cup = 0;
+      if (shared == 0 && direct == 0 && regrasps == 0 && suction_deliverable) {
+        at_candidate();
+        for (int s = 0; s < n_suction && on_cup < settings.direct_stored; ++s) {
+          if (!pickable[static_cast<std::size_t>(s)]) continue;
+          const core::Pose tcp = c.board * grasps.suction[static_cast<std::size_t>(s)].cup *
+                                 scene.cup_in_tcp.inverse();
+          const int n = suction_arm.ur_ik->solve(suction_base_inv * tcp, suction_arm.spec.home, ik);
+          for (int k = 0; k < n; ++k) {
+            cell.set_arm(robot_q, suction_arm, ik.q[static_cast<std::size_t>(k)]);
+            core::set_robot_state(cell, scene.cell, data, robot_q);
+            core::set_tool_held(cell, scene, data, tcp);
+            if (core::in_collision(scene.cell.model, data, suction_bodies)) continue;
+            db::SuctionDeliveryRecord r;
+            r.candidate_id = ci;
+            r.suction_grasp_id = s;
+            r.arm = suction_arm.spec.name;
+            r.joints_rh = ik.q[static_cast<std::size_t>(k)];
+            result.suction_deliveries.push_back(r);
+            ++on_cup;
+            break;
+          }
+        }
+        reset_state();
+      }
+      if (shared == 0 && direct == 0 && regrasps == 0 && on_cup == 0) continue;
       // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
       // are coarse, so a bin's Q may come from a neighbouring hand orientation.
       if (verified < settings.human_ik_goals) {
@@ -1012,6 +1048,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
               std::remove_if(result.regrasps.begin(), result.regrasps.end(),
                              [&](const db::TableRegraspRecord& r) { return r.candidate_id == ci; }),
               result.regrasps.end());
+          std::erase_if(result.suction_deliveries,
+                        [&](const db::SuctionDeliveryRecord& r) { return r.candidate_id == ci; });
           continue;
         }
         ++verified;
@@ -1090,6 +1128,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     } else {
       why += "; " + direct_failure;
     }
+    if (suction_deliverable) {
+      why += "; nor presented on the " + suction_arm.spec.name +
+             " arm's suction cup (its IK at the candidates in collision or out of reach)";
+    }
     if (threshold < settings.comfort_threshold) {
       why += "; none either down to comfort Q " + core::format_number(threshold);
     }
@@ -1114,6 +1156,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                    });
   std::stable_sort(result.regrasps.begin(), result.regrasps.end(),
                    [&](const db::TableRegraspRecord& a, const db::TableRegraspRecord& b) {
+                     return result.candidates[static_cast<std::size_t>(a.candidate_id)].rank <
+                            result.candidates[static_cast<std::size_t>(b.candidate_id)].rank;
+                   });
+  std::stable_sort(result.suction_deliveries.begin(), result.suction_deliveries.end(),
+                   [&](const db::SuctionDeliveryRecord& a, const db::SuctionDeliveryRecord& b) {
                      return result.candidates[static_cast<std::size_t>(a.candidate_id)].rank <
                             result.candidates[static_cast<std::size_t>(b.candidate_id)].rank;
                    });

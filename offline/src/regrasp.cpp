@@ -697,9 +697,47 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       result.first_served_rank = handover.candidates[static_cast<std::size_t>(c)].rank;
     }
   }
-  // Goals reached by a direct pick or a regrasp on the table have no exchange chain here: the
-  // online planner plans them through the picking arm's roadmap.
-  if (result.goals_served == 0 && handover.direct.empty() && handover.regrasps.empty()) {
+  // Suction deliveries of the first goals: the suction arm's pick (its node, transit and the
+  // cup's filter) and its transfer, the board on the cup, to the goal's robot-human pose, as for
+  // a robot-robot pose: the online planner follows the stored path and its end's branch.
+  for (const auto& d : handover.suction_deliveries) {
+    const auto& candidate = handover.candidates[static_cast<std::size_t>(d.candidate_id)];
+    if (candidate.rank < 0 || candidate.rank >= settings.goals) continue;
+    const Pick& pick = pick_for(d.suction_grasp_id);
+    if (pick.node < 0 || pick.lift.size() == 0) continue;
+    const auto& grasp = grasps.suction[static_cast<std::size_t>(d.suction_grasp_id)];
+    const core::Pose board_in_tcp = cup_in_tcp * grasp.cup.inverse();
+    suction.workspace.hold(board_in_tcp, 0.0);
+    std::vector<Eigen::VectorXd> ends =
+        valid_branches(suction, candidate.board * board_in_tcp.inverse(), d.joints_rh);
+    const auto& edges = result.filters[static_cast<std::size_t>(pick.filter)].edges;
+    const Endpoint lifted = endpoint(suction, no_slip_limit, pick.lift, k);
+    Connection transfer;
+    std::size_t chosen = 0;
+    for (int pass = 0; pass < 2 && !transfer.connected; ++pass) {
+      for (chosen = 0; chosen < ends.size(); ++chosen) {
+        if (pass == 1 && static_cast<int>(chosen) >= settings.transfer_bridges) break;
+        transfer = pass == 0
+                       ? roadmap_path(suction, no_slip_limit, edges, lifted,
+                                      endpoint(suction, no_slip_limit, ends[chosen], k), search)
+                       : bridge_path(suction, no_slip_limit, pick.lift, ends[chosen], bridge());
+        if (transfer.connected) break;
+      }
+    }
+    suction.workspace.release();
+    if (ends.empty()) ends.push_back(d.joints_rh);
+    if (transfer.connected) std::swap(ends.front(), ends[chosen]);
+    const int node = add_node("human_handover", settings.suction_arm, "suction",
+                              d.suction_grasp_id, -1, d.candidate_id, candidate.board, ends);
+    add_edge("transfer", settings.suction_arm, pick.node, node, pick.filter, transfer);
+    ++result.suction_transfers;
+    result.suction_transfers_connected += transfer.connected ? 1 : 0;
+  }
+  // Goals reached by a direct pick, a regrasp on the table or on the suction cup have no
+  // exchange chain here: the online planner plans them through the picking arm's roadmap (the
+  // stored transfers above where they connected).
+  if (result.goals_served == 0 && handover.direct.empty() && handover.regrasps.empty() &&
+      handover.suction_deliveries.empty()) {
     return finish("none of the first " + std::to_string(result.goals_considered) +
                   " goals connects home -> pick -> robot-robot -> robot-human in the roadmaps (" +
                   std::to_string(result.shared_grasps) +

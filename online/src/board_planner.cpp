@@ -30,6 +30,8 @@ const char* to_string(DeliveryMode mode) {
       return "direct";
     case DeliveryMode::kRegrasp:
       return "regrasp";
+    case DeliveryMode::kSuction:
+      return "suction";
   }
   return "?";
 }
@@ -201,6 +203,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   // tried; with none left, the status says so.
   std::string over_payload;
   bool exchange_within_payload = true;
+  bool suction_within_payload = true;  // the suction way: the board on the tool, nothing else
   for (const auto& check :
        {core::check_payload(run.suction_arm().spec.name, run.suction_arm().spec.payload, part->mass,
                             core::CarryMode::kSuction, model_.cell().spec().suction.mass),
@@ -209,6 +212,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
                             model_.cell().spec().suction.mass)}) {
     if (!check.within_allowed()) {
       exchange_within_payload = false;
+      if (check.mode == core::CarryMode::kSuction) suction_within_payload = false;
       if (over_payload.empty()) over_payload = "over the payload: " + check.describe();
     }
   }
@@ -223,7 +227,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       over_payload = "over the payload: " + check.describe();
     }
   }
-  if (!exchange_within_payload && direct_within_payload.empty()) {
+  if (!exchange_within_payload && !suction_within_payload && direct_within_payload.empty()) {
     return finish(BoardPlanStatus::kOverPayload, over_payload);
   }
   // At the stance the goals were built for, their stored Q is the scene human's (the same
@@ -316,7 +320,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     result.goal_rank = goal.rank;
     result.candidate_id = goal.id;
     result.robot_grasp_id = robot_grasp_id;
-    result.theta_c_deg = run.robot_grasps().at(robot_grasp_id).theta_c_deg;
+    // The cup has no slip limit (its grasps hold the weight at any tilt).
+    result.theta_c_deg =
+        robot_grasp_id == 0 ? 90.0 : run.robot_grasps().at(robot_grasp_id).theta_c_deg;
     result.quality = worker_quality.at(goal.id);
     const auto& posture = reach_of.at(goal.id);
     result.human_arm = goal.human_arm;
@@ -376,6 +382,28 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     result.set_down = r.placement;
     return true;
   };
+  // One suction chain of a goal; true when it is planned (result filled in).
+  auto try_suction = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
+                         const db::SuctionDeliveryRecord& d) {
+    GoalAttempt attempt;
+    attempt.rank = goal.rank;
+    attempt.candidate_id = goal.id;
+    attempt.mode = DeliveryMode::kSuction;
+    attempt.arm = d.arm;
+    attempt.suction_grasp_id = d.suction_grasp_id;
+    std::vector<PlanStep> steps;
+    ArmsState end;
+    const std::string failure = run.suction_chain(goal, d, steps, end);
+    record(attempt, round, failure, deadline);
+    result.attempts.push_back(attempt);
+    if (!failure.empty()) return false;
+    planned(goal, 0, steps, end);
+    result.mode = DeliveryMode::kSuction;
+    result.picking_arm = d.arm;
+    result.delivering_arm = d.arm;
+    result.suction_grasp_id = run.suction_delivery_cup(d, goal);
+    return true;
+  };
   // One exchange chain of a goal under the round's budgets; true when it is planned (result
   // filled in).
   auto try_shared = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
@@ -428,6 +456,14 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
           if (std::chrono::steady_clock::now() >= deadline) return false;
           if (direct_within_payload.count(r.arm) == 0) continue;
           if (try_regrasp(round, goal, r)) return true;
+        }
+      }
+      // The suction way, where the build found no gripper for this goal: one arm, no exchange.
+      if (const auto deliveries = records->suction_deliveries.find(goal.id);
+          suction_within_payload && deliveries != records->suction_deliveries.end()) {
+        for (const auto& d : deliveries->second) {
+          if (std::chrono::steady_clock::now() >= deadline) return false;
+          if (try_suction(round, goal, d)) return true;
         }
       }
       if (!exchange_within_payload) continue;

@@ -194,6 +194,17 @@ class Run {
                             const db::TableRegraspRecord& regrasp, std::vector<PlanStep>& steps,
                             ArmsState& end);
 
+  // --- The suction way: the suction arm picks the board with the tool and presents it on its
+  // cup; the human takes it from the cup (suction_way.cpp) ---------------------------------------
+
+  std::string suction_chain(const db::HandoverCandidateRecord& goal,
+                            const db::SuctionDeliveryRecord& delivery, std::vector<PlanStep>& steps,
+                            ArmsState& end);
+  // The suction grasp the delivery picks and presents the board with (a stand-in of the
+  // database's where that one's pick or presentation failed; the database's when not planned).
+  std::int64_t suction_delivery_cup(const db::SuctionDeliveryRecord& delivery,
+                                    const db::HandoverCandidateRecord& goal) const;
+
  private:
   // --- Construction, the memoised stages and the board's records (plan_run.cpp) --------------
 
@@ -217,6 +228,8 @@ class Run {
     visit(repicks_);
     visit(regrasp_presents_);
     visit(regrasp_leaves_);
+    visit(suction_presents_);
+    visit(suction_leaves_);
   }
 
   // Drops the memoised stages `which` picks, to be planned again when next asked for.
@@ -493,6 +506,18 @@ class Run {
   const Stage& regrasp_leave(const core::Arm& arm, const db::HandoverCandidateRecord& goal,
                              const db::TableRegraspRecord& regrasp, const Stage& presented);
 
+  // --- The suction way's stages after the pick (suction_way.cpp) ----------------------------
+
+  // The pick (by stand_in_cups(), the first whose pick and presentation plan) and the transfer,
+  // the board on the cup, to the goal's robot-human pose through the suction grasp's filtered
+  // roadmap (`wait_for_human`). Stage::cup says which cup.
+  const Stage& suction_present(const db::SuctionDeliveryRecord& delivery,
+                               const db::HandoverCandidateRecord& goal);
+  // The human holds the board: suction off, back along the cup's axis where the scene lets it,
+  // home with the tool.
+  const Stage& suction_leave(const db::SuctionDeliveryRecord& delivery,
+                             const db::HandoverCandidateRecord& goal);
+
   // --- The run's state -----------------------------------------------------------------------
 
   const PlannerModel& model_;
@@ -554,6 +579,9 @@ class Run {
   std::map<std::int64_t, Stage> repicks_;
   std::map<std::int64_t, Stage> regrasp_presents_;
   std::map<std::int64_t, Stage> regrasp_leaves_;
+  // The suction way's, by (the delivery's suction grasp, goal).
+  std::map<std::pair<std::int64_t, std::int64_t>, Stage> suction_presents_;
+  std::map<std::pair<std::int64_t, std::int64_t>, Stage> suction_leaves_;
 };
 
 }  // namespace hila::online::detail

@@ -45,6 +45,7 @@ PlannerModel::PlannerModel(std::shared_ptr<const core::Cell> cell, core::Product
       b.shared_grasps[goal.id] = database_.shared_grasps(goal.id);
       b.direct_grasps[goal.id] = database_.direct_grasps(goal.id);
       b.table_regrasps[goal.id] = database_.table_regrasps(goal.id);
+      b.suction_deliveries[goal.id] = database_.suction_deliveries(goal.id);
     }
     for (auto& g : database_.robot_grasps(part.id)) b.robot_grasps[g.id] = std::move(g);
     for (auto& g : database_.suction_grasps(part.id)) b.suction_grasps[g.id] = std::move(g);

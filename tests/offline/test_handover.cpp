@@ -309,6 +309,7 @@ TEST(Handover, NoRobotRobotPoseFailsWithAReason) {
   settings.candidates = 60;
   settings.max_candidates = 60;
   settings.rr_positions = {{2.0, 0.0, 2.5}};
+  settings.suction_delivery = false;  // the right arm could present the board on its cup
   const auto r =
       offline::plan_handover_goals(*cell, product(), 0, board_grasps(0), comfort(), settings);
   EXPECT_EQ(r.stage.goals, 0);
@@ -320,6 +321,28 @@ TEST(Handover, NoRobotRobotPoseFailsWithAReason) {
   EXPECT_NE(r.stage.failure.find("the left arm's gripper would hold it at"), std::string::npos)
       << r.stage.failure;
   EXPECT_EQ(r.stage.failure.find("out of both arms' reach"), std::string::npos) << r.stage.failure;
+
+  // With suction deliveries the right arm presents it on its cup: goals, each served by them
+  // alone, every stored IK holding the cup where its grasp meets the board at the goal (FK).
+  settings.suction_delivery = true;
+  const auto on_cup =
+      offline::plan_handover_goals(*cell, product(), 0, board_grasps(0), comfort(), settings);
+  ASSERT_GT(on_cup.stage.goals, 0) << on_cup.stage.failure;
+  EXPECT_TRUE(on_cup.shared.empty());
+  ASSERT_FALSE(on_cup.suction_deliveries.empty());
+  const core::Arm& right = cell->arm("right");
+  const core::Pose cup_in_tcp =
+      core::build_stage_scene(*cell, product().parts[0].mesh, {}, "right").cup_in_tcp;
+  for (const auto& d : on_cup.suction_deliveries) {
+    const auto& goal = on_cup.candidates[static_cast<std::size_t>(d.candidate_id)];
+    EXPECT_EQ(goal.status, "goal");
+    const core::Pose cup =
+        core::arm_base_in_world(*cell, right) * right.chain.fk(d.joints_rh) * cup_in_tcp;
+    const core::Pose want =
+        goal.board * board_grasps(0).suction[static_cast<std::size_t>(d.suction_grasp_id)].cup;
+    EXPECT_LT((cup.translation() - want.translation()).norm(), 1e-6);
+    EXPECT_TRUE(cup.linear().isApprox(want.linear(), 1e-6));
+  }
 }
 
 TEST(Handover, APartWithNoGoalAboveTheThresholdGetsTheMostComfortableBelowIt) {

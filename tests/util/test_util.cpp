@@ -1,5 +1,7 @@
 #include "util/test_util.hpp"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,7 +40,10 @@ Eigen::VectorXd arm_pointing_down_at(const core::Cell& cell, const core::Arm& ar
 }
 
 std::string temp_dir(const std::string& name) {
-  const auto dir = std::filesystem::path(HILA_TEST_TMP_DIR) / name;
+  // Per process: ctest -j runs a suite's tests as separate processes at once, and one removing
+  // the directory another is building in made the latter's suite set-up fail.
+  const auto dir =
+      std::filesystem::path(HILA_TEST_TMP_DIR) / (name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

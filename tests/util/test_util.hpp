@@ -24,7 +24,7 @@ std::shared_ptr<const core::Cell> reference_cell();
 Eigen::VectorXd arm_pointing_down_at(const core::Cell& cell, const core::Arm& arm,
                                      const Eigen::Vector3d& p);
 
-// A fresh, empty directory for this test (removed and recreated on every call).
+// A fresh, empty directory for this test in this process (removed and recreated on every call).
 std::string temp_dir(const std::string& name);
 // Writes `text` to `dir/name` and returns the path.
 std::string write_file(const std::string& dir, const std::string& name, const std::string& text);

@@ -93,6 +93,7 @@ struct RegraspIndex {
   std::map<RrGrasp, Stored> way_in;       // the receiving arm from home into the exchange grasp
   std::map<RrGrasp, Stored> exchange;     // suction cup -> receiving gripper
   std::map<RrGraspGoal, Stored> to_goal;  // the receiving arm's transfer to the goal
+  std::map<std::pair<Id, Id>, Stored> cup_to_goal;  // (cup, goal) -> the suction arm's transfer
 
   RegraspIndex(const std::vector<db::RegraspNodeRecord>& nodes,
                const std::vector<db::RegraspEdgeRecord>& edges) {
@@ -109,6 +110,9 @@ struct RegraspIndex {
         cup_transfer[to.robot_handover_id].add(e);
       } else if (e.kind == "handover") {
         exchange[{to.robot_handover_id, to.grasp_id}].add(e);
+      } else if (e.kind == "transfer" && to.kind == "human_handover" &&
+                 to.grasp_kind == "suction") {
+        cup_to_goal[{to.grasp_id, to.candidate_id}].add(e);
       } else if (e.kind == "transfer" && to.kind == "human_handover") {
         to_goal[{from.robot_handover_id, to.grasp_id, to.candidate_id}].add(e);
       }
@@ -131,13 +135,15 @@ struct Goal {
   std::vector<db::SharedGraspRecord> shared;
   std::vector<db::DirectGraspRecord> direct;
   std::vector<db::TableRegraspRecord> regrasps;
+  std::vector<db::SuctionDeliveryRecord> on_cup;
 };
 
 // One way to the human: a direct pick by `arm`, a regrasp on the table by `arm` (its gripper
-// picks, sets the part down elsewhere, takes it again), or an exchange from `suction_arm`'s cup
-// to `arm`'s gripper. The online planner tries them in that order within a goal.
+// picks, sets the part down elsewhere, takes it again), on `arm`'s suction cup (it picks and
+// presents the part with the tool), or an exchange from `suction_arm`'s cup to `arm`'s gripper.
+// The online planner tries them in that order within a goal.
 struct Way {
-  enum class Kind { kDirect, kRegrasp, kExchange };
+  enum class Kind { kDirect, kRegrasp, kSuction, kExchange };
   Kind kind = Kind::kDirect;
   std::string suction_arm;  // the exchange's
   std::string arm;          // the arm that delivers
@@ -149,7 +155,10 @@ struct Way {
   bool direct() const { return kind == Kind::kDirect; }
   bool exchange() const { return kind == Kind::kExchange; }
   const char* kind_name() const {
-    return kind == Kind::kDirect ? "direct" : kind == Kind::kRegrasp ? "regrasp" : "exchange";
+    return kind == Kind::kDirect    ? "direct"
+           : kind == Kind::kRegrasp ? "regrasp"
+           : kind == Kind::kSuction ? "suction"
+                                    : "exchange";
   }
   std::string name() const {
     switch (kind) {
@@ -157,6 +166,8 @@ struct Way {
         return "direct by " + arm;
       case Kind::kRegrasp:
         return "regrasp on table by " + arm;
+      case Kind::kSuction:
+        return "on the cup by " + arm;
       case Kind::kExchange:
         break;
     }
@@ -232,19 +243,32 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
   for (const auto& r : database.robot_handovers(part.id)) g.robot_handovers[r.id] = r;
   for (const auto& c : database.handover_goals(part.id)) {
     g.goals.push_back({c, database.shared_grasps(c.id), database.direct_grasps(c.id),
-                       database.table_regrasps(c.id)});
+                       database.table_regrasps(c.id), database.suction_deliveries(c.id)});
   }
 
   std::map<WayKey, Way> ways;
   std::map<std::string, std::set<Id>> picked;          // arm -> its direct grasps over every goal
   std::set<std::tuple<std::string, Id, Id>> received;  // (receiving arm, rr, grasp)
-  int goals_direct = 0, goals_regrasp = 0, goals_exchange = 0;
+  int goals_direct = 0, goals_regrasp = 0, goals_exchange = 0, goals_suction = 0;
   std::set<int> goals_connected;
   for (const auto& goal : g.goals) {
     const int rank = goal.candidate.rank;
     goals_direct += goal.direct.empty() ? 0 : 1;
     goals_regrasp += goal.regrasps.empty() ? 0 : 1;
     goals_exchange += goal.shared.empty() ? 0 : 1;
+    goals_suction += goal.on_cup.empty() ? 0 : 1;
+    for (const auto& d : goal.on_cup) {
+      Way& w = ways[{"cup", d.arm}];
+      w.kind = Way::Kind::kSuction;
+      w.arm = d.arm;
+      w.ranks.insert(rank);
+      w.suction_grasps.insert(d.suction_grasp_id);
+      if (connected(find(g.regrasp.pick_transit, d.suction_grasp_id)) &&
+          connected(find(g.regrasp.cup_to_goal, std::make_pair(d.suction_grasp_id,
+                                                                goal.candidate.id)))) {
+        w.connected.insert(rank);
+      }
+    }
     for (const auto& d : goal.direct) {
       Way& w = ways[{"", d.arm}];
       w.arm = d.arm;
@@ -280,7 +304,8 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
     }
   }
   // In the order the online planner tries them within a goal.
-  for (const auto kind : {Way::Kind::kDirect, Way::Kind::kRegrasp, Way::Kind::kExchange}) {
+  for (const auto kind :
+       {Way::Kind::kDirect, Way::Kind::kRegrasp, Way::Kind::kSuction, Way::Kind::kExchange}) {
     for (auto& [key, w] : ways) {
       if (w.kind == kind) g.ways.push_back(w);
     }
@@ -331,19 +356,22 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
     }
   }
   std::set<std::pair<std::string, Id>> cups;
-  for (const auto& [id, rr] : g.robot_handovers) {
-    if (!cups.insert({rr.arm, rr.suction_grasp_id}).second) continue;
-    const std::string cup = cup_node(rr.arm, rr.suction_grasp_id);
-    const Stored* transit = find(g.regrasp.pick_transit, rr.suction_grasp_id);
+  auto add_cup = [&](const std::string& arm, Id suction_grasp, const char* way) {
+    if (!cups.insert({arm, suction_grasp}).second) return;
+    const std::string cup = cup_node(arm, suction_grasp);
+    const Stored* transit = find(g.regrasp.pick_transit, suction_grasp);
     nodes.push_back({{"id", cup},
                      {"kind", "cup"},
-                     {"arm", rr.arm},
-                     {"label", "on the " + rr.arm + " suction cup, suction grasp " +
-                                   std::to_string(rr.suction_grasp_id)},
-                     {"suction_grasp", rr.suction_grasp_id}});
-    edges.push_back(edge_json("table", cup, "suction_pick", "exchange", rr.arm, "suction",
-                              {rr.suction_grasp_id}, transit ? "stored" : "not_stored", nullptr,
-                              transit));
+                     {"arm", arm},
+                     {"label", "on the " + arm + " suction cup, suction grasp " +
+                                   std::to_string(suction_grasp)},
+                     {"suction_grasp", suction_grasp}});
+    edges.push_back(edge_json("table", cup, "suction_pick", way, arm, "suction", {suction_grasp},
+                              transit ? "stored" : "not_stored", nullptr, transit));
+  };
+  for (const auto& [id, rr] : g.robot_handovers) add_cup(rr.arm, rr.suction_grasp_id, "exchange");
+  for (const auto& goal : g.goals) {
+    for (const auto& d : goal.on_cup) add_cup(d.arm, d.suction_grasp_id, "suction");
   }
   for (const auto& [id, rr] : g.robot_handovers) {
     const std::string node = "rr:" + std::to_string(id);
@@ -381,6 +409,29 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
     for (const auto& [arm, grasps] : direct) arms.insert(arm);
     for (const auto& r : goal.regrasps) arms.insert(r.arm);
     for (const auto& s : goal.shared) arms.insert(s.arm);
+    std::set<std::string> cup_arms;
+    for (const auto& d : goal.on_cup) cup_arms.insert(d.arm);
+    for (const auto& arm : cup_arms) {
+      nodes.push_back(
+          {{"id", goal_node(c.rank, arm) + ":cup"},
+           {"kind", "goal"},
+           {"arm", arm},
+           {"label", "at goal rank " + std::to_string(c.rank) + " on the " + arm + " suction cup"},
+           {"rank", c.rank},
+           {"candidate", c.id},
+           {"distance", round_to(c.distance, 1e-5)},
+           {"quality", round_to(c.quality, 1e-4)}});
+      edges.push_back(edge_json(goal_node(c.rank, arm) + ":cup", "human", "present", nullptr, arm,
+                                nullptr, nlohmann::json::array(), "none", nullptr, nullptr));
+    }
+    for (const auto& d : goal.on_cup) {
+      const Stored* transfer =
+          find(g.regrasp.cup_to_goal, std::make_pair(d.suction_grasp_id, c.id));
+      edges.push_back(edge_json(cup_node(d.arm, d.suction_grasp_id),
+                                goal_node(c.rank, d.arm) + ":cup", "transfer", "suction", d.arm,
+                                "suction", {d.suction_grasp_id}, transfer ? "stored" : "not_stored",
+                                transfer, nullptr));
+    }
     for (const auto& arm : arms) {
       nodes.push_back(
           {{"id", goal_node(c.rank, arm)},
@@ -430,8 +481,9 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
          {"suction_grasps", w.suction_grasps},
          {"robot_handovers", w.robot_handovers},
          {"set_downs", w.set_downs},
-         {"goals_connected_offline",
-          w.exchange() ? nlohmann::json(w.connected.size()) : nlohmann::json(nullptr)}});
+         {"goals_connected_offline", w.exchange() || w.kind == Way::Kind::kSuction
+                                         ? nlohmann::json(w.connected.size())
+                                         : nlohmann::json(nullptr)}});
   }
   g.json = {{"part", part.name},
             {"order", part.assembly_order},
@@ -445,6 +497,7 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
               {"goals_direct", goals_direct},
               {"goals_regrasp", goals_regrasp},
               {"goals_exchange", goals_exchange},
+              {"goals_suction", goals_suction},
               {"goals_connected_offline", goals_connected.size()},
               {"robot_handovers", g.robot_handovers.size()},
               {"ways", ways_json}}},
@@ -459,7 +512,8 @@ void print_text(const Graph& g, int shown_goals) {
   std::cout << "graph of " << j["part"].get<std::string>() << " (order " << j["order"]
             << "): " << count(g.goals.size(), "goal") << ", " << summary["goals_exchange"]
             << " by exchange, " << summary["goals_direct"] << " direct, "
-            << summary["goals_regrasp"] << " by a regrasp on the table; "
+            << summary["goals_regrasp"] << " by a regrasp on the table, "
+            << summary["goals_suction"] << " on the suction cup; "
             << count(g.robot_handovers.size(), "robot-robot pose") << "\n";
   if (!j["suction_tool_relay"].is_null()) {
     const auto& xyz = j["suction_tool_relay"]["xyz"];
@@ -475,6 +529,8 @@ void print_text(const Graph& g, int shown_goals) {
     std::string grasps = std::to_string(w.gripper_grasps.size()) + " gripper";
     if (w.kind == Way::Kind::kRegrasp) {
       grasps += " at " + count(w.set_downs.size(), "set-down");
+    } else if (w.kind == Way::Kind::kSuction) {
+      grasps = std::to_string(w.suction_grasps.size()) + " suction";
     } else if (w.exchange()) {
       grasps += ", " + std::to_string(w.suction_grasps.size()) + " suction at " +
                 count(w.robot_handovers.size(), "robot-robot pose");
@@ -483,7 +539,10 @@ void print_text(const Graph& g, int shown_goals) {
               << w.ranks.size() << std::setw(11) << *w.ranks.begin() << "  " << grasps << "\n";
   }
   for (const auto& w : g.ways) {
-    if (!w.exchange()) {
+    if (w.kind == Way::Kind::kSuction) {
+      std::cout << "  " << w.name() << ": " << count(w.connected.size(), "goal")
+                << " with a stored pick and transfer to the goal\n";
+    } else if (!w.exchange()) {
       std::cout << "  " << w.name()
                 << ": no stored path (the online planner plans it through the arm's roadmap)\n";
     } else if (!j["regrasp_stored"].get<bool>()) {
@@ -537,6 +596,16 @@ void print_text(const Graph& g, int shown_goals) {
       if (list.size() > 4) pairs += ", ...";
       std::cout << "    regrasp on table by " << arm << ": " << count(list.size(), "set-down")
                 << " (grasps picked -> taken again: " << pairs << "; planned online)\n";
+    }
+    std::map<std::string, std::set<Id>> on_cup;  // arm -> suction grasps
+    for (const auto& d : goal.on_cup) on_cup[d.arm].insert(d.suction_grasp_id);
+    for (const auto& [arm, cups] : on_cup) {
+      int stored = 0;
+      for (const Id cup : cups) {
+        stored += connected(find(g.regrasp.cup_to_goal, std::make_pair(cup, c.id))) ? 1 : 0;
+      }
+      std::cout << "    on the cup by " << arm << ": " << count(cups.size(), "suction grasp") << " "
+                << id_list(cups) << " (" << stored << " with a stored transfer)\n";
     }
     // Exchange ways, each by robot-robot pose: the suction arm's pick and transfer to it, the
     // receiving arm's way in, and its best stored transfer to the goal over the grasps there.

@@ -47,6 +47,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
                         {"mode", online::to_string(a.mode)},
                         {"arm", a.arm},
                         {"robot_grasp", a.robot_grasp_id},
+                        {"suction_grasp", a.suction_grasp_id},
                         {"robot_handover", a.robot_handover_id},
                         {"result", online::to_string(a.result)},
                         {"larger_bridges", a.larger_bridges},
@@ -94,7 +95,10 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
         {"way", online::to_string(plan.mode)},
         {"pick",
          {{"arm", plan.picking_arm},
-          {"by", plan.mode == online::DeliveryMode::kExchange ? "suction" : "gripper"}}},
+          {"by", plan.mode == online::DeliveryMode::kExchange ||
+                         plan.mode == online::DeliveryMode::kSuction
+                     ? "suction"
+                     : "gripper"}}},
         {"exchanges", exchanges},
         {"delivered_by", plan.delivering_arm},
         {"suction_tool", {{"arm", plan.suction_arm}, {"in_hand_after", plan.tool_in_hand_after}}}};

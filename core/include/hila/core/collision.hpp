@@ -99,7 +99,7 @@ bool in_collision_brute_force(const CollisionModel& model, CollisionData& data,
                               const std::vector<int>& bodies, CollisionPair* first = nullptr);
 // Smallest distance over the same pairs (negative or zero when in collision). Ask in_collision
 // first: between touching shapes FCL runs its penetration code (EPA), which asserts, and aborts
-// the process, on some mesh pairs.
+// the process, on some mesh pairs. A pair on which FCL throws (exact contact) counts as 0.
 double min_distance(const CollisionModel& model, CollisionData& data,
                     CollisionPair* closest = nullptr);
 

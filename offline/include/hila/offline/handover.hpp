@@ -71,6 +71,11 @@ struct HandoverSettings {
   // arm that picks the part sets it down where it lay on another resting pose and takes it again
   // with a grasp that holds it at the goal (up to direct_stored per goal and arm).
   TableRegraspSettings table_regrasp;
+  // Suction deliveries, for a comfortable candidate no exchange, direct grasp or regrasp serves:
+  // the suction arm presents the part on its cup (a suction grasp it picks the part with from
+  // where it lies, its IK at the candidate clear of the cell and of the human's hands; up to
+  // direct_stored per goal). The cup holds the weight at any tilt (suction_grasps.hpp).
+  bool suction_delivery = true;
   // A part with no goal in these roles is tried again with the arms' roles swapped (the
   // receiving arm takes the tool and picks by suction, the suction arm receives), and the swapped
   // roles are kept when they give goals and the new suction arm reaches the tool on its stand.
@@ -88,6 +93,7 @@ struct HandoverResult {
   std::vector<db::SharedGraspRecord> shared;            // for the goals, by rank
   std::vector<db::DirectGraspRecord> direct;            // for the goals, by rank
   std::vector<db::TableRegraspRecord> regrasps;         // for the goals, by rank
+  std::vector<db::SuctionDeliveryRecord> suction_deliveries;  // for the goals, by rank
   double seconds = 0.0;
 };
 

@@ -72,6 +72,10 @@ struct RegraspResult {
   int cut_before_exchange = 0;
   int transfers = 0;  // receiving-arm robot-robot -> robot-human transfers tried
   int transfers_connected = 0;
+  // Suction deliveries of the first goals: the suction arm's transfers, the board on the cup,
+  // from the lift to the robot-human pose, tried and connected.
+  int suction_transfers = 0;
+  int suction_transfers_connected = 0;
   int bridges = 0;           // edges connected by a bridge rather than the roadmap
   int alternatives = 0;      // of those, other bridges of a transfer (bridge_alternatives)
   int goals_considered = 0;  // goals examined (in Eq. 8 order)

@@ -71,14 +71,13 @@ struct PlanStep {
   ValidationReport validation;
 };
 
-// How the board reaches the human. kExchange: the suction arm picks it with the tool, hands it
-// to the other arm's gripper at a robot-robot pose, and that arm delivers it. kDirect: one arm's
-// gripper picks it where it lies and delivers it (no tool, no exchange).
-// kExchange: the suction arm picks the board with the tool and hands it to the other arm's
-// gripper. kDirect: one arm's gripper picks it where it lies. kRegrasp: one arm's gripper picks
-// it, sets it down on the table on another resting pose and takes it again with another grasp.
-// The delivering arm's gripper then takes it to the human.
-enum class DeliveryMode { kExchange, kDirect, kRegrasp };
+// How the board reaches the human. kExchange: the suction arm picks the board with the tool and
+// hands it to the other arm's gripper. kDirect: one arm's gripper picks it where it lies.
+// kRegrasp: one arm's gripper picks it, sets it down on the table on another resting pose and
+// takes it again with another grasp. The delivering arm's gripper then takes it to the human.
+// kSuction: the suction arm picks it with the tool and presents it on the cup; the human takes
+// it from the cup (where no gripper serves a comfortable goal).
+enum class DeliveryMode { kExchange, kDirect, kRegrasp, kSuction };
 const char* to_string(DeliveryMode mode);
 
 // A handover goal tried by one way, and why it was left.
@@ -92,7 +91,8 @@ struct GoalAttempt {
   std::int64_t candidate_id = 0;
   DeliveryMode mode = DeliveryMode::kExchange;
   std::string arm;  // the delivering arm
-  std::int64_t robot_grasp_id = 0;
+  std::int64_t robot_grasp_id = 0;     // 0 for the suction way
+  std::int64_t suction_grasp_id = 0;   // the suction way's cup (the database's), else 0
   std::int64_t robot_handover_id = 0;  // 0 for a direct pick
   AttemptResult result = AttemptResult::kFailed;
   bool larger_bridges = false;  // tried in the second round (MotionSettings escalated budgets)
@@ -138,7 +138,7 @@ struct BoardPlan {
   std::string picking_arm;
   std::string delivering_arm;
   std::int64_t robot_grasp_id = 0;
-  std::int64_t suction_grasp_id = 0;  // 0 for a direct pick
+  std::int64_t suction_grasp_id = 0;  // 0 for a pick by a gripper
   // kRegrasp only: the grasp the board is picked and set down with, and where it is set down
   // (world); robot_grasp_id is the grasp it is taken again and delivered with.
   std::int64_t pick_grasp_id = 0;

@@ -26,6 +26,7 @@ struct BoardRecords {
   std::map<std::int64_t, std::vector<db::SharedGraspRecord>> shared_grasps;    // by goal, id order
   std::map<std::int64_t, std::vector<db::DirectGraspRecord>> direct_grasps;    // by goal, id order
   std::map<std::int64_t, std::vector<db::TableRegraspRecord>> table_regrasps;  // by goal, id order
+  std::map<std::int64_t, std::vector<db::SuctionDeliveryRecord>> suction_deliveries;  // likewise
   std::map<std::int64_t, db::RobotGraspRecord> robot_grasps;
   std::map<std::int64_t, db::SuctionGraspRecord> suction_grasps;
   std::map<std::int64_t, db::HumanGraspRecord> human_grasps;
