@@ -171,18 +171,21 @@ struct DirectGraspRecord {
 
 // A regrasp on the table: the arm's gripper picks the part where it lies with one grasp, sets it
 // down at `placement` (another of its resting poses, or the same turned about the vertical), lets
-// go, takes it again with the delivering grasp and holds that at a goal's robot-human pose.
+// go, and `repick_arm`'s gripper takes it again with the delivering grasp and holds that at a
+// goal's robot-human pose. A relay (repick_arm the other arm, schema version 8): the part is set
+// down where both arms reach and the other arm delivers it.
 struct TableRegraspRecord {
   std::int64_t id = 0;
   std::int64_t candidate_id = 0;                  // a "goal" candidate
   std::int64_t pick_grasp_id = 0;                 // the grasp the part is picked and set down with
   std::int64_t robot_grasp_id = 0;                // the grasp it is taken again and delivered with
-  std::string arm;                                // the arm that does it all
+  std::string arm;                                // the arm that picks it and sets it down
+  std::string repick_arm;                         // the arm that takes it again and delivers it
   core::Pose placement = core::Pose::Identity();  // the part where it is set down (world)
   Eigen::VectorXd joints_pick;                    // pick_grasp at the part's initial pose, rad
   Eigen::VectorXd joints_place;                   // pick_grasp at the placement
-  Eigen::VectorXd joints_repick;                  // robot_grasp at the placement
-  Eigen::VectorXd joints_rh;                      // robot_grasp at the robot-human pose
+  Eigen::VectorXd joints_repick;                  // robot_grasp at the placement (repick_arm)
+  Eigen::VectorXd joints_rh;  // robot_grasp at the robot-human pose (repick_arm)
   double inclination_pick_deg = 0.0;  // opening axis vs gravity at each pose (<= theta_c)
   double inclination_place_deg = 0.0;
   double inclination_repick_deg = 0.0;
