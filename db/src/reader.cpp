@@ -674,7 +674,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
       });
   db.table_regrasps_ = load_rows<TableRegraspRecord>(
       *connection, "table_regrasps",
-      "candidate_id, pick_grasp_id, robot_grasp_id, arm, " + pose_columns("placement") +
+      "candidate_id, pick_grasp_id, robot_grasp_id, arm, repick_arm, " + pose_columns("placement") +
           ", joints_pick, joints_place, joints_repick, joints_rh, inclination_pick_deg, "
           "inclination_place_deg, inclination_repick_deg, inclination_rh_deg",
       fix, verify, [&](detail::Statement& s, std::int64_t id, TableRegraspRecord& r) {
@@ -683,6 +683,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.pick_grasp_id = s.next_int64();
         r.robot_grasp_id = s.next_int64();
         r.arm = s.next_text();
+        r.repick_arm = s.next_text();
         r.placement = read_pose(s, path, "table_regrasps", "placement", id, fix);
         r.joints_pick = read_joints(s, path, "table_regrasps", "joints_pick", id, fix);
         r.joints_place = read_joints(s, path, "table_regrasps", "joints_place", id, fix);

@@ -272,9 +272,9 @@ CREATE INDEX direct_grasps_candidate_id ON direct_grasps(candidate_id);
 )sql";
 
 // The table_regrasps table as schema version 6 defines it (with its index): regrasps on the table
-// by one arm's gripper (records::TableRegraspRecord). Created by schema_sql() and by the 5 -> 6
-// step from this text. The placement is a pose; the joints are joint vectors as in the version 3
-// tables.
+// by one arm's gripper (records::TableRegraspRecord). Created by the 5 -> 6 step from this text
+// (schema_sql() has the version 8 table, kCreateTableRegraspsV8). The placement is a pose; the
+// joints are joint vectors as in the version 3 tables.
 constexpr const char* kCreateTableRegraspsV6 = R"sql(
 CREATE TABLE table_regrasps (
   id INTEGER PRIMARY KEY,
@@ -297,6 +297,57 @@ CREATE TABLE table_regrasps (
 CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);
 )sql";
 
+// The table_regrasps table as schema version 8 defines it (with its index): version 6's with
+// repick_arm, the arm that takes the part again and delivers it (arm for a regrasp by one arm, the
+// other arm for a relay). Created by schema_sql() and by the 7 -> 8 step (kRebuildTableRegraspsV8)
+// from this text.
+constexpr const char* kCreateTableRegraspsV8 = R"sql(
+CREATE TABLE table_regrasps (
+  id INTEGER PRIMARY KEY,
+  candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id),
+  pick_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),
+  arm TEXT NOT NULL,
+  repick_arm TEXT NOT NULL,
+  placement_x REAL NOT NULL, placement_y REAL NOT NULL, placement_z REAL NOT NULL,
+  placement_qw REAL NOT NULL, placement_qx REAL NOT NULL, placement_qy REAL NOT NULL,
+  placement_qz REAL NOT NULL,
+  joints_pick BLOB NOT NULL,
+  joints_place BLOB NOT NULL,
+  joints_repick BLOB NOT NULL,
+  joints_rh BLOB NOT NULL,
+  inclination_pick_deg REAL NOT NULL,
+  inclination_place_deg REAL NOT NULL,
+  inclination_repick_deg REAL NOT NULL,
+  inclination_rh_deg REAL NOT NULL
+);
+CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);
+)sql";
+
+// The 7 -> 8 step's change to table_regrasps: the version 8 table in place of the version 7 one
+// (which is version 6's), every row kept, repick_arm its arm. Rebuilt rather than ALTER TABLE ...
+// ADD COLUMN, which can only append (the checks at open want the schema's column order) and would
+// need a DEFAULT. The old table is renamed out of the way first (its index dropped, so the name is
+// free), which leaves the new table's CREATE text exactly kCreateTableRegraspsV8's; nothing in a
+// version 7 file refers to table_regrasps, so the rename rewrites no other table.
+constexpr const char* kTableRegraspsCopiedColumns =
+    "placement_x, placement_y, placement_z, placement_qw, placement_qx, placement_qy, "
+    "placement_qz, joints_pick, joints_place, joints_repick, joints_rh, inclination_pick_deg, "
+    "inclination_place_deg, inclination_repick_deg, inclination_rh_deg";
+
+std::string rebuild_table_regrasps_v8() {
+  return std::string(
+             "DROP INDEX table_regrasps_candidate_id;\n"
+             "ALTER TABLE table_regrasps RENAME TO table_regrasps_v7;\n") +
+         kCreateTableRegraspsV8 +
+         "INSERT INTO table_regrasps (id, candidate_id, pick_grasp_id, robot_grasp_id, arm, "
+         "repick_arm, " +
+         kTableRegraspsCopiedColumns +
+         ")\n  SELECT id, candidate_id, pick_grasp_id, robot_grasp_id, arm, arm, " +
+         kTableRegraspsCopiedColumns + " FROM table_regrasps_v7 ORDER BY id;\n" +
+         "DROP TABLE table_regrasps_v7;\n";
+}
+
 // The suction_deliveries table as schema version 8 defines it (with its index): deliveries by the
 // arm holding the suction tool, the board on its cup (records::SuctionDeliveryRecord). Created by
 // schema_sql() and by the 7 -> 8 step from this text. joints_rh is a joint vector as in the
@@ -317,7 +368,7 @@ CREATE INDEX suction_deliveries_candidate_id ON suction_deliveries(candidate_id)
 // Written out in full (not generated) so this file is the readable reference of the schema (the
 // comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
 // kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones, the
-// direct_grasps table kCreateDirectGraspsV5, the table_regrasps table kCreateTableRegraspsV6, the
+// direct_grasps table kCreateDirectGraspsV5, the table_regrasps table kCreateTableRegraspsV8, the
 // suction_deliveries table kCreateSuctionDeliveriesV8).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
@@ -400,7 +451,7 @@ CREATE TABLE human_grasps (
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql" + std::string(kCreateComfortMapsV2) +
                                  create_tables_v3() + create_tables_v4() + kCreateDirectGraspsV5 +
-                                 kCreateTableRegraspsV6 + kCreateSuctionDeliveriesV8;
+                                 kCreateTableRegraspsV8 + kCreateSuctionDeliveriesV8;
   return sql;
 }
 
@@ -427,9 +478,10 @@ const std::vector<MigrationStep>& migration_steps() {
       // cannot hash, so the migration itself writes them after its last step, for the content the
       // file then holds; the step only drops any the file already had.
       {6, "DELETE FROM meta WHERE key GLOB 'digest.*';\n"},
-      // 7 -> 8: suction deliveries (a new table, empty in a migrated file until it is rebuilt; the
-      // old tables are unchanged). The migration rewrites every table's digest after its last step.
-      {7, kCreateSuctionDeliveriesV8},
+      // 7 -> 8: suction deliveries (a new table, empty in a migrated file until it is rebuilt) and
+      // table_regrasps.repick_arm (the table rebuilt with the column, each row's its arm: version 7
+      // had no relays). The migration rewrites every table's digest after its last step.
+      {7, kCreateSuctionDeliveriesV8 + rebuild_table_regrasps_v8()},
   };
   return steps;
 }

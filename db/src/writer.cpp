@@ -323,7 +323,7 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
     m.insert_regrasp.emplace(
         *m.connection,
         insert_sql("table_regrasps",
-                   "candidate_id, pick_grasp_id, robot_grasp_id, arm, " +
+                   "candidate_id, pick_grasp_id, robot_grasp_id, arm, repick_arm, " +
                        pose_columns("placement") +
                        ", joints_pick, joints_place, joints_repick, joints_rh, "
                        "inclination_pick_deg, inclination_place_deg, inclination_repick_deg, "
@@ -731,6 +731,10 @@ void DatabaseWriter::add_table_regrasps(const std::vector<TableRegraspRecord>& r
         refuse("add_table_regrasps", "table_regrasps.arm", record,
                "TableRegraspRecord::arm is empty, expected an arm name");
       }
+      if (g.repick_arm.empty()) {
+        refuse("add_table_regrasps", "table_regrasps.repick_arm", record,
+               "TableRegraspRecord::repick_arm is empty, expected an arm name");
+      }
       check.set_record(record);
       check.pose("placement", g.placement);
       check.joints("joints_pick", g.joints_pick);
@@ -752,6 +756,7 @@ void DatabaseWriter::add_table_regrasps(const std::vector<TableRegraspRecord>& r
       s.bind_next(g.pick_grasp_id);
       s.bind_next(g.robot_grasp_id);
       s.bind_next(g.arm);
+      s.bind_next(g.repick_arm);
       bind_pose(s, g.placement);
       bind_joints(s, g.joints_pick);
       bind_joints(s, g.joints_place);

@@ -84,7 +84,8 @@ class DatabaseWriter {
   // arm must be non-empty (schema version 5).
   void add_direct_grasps(const std::vector<DirectGraspRecord>& grasps);
   // candidate_id, pick_grasp_id and robot_grasp_id are taken from each record and must name
-  // written records; arm must be non-empty, the placement and joints finite (schema version 6).
+  // written records; arm and repick_arm must be non-empty, the placement and joints finite (schema
+  // version 6; repick_arm since 8).
   void add_table_regrasps(const std::vector<TableRegraspRecord>& regrasps);
   // candidate_id and suction_grasp_id are taken from each record and must name written records;
   // arm must be non-empty, joints_rh finite (schema version 8).
