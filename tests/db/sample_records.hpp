@@ -482,13 +482,13 @@ inline void add_direct_grasps(Sample& s, std::uint64_t seed) {
 
 // Table regrasps of part 1's three goals (part 2 has none), written with the candidates
 // interleaved (5, 2, 4, 2, 5), so that one candidate's regrasps are not consecutive ids: both arms,
-// a non-ASCII arm name, a regrasp that sets down and takes again with the same grasp, one without
-// stored place and repick solutions (empty
-// joints_place and joints_repick), -0.0 and a subnormal in joint blobs, a subnormal placement
-// coordinate, a placement turned exactly half about the vertical, inclinations of exactly 0 and
-// just below 90 degrees, and four inclinations that differ in every record (so that no column can
-// stand in for another). From an RNG of its own, so that every other record of the sample keeps
-// the values it had before the table.
+// a non-ASCII arm name, two relays (taken again by the other arm: records 1 and 4, one each way;
+// the others by the arm that set it down), a regrasp that sets down and takes again with the same
+// grasp, one without stored place and repick solutions (empty joints_place and joints_repick), -0.0
+// and a subnormal in joint blobs, a subnormal placement coordinate, a placement turned exactly half
+// about the vertical, inclinations of exactly 0 and just below 90 degrees, and four inclinations
+// that differ in every record (so that no column can stand in for another). From an RNG of its
+// own, so that every other record of the sample keeps the values it had before the table.
 inline void add_table_regrasps(Sample& s, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   SamplePart& p = s.parts[0];
@@ -507,6 +507,7 @@ inline void add_table_regrasps(Sample& s, std::uint64_t seed) {
     r.pick_grasp_id = 1 + (2 * k + 1) % grasps;
     r.robot_grasp_id = 1 + (3 * k) % grasps;
     r.arm = i == 3 ? "left ✋" : i % 2 == 0 ? "left" : "right";
+    r.repick_arm = r.arm;
     r.placement = test::random_pose(rng, 0.6);
     r.joints_pick = random_joints(rng, 6);
     if (i != 2) {
@@ -522,6 +523,8 @@ inline void add_table_regrasps(Sample& s, std::uint64_t seed) {
     p.table_regrasps.push_back(r);
   }
   p.table_regrasps[1].robot_grasp_id = p.table_regrasps[1].pick_grasp_id;  // the same grasp
+  p.table_regrasps[1].repick_arm = "left";  // relays: the other arm takes it again
+  p.table_regrasps[4].repick_arm = "right";
   p.table_regrasps[0].joints_place[3] = -0.0;
   p.table_regrasps[0].joints_repick[0] = std::numeric_limits<double>::denorm_min();
   p.table_regrasps[4].joints_rh[5] = -0.0;

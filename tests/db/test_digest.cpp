@@ -240,6 +240,16 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
   });
   add("table regrasp candidate", [](Sample& s) { s.parts[0].table_regrasps[2].candidate_id = 5; });
   add("table regrasp arm", [](Sample& s) { s.parts[0].table_regrasps[0].arm = "right"; });
+  // Schema version 8: the arm that takes it again.
+  add("table regrasp repick arm (a relay)",
+      [](Sample& s) { s.parts[0].table_regrasps[2].repick_arm = "right"; });
+  add("table regrasp relay undone", [](Sample& s) {
+    s.parts[0].table_regrasps[1].repick_arm = s.parts[0].table_regrasps[1].arm;
+  });
+  add("table regrasp arm and repick arm swapped", [](Sample& s) {
+    auto& r = s.parts[0].table_regrasps[4];
+    std::swap(r.arm, r.repick_arm);
+  });
   add("table regrasp placement position ulp", [](Sample& s) {
     double& x = s.parts[0].table_regrasps[3].placement.translation().x();
     x = std::nextafter(x, 10.0);

@@ -7,6 +7,7 @@
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
 #include "sample_records.hpp"
+#include "sqlite_handle.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila::db;
@@ -52,6 +53,22 @@ std::vector<MigrationStep> steps_from_v0() {
   std::vector<MigrationStep> steps = kSteps;
   steps.insert(steps.end(), migration_steps().begin(), migration_steps().end());
   return steps;
+}
+
+// The CREATE statements sqlite_master holds for table_regrasps and its index (and for any table
+// left over by a step), in name order: how the file itself declares the table.
+std::vector<std::string> table_regrasps_sql(const std::string& path) {
+  const ErrorContext context{"(sqlite_master)", "a readable schema", ""};
+  Connection connection(path, SQLITE_OPEN_READONLY, path);
+  std::vector<std::string> statements;
+  {
+    Statement select(
+        connection, "SELECT sql FROM sqlite_master WHERE name GLOB 'table_regrasps*' ORDER BY name",
+        context);
+    while (select.step()) statements.push_back(select.column_text(0));
+  }
+  connection.close();
+  return statements;
 }
 
 std::vector<std::string> files_in(const std::string& dir) {
@@ -479,11 +496,14 @@ std::string write_v6(const std::string& dir) {
 // version 3 records (and meta.human_bodies) of write_v3 when `with_handover_records`, with the
 // version 4 records of write_v4 when `with_roadmap_records` (which needs the version 3 ones), with
 // the version 5 record of write_v5 when `with_direct_grasp_records` (which needs the version 3
-// ones), and with the version 6 record of write_v6 when `with_table_regrasp_records` (likewise).
+// ones), and with the version 6 record of write_v6 when `with_table_regrasp_records` (likewise),
+// taken again by `table_regrasp_repick_arm` (the arm that set it down, as a migrated version 6 row
+// says, unless told otherwise).
 void write_reference_content(const std::string& path, bool with_comfort_map,
                              bool with_handover_records = false, bool with_roadmap_records = false,
                              bool with_direct_grasp_records = false,
-                             bool with_table_regrasp_records = false) {
+                             bool with_table_regrasp_records = false,
+                             const std::string& table_regrasp_repick_arm = "left") {
   Meta meta;
   meta.hila_version = "0.1.0";
   meta.product_name = "cabinet";
@@ -633,6 +653,7 @@ void write_reference_content(const std::string& path, bool with_comfort_map,
     regrasp.pick_grasp_id = 1;
     regrasp.robot_grasp_id = 1;
     regrasp.arm = "left";
+    regrasp.repick_arm = table_regrasp_repick_arm;
     regrasp.placement.translation() = Eigen::Vector3d(0.5, -0.25, 0.75);
     regrasp.joints_pick = Eigen::VectorXd::Constant(1, 0.5);
     regrasp.joints_repick = Eigen::VectorXd::Constant(1, -2.0);
@@ -1044,12 +1065,14 @@ TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   write_reference_content(without, true, true, true, false);
   EXPECT_NE(content_digest(path), content_digest(without));
 
-  // The migrated file takes table regrasps like a fresh one (the table and its foreign keys are
-  // there): a row by SQL, read back, then one whose pick grasp does not exist.
-  execute_script(path,
-                 "INSERT INTO table_regrasps VALUES (1, 1, 1, 1, 'left', 0.5, -0.25, 0.75, "
-                 "0.0, 0.0, 0.0, 1.0, x'000000000000e03f', x'', x'00000000000000c0', "
-                 "x'000000000000e03f000000000000f03f', 10.5, 20.5, 30.5, 40.5);");
+  // The migrated file takes table regrasps like a fresh one (the version 8 table, repick_arm
+  // included, and its foreign keys are there): a relay row by SQL, read back, then one whose pick
+  // grasp does not exist.
+  execute_script(
+      path,
+      "INSERT INTO table_regrasps VALUES (1, 1, 1, 1, 'left', 'right', 0.5, -0.25, 0.75, "
+      "0.0, 0.0, 0.0, 1.0, x'000000000000e03f', x'', x'00000000000000c0', "
+      "x'000000000000e03f000000000000f03f', 10.5, 20.5, 30.5, 40.5);");
   reseal(path);
   const auto regrasps = open_migrated(path).table_regrasps(1);
   ASSERT_EQ(regrasps.size(), 1u);
@@ -1057,6 +1080,7 @@ TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(regrasps[0].pick_grasp_id, 1);
   EXPECT_EQ(regrasps[0].robot_grasp_id, 1);
   EXPECT_EQ(regrasps[0].arm, "left");
+  EXPECT_EQ(regrasps[0].repick_arm, "right");
   EXPECT_EQ(regrasps[0].placement.translation(), Eigen::Vector3d(0.5, -0.25, 0.75));
   EXPECT_EQ(regrasps[0].placement.linear(),
             Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal().toDenseMatrix())
@@ -1075,9 +1099,10 @@ TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(open_migrated(path).direct_grasps(1).size(), 1u) << "a table of its own";
   expect_input_error(
       [&] {
-        execute_script(path,
-                       "INSERT INTO table_regrasps VALUES (2, 1, 2, 1, 'left', 0.0, 0.0, 0.0, "
-                       "1.0, 0.0, 0.0, 0.0, x'', x'', x'', x'', 0.0, 0.0, 0.0, 0.0);");
+        execute_script(
+            path,
+            "INSERT INTO table_regrasps VALUES (2, 1, 2, 1, 'left', 'left', 0.0, 0.0, 0.0, "
+            "1.0, 0.0, 0.0, 0.0, x'', x'', x'', x'', 0.0, 0.0, 0.0, 0.0);");
       },
       {"FOREIGN KEY constraint failed"});
 
@@ -1135,6 +1160,7 @@ TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(regrasps[0].pick_grasp_id, 1);
   EXPECT_EQ(regrasps[0].robot_grasp_id, 1);
   EXPECT_EQ(regrasps[0].arm, "left");
+  EXPECT_EQ(regrasps[0].repick_arm, "left") << "the 7 -> 8 step fills repick_arm with arm";
   EXPECT_EQ(regrasps[0].placement.translation(), Eigen::Vector3d(0.5, -0.25, 0.75));
   EXPECT_EQ(regrasps[0].placement.linear(), Eigen::Matrix3d::Identity());
   EXPECT_EQ(regrasps[0].joints_pick, Eigen::VectorXd::Constant(1, 0.5));
@@ -1158,6 +1184,13 @@ TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
   const std::string without = dir + "/without.db";
   write_reference_content(without, true, true, true, true, false);
   EXPECT_NE(content_digest(path), content_digest(without));
+  // As a relay it differs too: the comparison sees repick_arm.
+  const std::string relay = dir + "/relay.db";
+  write_reference_content(relay, true, true, true, true, true, "right");
+  EXPECT_NE(content_digest(path), content_digest(relay));
+  // The table (and its index) declared as a fresh file declares them, nothing left over.
+  EXPECT_EQ(table_regrasps_sql(path), table_regrasps_sql(fresh));
+  EXPECT_EQ(table_regrasps_sql(path).size(), 2u);
 
   // The migrated file takes suction deliveries like a fresh one (the table and its foreign keys
   // are there): a row by SQL, read back, then one whose suction grasp does not exist.
@@ -1189,20 +1222,29 @@ TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
 }
 
 TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
-  // A version 7 file as this hila's writer would have made it: no suction_deliveries table, and a
-  // stored digest for every other table. The step adds the table, the migration the digests of
-  // all of them, the new one included.
+  // A version 7 file as this hila's writer would have made it: no suction_deliveries table, no
+  // table_regrasps.repick_arm, and a stored digest for every table. The step adds the table and
+  // the column (each row's its arm), the migration the digests of all of them, the new one
+  // included.
   const std::string dir = temp_dir("db_migration_v7");
   Sample sample = make_sample();
   sample.parts[0].suction_deliveries.clear();  // a version 7 file cannot hold any
-  const std::string written = dir + "/written.db";
-  write_sample(written, sample);
   const std::string path = dir + "/v7.db";
-  write_sample(path, sample);
+  write_sample(path, sample);  // the sample's relays lose their repick arm with the column
   execute_script(path,
                  "DROP TABLE suction_deliveries;"
                  "DELETE FROM meta WHERE key = 'digest.suction_deliveries';"
+                 "ALTER TABLE table_regrasps DROP COLUMN repick_arm;"
                  "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  // What this hila writes for the same records: every regrasp taken again by its own arm.
+  std::size_t relays = 0;
+  for (auto& r : sample.parts[0].table_regrasps) {
+    relays += r.repick_arm != r.arm ? 1 : 0;
+    r.repick_arm = r.arm;
+  }
+  ASSERT_GT(relays, 0u) << "the sample has relays, so the migration must not keep what it had";
+  const std::string written = dir + "/written.db";
+  write_sample(written, sample);
   expect_input_error([&] { Database::open(path); },
                      {path + ": meta.schema_version", "written by schema version 7 (an older hila)",
                       "(or migrate it in place with hila::db::migrate_in_place)"});
@@ -1217,10 +1259,24 @@ TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
     EXPECT_TRUE(db.suction_deliveries(c.id).empty()) << c.id;
   }
   std::size_t regrasps = 0;
-  for (const auto& c : db.handover_candidates(1)) regrasps += db.table_regrasps(c.id).size();
+  for (const auto& c : db.handover_candidates(1)) {
+    for (const auto& r : db.table_regrasps(c.id)) {
+      SCOPED_TRACE(r.id);
+      ++regrasps;
+      EXPECT_FALSE(r.arm.empty());
+      EXPECT_EQ(r.repick_arm, r.arm) << "the step fills repick_arm with the row's arm";
+      const auto& want = sample.parts[0].table_regrasps.at(static_cast<std::size_t>(r.id - 1));
+      EXPECT_EQ(r.arm, want.arm) << "the rest of the row is kept";
+      EXPECT_EQ(r.candidate_id, want.candidate_id);
+      EXPECT_EQ(r.inclination_rh_deg, want.inclination_rh_deg);
+    }
+  }
   EXPECT_EQ(regrasps, sample.parts[0].table_regrasps.size()) << "the version 6 rows are kept";
   EXPECT_EQ(content_digest(path), content_digest(written));
   EXPECT_NE(content_digest(path), digest_v7);
+  // The table and its index declared as a fresh file declares them, nothing left over.
+  EXPECT_EQ(table_regrasps_sql(path), table_regrasps_sql(written));
+  EXPECT_EQ(table_regrasps_sql(path).size(), 2u);
   EXPECT_EQ(files_in(dir), (std::vector<std::string>{"v7.db", "written.db"}));
 }
 

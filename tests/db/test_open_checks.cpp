@@ -136,8 +136,10 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
 
 // SQL that drops the tables schema versions 8, 6 and 5 added and the ones version 4 added
 // (regrasp_edges first: it refers to the others); suction_deliveries, table_regrasps and
-// direct_grasps go before handover_candidates, which they refer to.
+// direct_grasps go before handover_candidates, which they refer to. Version 8 also added
+// table_regrasps.repick_arm (kDropVersion8Columns, for a file that keeps the table).
 const char* const kDropVersion8Tables = "DROP TABLE suction_deliveries;";
+const char* const kDropVersion8Columns = "ALTER TABLE table_regrasps DROP COLUMN repick_arm;";
 const char* const kDropVersion6Tables = "DROP TABLE table_regrasps;";
 const char* const kDropVersion5Tables = "DROP TABLE direct_grasps;";
 const char* const kDropVersion4Tables =
@@ -240,7 +242,7 @@ TEST(OpenChecks, Version5OffersMigration) {
 TEST(OpenChecks, Version7OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v7"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, std::string(kDropVersion8Tables) +
+  detail::execute_script(path, std::string(kDropVersion8Tables) + kDropVersion8Columns +
                                    "DELETE FROM meta WHERE key = 'digest.suction_deliveries';"
                                    "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
   expect_input_error(
@@ -250,11 +252,23 @@ TEST(OpenChecks, Version7OffersMigration) {
        "got one written by schema version 7 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
-  // The digest still reads it (a version 7 file has no suction_deliveries table to hash), and
-  // differs.
+  // The digest still reads it (a version 7 file has no suction_deliveries table to hash, and no
+  // table_regrasps.repick_arm), and differs.
   const std::string digest_v7 = content_digest(path);
   EXPECT_EQ(digest_v7.size(), 64u);
   EXPECT_NE(digest_v7, digest_current);
+  // Migrated, it opens with every check (its digests rewritten), each regrasp taken again by the
+  // arm that set it down.
+  migrate_in_place(path);
+  const Database db = Database::open(path);
+  std::size_t regrasps = 0;
+  for (const auto& c : db.handover_candidates(1)) {
+    for (const auto& r : db.table_regrasps(c.id)) {
+      ++regrasps;
+      EXPECT_EQ(r.repick_arm, r.arm) << r.id;
+    }
+  }
+  EXPECT_EQ(regrasps, 5u);
 }
 
 TEST(OpenChecks, NewerSchemaVersion) {

@@ -311,6 +311,18 @@ TEST(OpenVerification, RegraspEdgeDeleted) {
                       rebuild(path)});
 }
 
+TEST(OpenVerification, RelayUndoneByHand) {
+  // A relay turned into a regrasp by one arm (repick_arm set to arm): a valid row every other
+  // check accepts; only table_regrasps' digest sees it.
+  const std::string path = write_small(temp_dir("db_verify_relay"));
+  ASSERT_EQ(query_int(path, "SELECT count(*) FROM table_regrasps WHERE repick_arm <> arm"), 2);
+  edit(path, "UPDATE table_regrasps SET repick_arm = arm WHERE id = 2");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": table_regrasps: expected the content digest stored when it was "
+                             "written (meta.digest.table_regrasps = ",
+                      rebuild(path)});
+}
+
 TEST(OpenVerification, RoadmapEdgeDeleted) {
   // The last of the left arm's 13 roadmap edges cut from its arrays (8 bytes each), the count
   // lowered to match, and that edge's bit (bit 4 of byte 1) cleared in every filter of the
@@ -584,16 +596,19 @@ TEST(OpenVerification, DigestsAreDeterministicAndOutsideTheContentDigest) {
 // migrated, it holds the digests the writer gives the same content, and opens.
 TEST(OpenVerification, Version6FileIsMigratedWithItsDigests) {
   const std::string dir = temp_dir("db_verify_v6");
-  const std::string written = dir + "/written.db";
   Sample sample = make_sample();
   sample.parts[0].suction_deliveries.clear();  // a version 6 file cannot hold any
-  write_sample(written, sample);
   const std::string path = dir + "/v6.db";
-  fs::copy_file(written, path);
+  write_sample(path, sample);  // its relays lose their repick arm with the column
   edit(path,
        "DROP TABLE suction_deliveries;"
+       "ALTER TABLE table_regrasps DROP COLUMN repick_arm;"
        "DELETE FROM meta WHERE key GLOB 'digest.*';"
        "UPDATE meta SET value = '6' WHERE key = 'schema_version'");
+  // This hila's writer for the same records: a version 6 regrasp is taken again by its own arm.
+  for (auto& r : sample.parts[0].table_regrasps) r.repick_arm = r.arm;
+  const std::string written = dir + "/written.db";
+  write_sample(written, sample);
   expect_input_error([&] { Database::open(path); },
                      {path +
                       ": meta.schema_version: expected a database this hila reads (schema "

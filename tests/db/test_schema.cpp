@@ -90,33 +90,64 @@ TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
     EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
   }
   EXPECT_EQ(migration_steps()[3].sql.find("INSERT"), std::string::npos);
-  // 5 -> 6: the table_regrasps table and its index, as a fresh database has them, and nothing
-  // else.
+  // 5 -> 6: the table_regrasps table and its index as version 6 declared them (the table a fresh
+  // database has but for version 8's repick_arm), and nothing else.
   const auto created_v6 = create_statements(migration_steps()[4].sql);
   ASSERT_EQ(created_v6.size(), 2u) << "1 table, 1 index";
   EXPECT_EQ(created_v6[0].rfind("CREATE TABLE table_regrasps (", 0), 0u) << created_v6[0];
+  EXPECT_EQ(created_v6[0].find("repick_arm"), std::string::npos) << created_v6[0];
+  EXPECT_EQ(schema_sql().find(created_v6[0]), std::string::npos) << "version 8 changed the table";
+  {
+    std::string with_repick_arm = created_v6[0];
+    const std::string arm = "  arm TEXT NOT NULL,\n";
+    ASSERT_NE(with_repick_arm.find(arm), std::string::npos);
+    with_repick_arm.insert(with_repick_arm.find(arm) + arm.size(), "  repick_arm TEXT NOT NULL,\n");
+    EXPECT_NE(schema_sql().find(with_repick_arm), std::string::npos) << with_repick_arm;
+  }
   EXPECT_EQ(created_v6[1],
             "CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);");
-  for (const auto& statement : created_v6) {
-    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
-  }
+  EXPECT_NE(schema_sql().find(created_v6[1]), std::string::npos);
   EXPECT_EQ(migration_steps()[4].sql.find("INSERT"), std::string::npos);
   // 6 -> 7: no table changes; the migration writes the per-table digests after its last step, the
   // step only drops digests a file may already have.
   EXPECT_TRUE(create_statements(migration_steps()[5].sql).empty());
   EXPECT_EQ(migration_steps()[5].sql, "DELETE FROM meta WHERE key GLOB 'digest.*';\n");
   EXPECT_EQ(kTableDigestsSince, 7);
-  // 7 -> 8: the suction_deliveries table and its index, as a fresh database has them, and nothing
-  // else.
-  const auto created_v8 = create_statements(migration_steps()[6].sql);
-  ASSERT_EQ(created_v8.size(), 2u) << "1 table, 1 index";
+  // 7 -> 8: the suction_deliveries table and its index, and table_regrasps rebuilt with repick_arm
+  // (and its index again), as a fresh database has them, and nothing else.
+  const std::string& step_v8 = migration_steps()[6].sql;
+  const auto created_v8 = create_statements(step_v8);
+  ASSERT_EQ(created_v8.size(), 4u) << "2 tables, 2 indexes";
   EXPECT_EQ(created_v8[0].rfind("CREATE TABLE suction_deliveries (", 0), 0u) << created_v8[0];
   EXPECT_EQ(created_v8[1],
             "CREATE INDEX suction_deliveries_candidate_id ON suction_deliveries(candidate_id);");
+  EXPECT_EQ(created_v8[2].rfind("CREATE TABLE table_regrasps (", 0), 0u) << created_v8[2];
+  EXPECT_NE(created_v8[2].find("  repick_arm TEXT NOT NULL,\n"), std::string::npos);
+  EXPECT_EQ(created_v8[3],
+            "CREATE INDEX table_regrasps_candidate_id ON table_regrasps(candidate_id);");
   for (const auto& statement : created_v8) {
     EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
   }
-  EXPECT_EQ(migration_steps()[6].sql.find("INSERT"), std::string::npos);
+  // The old table's rows go over with repick_arm = arm, then the old table goes.
+  const std::size_t moved = step_v8.find("ALTER TABLE table_regrasps RENAME TO table_regrasps_v7;");
+  const std::size_t copied = step_v8.find("INSERT INTO table_regrasps (");
+  const std::size_t dropped = step_v8.find("DROP TABLE table_regrasps_v7;");
+  ASSERT_NE(moved, std::string::npos) << step_v8;
+  ASSERT_NE(copied, std::string::npos) << step_v8;
+  ASSERT_NE(dropped, std::string::npos) << step_v8;
+  EXPECT_LT(step_v8.find("DROP INDEX table_regrasps_candidate_id;"), moved);
+  EXPECT_LT(moved, step_v8.find("CREATE TABLE table_regrasps ("));
+  EXPECT_LT(step_v8.find("CREATE TABLE table_regrasps ("), copied);
+  EXPECT_LT(copied, dropped);
+  EXPECT_NE(step_v8.find("robot_grasp_id, arm, repick_arm, placement_x,", copied),
+            std::string::npos);
+  EXPECT_NE(step_v8.find("SELECT id, candidate_id, pick_grasp_id, robot_grasp_id, arm, arm, "
+                         "placement_x,",
+                         copied),
+            std::string::npos)
+      << step_v8;
+  EXPECT_EQ(step_v8.find("INSERT", copied + 1), std::string::npos) << "one INSERT";
+  EXPECT_EQ(step_v8.find("INSERT"), copied);
   EXPECT_EQ(migration_steps()[6].sql.find("digest"), std::string::npos)
       << "the migration, not the step, writes the digests";
 }
@@ -327,6 +358,7 @@ TEST(Schema, TableRegraspColumnsAreDeclared) {
             "  pick_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),\n"
             "  robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id),\n"
             "  arm TEXT NOT NULL,\n"
+            "  repick_arm TEXT NOT NULL,\n"
             "  placement_x REAL NOT NULL, placement_y REAL NOT NULL, placement_z REAL NOT NULL,\n"
             "  placement_qw REAL NOT NULL, placement_qx REAL NOT NULL, placement_qy REAL NOT "
             "NULL,\n"
@@ -340,6 +372,17 @@ TEST(Schema, TableRegraspColumnsAreDeclared) {
             "  inclination_repick_deg REAL NOT NULL,\n"
             "  inclination_rh_deg REAL NOT NULL\n"
             ");");
+  // And the column specs the checks at open use say the same: repick_arm right after arm, as the
+  // writer and reader name them.
+  const auto& columns = schema_columns("table_regrasps");
+  ASSERT_EQ(columns.size(), 21u);
+  EXPECT_EQ(columns[4].name, "arm");
+  EXPECT_EQ(columns[4].storage_class, SQLITE_TEXT);
+  EXPECT_EQ(columns[5].name, "repick_arm");
+  EXPECT_EQ(columns[5].storage_class, SQLITE_TEXT);
+  EXPECT_FALSE(columns[5].nullable);
+  EXPECT_EQ(columns[6].name, "placement_x");
+  EXPECT_EQ(columns[20].name, "inclination_rh_deg");
 }
 
 TEST(Schema, SuctionDeliveryColumnsAreDeclared) {

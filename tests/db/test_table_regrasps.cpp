@@ -1,4 +1,5 @@
-// The schema version 6 table table_regrasps through DatabaseWriter and Database.
+// The schema version 6 table table_regrasps (with repick_arm since version 8) through
+// DatabaseWriter and Database.
 
 #include <gtest/gtest.h>
 
@@ -38,6 +39,7 @@ void expect_same(const TableRegraspRecord& got, const TableRegraspRecord& want) 
   EXPECT_EQ(got.pick_grasp_id, want.pick_grasp_id);
   EXPECT_EQ(got.robot_grasp_id, want.robot_grasp_id);
   EXPECT_EQ(got.arm, want.arm);
+  EXPECT_EQ(got.repick_arm, want.repick_arm);
   EXPECT_EQ(got.placement.translation(), want.placement.translation());
   EXPECT_LT(pose_error(got.placement, want.placement), 1e-12);
   {
@@ -134,11 +136,16 @@ TEST(TableRegrasps, EveryFieldRoundTripsPerCandidateInIdOrder) {
   EXPECT_EQ(five[1].inclination_repick_deg, 89.999999999999986);
   EXPECT_EQ(five[1].inclination_place_deg, 17.5 * 4 + 1e-13 + 1.5);
   EXPECT_EQ(five[1].inclination_rh_deg, 17.5 * 4 + 1e-13 + 4.0);
+  EXPECT_EQ(five[0].arm, "left");
+  EXPECT_EQ(five[0].repick_arm, "left") << "set down and taken again by the same arm";
+  EXPECT_EQ(five[1].arm, "left");
+  EXPECT_EQ(five[1].repick_arm, "right") << "a relay: the other arm takes it again";
   const auto two = db.table_regrasps(2);
   ASSERT_EQ(two.size(), 2u);
   EXPECT_EQ(two[0].pick_grasp_id, 4);
   EXPECT_EQ(two[0].robot_grasp_id, 4) << "set down and taken again with the same grasp";
   EXPECT_EQ(two[0].arm, "right");
+  EXPECT_EQ(two[0].repick_arm, "left") << "a relay the other way";
   EXPECT_EQ(two[0].placement.translation(), Eigen::Vector3d(0.5, -0.25, 0.0625));
   EXPECT_EQ(two[0].placement.linear(),
             Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal().toDenseMatrix())
@@ -146,8 +153,10 @@ TEST(TableRegrasps, EveryFieldRoundTripsPerCandidateInIdOrder) {
   EXPECT_EQ(two[1].pick_grasp_id, 3);
   EXPECT_EQ(two[1].robot_grasp_id, 5);
   EXPECT_EQ(two[1].arm, "left ✋");
+  EXPECT_EQ(two[1].repick_arm, "left ✋");
   const auto four = db.table_regrasps(4);
   ASSERT_EQ(four.size(), 1u);
+  EXPECT_EQ(four[0].repick_arm, "left");
   EXPECT_EQ(four[0].joints_place.size(), 0) << "an empty vector stays empty";
   EXPECT_EQ(four[0].joints_repick.size(), 0);
   EXPECT_EQ(four[0].joints_pick.size(), 6);
@@ -170,6 +179,7 @@ TEST(TableRegrasps, IdsContinueAcrossCallsWhateverTheRecordsSay) {
     r.pick_grasp_id = 3;
     r.robot_grasp_id = 2;
     r.arm = "left";
+    r.repick_arm = "right";
     f.writer->add_table_regrasps({r, r});
     f.writer->add_table_regrasps({});
     r.candidate_id = 2;
@@ -185,6 +195,8 @@ TEST(TableRegrasps, IdsContinueAcrossCallsWhateverTheRecordsSay) {
   EXPECT_EQ(four[1].id, 2);
   EXPECT_EQ(four[1].pick_grasp_id, 3);
   EXPECT_EQ(four[1].robot_grasp_id, 2);
+  EXPECT_EQ(four[1].arm, "left");
+  EXPECT_EQ(four[1].repick_arm, "right");
   const auto two = db.table_regrasps(2);
   ASSERT_EQ(two.size(), 1u);
   EXPECT_EQ(two[0].id, 3);
@@ -223,6 +235,18 @@ TEST(TableRegrasps, MistakesAreInvalidArgumentsNamingTableColumnAndRecord) {
   refused("empty arm", [](auto& r) { r[2].arm.clear(); },
           {"DatabaseWriter::add_table_regrasps: table_regrasps.arm (record 2 of 5, candidate id "
            "4): TableRegraspRecord::arm is empty, expected an arm name"});
+  refused("empty repick arm", [](auto& r) { r[3].repick_arm.clear(); },
+          {"DatabaseWriter::add_table_regrasps: table_regrasps.repick_arm (record 3 of 5, "
+           "candidate id 2): TableRegraspRecord::repick_arm is empty, expected an arm name"});
+  // Refused before anything is written: an earlier record that would fail its foreign key on
+  // insertion is not reached.
+  refused("empty repick arm after an unknown candidate",
+          [](auto& r) {
+            r[0].candidate_id = 99;
+            r[4].repick_arm.clear();
+          },
+          {"table_regrasps.repick_arm (record 4 of 5, candidate id 5): TableRegraspRecord::"
+           "repick_arm is empty"});
   refused("NaN pick inclination", [&](auto& r) { r[4].inclination_pick_deg = nan; },
           {"DatabaseWriter::add_table_regrasps: table_regrasps.inclination_pick_deg (record 4 of "
            "5, candidate id 5) must be finite, got nan"});
@@ -333,6 +357,12 @@ TEST(TableRegrasps, DamagedRowsAreDatabaseErrors) {
   expect_input_error([&] { Database::open(path); },
                      {"table_regrasps.joints_repick (id 5)", "got a value that is not finite"});
   std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
+  // A repick arm that is not text.
+  detail::execute_script(path, "UPDATE table_regrasps SET repick_arm = x'6c656674' WHERE id = 4");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": table_regrasps.repick_arm (id 4): expected a TEXT (the column is "
+                             "TEXT NOT NULL), got a BLOB of 4 bytes"});
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
   // A placement that is not a rotation.
   detail::execute_script(path, "UPDATE table_regrasps SET placement_qw = 2.0 WHERE id = 3");
   expect_input_error([&] { Database::open(path); },
@@ -347,6 +377,17 @@ TEST(TableRegrasps, ACurrentFileWithoutTheTableIsRefused) {
   expect_input_error(
       [&] { Database::open(path); },
       {path + ": table_regrasps: expected a readable hila table", "no such table: table_regrasps"});
+}
+
+TEST(TableRegrasps, ACurrentFileWithoutRepickArmIsRefused) {
+  // A version 8 file whose table lacks the column (a version 7 table with the version number of
+  // 8, or damaged by hand) cannot open; a version 7 file is migrated instead (test_migration).
+  const std::string path = temp_dir("db_table_regrasps_no_repick_arm") + "/p.db";
+  write_sample(path, make_sample());
+  detail::execute_script(path, "ALTER TABLE table_regrasps DROP COLUMN repick_arm");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": table_regrasps: expected a readable hila table",
+                      "no such column: repick_arm", "rebuild with: hila build"});
 }
 
 TEST(TableRegrasps, EmptyTableOpens) {
