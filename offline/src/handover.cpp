@@ -502,6 +502,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     std::optional<std::vector<SetDown>> set_downs;
   };
   std::vector<DirectArm> direct_arms;
+  // Arms whose gripper picks nothing where the part lies: they may still take it where the other
+  // arm sets it down (a relay).
+  std::vector<DirectArm> relay_only_arms;
   std::string direct_checks;  // per arm that picks nothing: how far its grasps got
   for (const core::Arm* a : direct_candidates) {
     if (!a->ur_ik) continue;
@@ -557,6 +560,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     if (!direct_checks.empty()) direct_checks += "; ";
     direct_checks += "the " + a->spec.name + " arm: " + (counts.empty() ? "no grasp" : counts);
+    relay_only_arms.push_back(std::move(d));
   }
   // Regrasps on the table. Arm d's set-downs, found once when a goal first needs them: the poses
   // where one of its pick grasps sets the part down (plan_gripper_pick's way in and lift, run
@@ -565,34 +569,54 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       settings.direct ? table_set_down_poses(cell, part.mesh, grasps.com, part.initial,
                                              grasps.placements, settings.table_regrasp)
                       : std::vector<core::Pose>{};
-  auto set_downs_of = [&](DirectArm& d) -> const std::vector<DirectArm::SetDown>& {
-    if (d.set_downs) return *d.set_downs;
-    d.set_downs.emplace();
-    auto taken = [&](const core::Pose& board, int g, Receiving& out) {
-      const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
-      const double slip = slip_at(board, g);
-      if (slip > grasp.theta_c_deg) return false;
-      const GripperPick p = plan_gripper_pick(*d.workspace, board, grasp, d.pick_settings);
-      if (!p.ok()) return false;
-      out = {g, p.grasp, slip};
-      return true;
-    };
-    for (const core::Pose& board : set_down_poses) {
+  // Arm `by`'s gripper takes the part standing at `board` with grasp g (its way in and lift).
+  auto taken_by = [&](DirectArm& by, const core::Pose& board, int g, Receiving& out) {
+    const auto& grasp = grasps.robot[static_cast<std::size_t>(g)];
+    const double slip = slip_at(board, g);
+    if (slip > grasp.theta_c_deg) return false;
+    const GripperPick p = plan_gripper_pick(*by.workspace, board, grasp, by.pick_settings);
+    if (!p.ok()) return false;
+    out = {g, p.grasp, slip};
+    return true;
+  };
+  // The set-downs at `poses` where d sets the part down with one of its pick grasps and `again`
+  // takes it with other grasps (d itself: another grasp than the one it let go of).
+  auto find_set_downs = [&](DirectArm& d, DirectArm& again, const std::vector<core::Pose>& poses) {
+    std::vector<DirectArm::SetDown> downs;
+    for (const core::Pose& board : poses) {
       DirectArm::SetDown down;
       down.board = board;
       for (const Receiving& at_pick : d.picks) {
-        if (!taken(board, at_pick.grasp, down.place)) continue;
+        if (!taken_by(d, board, at_pick.grasp, down.place)) continue;
         down.pick = at_pick;
         break;
       }
       if (down.place.grasp < 0) continue;
       for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
-        Receiving again;
-        if (g != down.place.grasp && taken(board, g, again)) down.repicks.push_back(again);
+        Receiving r;
+        if ((&again != &d || g != down.place.grasp) && taken_by(again, board, g, r)) {
+          down.repicks.push_back(r);
+        }
       }
-      if (!down.repicks.empty()) d.set_downs->push_back(std::move(down));
+      if (!down.repicks.empty()) downs.push_back(std::move(down));
     }
+    return downs;
+  };
+  auto set_downs_of = [&](DirectArm& d) -> const std::vector<DirectArm::SetDown>& {
+    if (!d.set_downs) d.set_downs = find_set_downs(d, d, set_down_poses);
     return *d.set_downs;
+  };
+  // Relays from d to the other arm `to`, found once per pair when a goal first needs them.
+  const std::vector<core::Pose> relay_poses =
+      settings.direct ? relay_set_down_poses(cell, part.mesh, grasps.com, part.initial,
+                                             grasps.placements, settings.table_regrasp)
+                      : std::vector<core::Pose>{};
+  std::map<std::pair<const DirectArm*, const DirectArm*>, std::vector<DirectArm::SetDown>> relays;
+  auto relays_of = [&](DirectArm& d, DirectArm& to) -> const std::vector<DirectArm::SetDown>& {
+    const auto key = std::make_pair(&d, &to);
+    auto it = relays.find(key);
+    if (it == relays.end()) it = relays.emplace(key, find_set_downs(d, to, relay_poses)).first;
+    return it->second;
   };
 
   std::string direct_failure;
@@ -975,6 +999,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
               r.pick_grasp_id = down.pick.grasp;
               r.robot_grasp_id = again.grasp;
               r.arm = d.arm->spec.name;
+              r.repick_arm = d.arm->spec.name;
               r.placement = down.board;
               r.joints_pick = down.pick.joints;
               r.joints_place = down.place.joints;
@@ -993,6 +1018,56 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
           restore_arm(*d.arm);
           reset_state();
           at_candidate();
+        }
+        reset_state();
+      }
+      // Relays: an arm that picks the part sets it down where the other arm takes it again.
+      if (shared == 0 && direct == 0 && regrasps == 0 && settings.table_regrasp.enabled &&
+          settings.table_regrasp.relay) {
+        for (DirectArm& d : direct_arms) {
+          for (auto* group : {&direct_arms, &relay_only_arms}) {
+            for (DirectArm& to : *group) {
+              if (to.arm == d.arm) continue;
+              const auto& downs = relays_of(d, to);
+              if (downs.empty()) continue;
+              if (to.tool_on_table) {
+                core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                                     product.suction_tool_pose);
+              }
+              int stored = 0;
+              for (const auto& down : downs) {
+                for (const Receiving& again : down.repicks) {
+                  Receiving at_rh;
+                  if (!reach_with(*to.arm, to.base_inv, c.board, again.grasp, to.bodies, false,
+                                  at_rh)) {
+                    continue;
+                  }
+                  db::TableRegraspRecord r;
+                  r.candidate_id = ci;
+                  r.pick_grasp_id = down.pick.grasp;
+                  r.robot_grasp_id = again.grasp;
+                  r.arm = d.arm->spec.name;
+                  r.repick_arm = to.arm->spec.name;
+                  r.placement = down.board;
+                  r.joints_pick = down.pick.joints;
+                  r.joints_place = down.place.joints;
+                  r.joints_repick = again.joints;
+                  r.joints_rh = at_rh.joints;
+                  r.inclination_pick_deg = down.pick.slip_deg;
+                  r.inclination_place_deg = down.place.slip_deg;
+                  r.inclination_repick_deg = again.slip_deg;
+                  r.inclination_rh_deg = at_rh.slip_deg;
+                  result.regrasps.push_back(r);
+                  ++regrasps;
+                  if (++stored >= settings.direct_stored) break;
+                }
+                if (stored >= settings.direct_stored) break;
+              }
+              restore_arm(*to.arm);
+              reset_state();
+              at_candidate();
+            }
+          }
         }
         reset_state();
       }
@@ -1123,7 +1198,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         why += set_down_poses.empty()
                    ? " (no regrasp on the table: the part does not lie on it)"
                    : " (nor after a regrasp on the table, at " +
-                         std::to_string(set_down_poses.size()) + " set-down poses)";
+                         std::to_string(set_down_poses.size()) + " set-down poses" +
+                         (relay_poses.empty() ? std::string()
+                                              : ", or a relay to the other arm there, at " +
+                                                    std::to_string(relay_poses.size()) + " poses") +
+                         ")";
       }
     } else {
       why += "; " + direct_failure;

@@ -228,6 +228,7 @@ class Run {
     visit(repicks_);
     visit(regrasp_presents_);
     visit(regrasp_leaves_);
+    visit(relay_tool_downs_);
     visit(suction_presents_);
     visit(suction_leaves_);
   }
@@ -497,6 +498,9 @@ class Run {
   // gripper opens, back along its approach.
   const Stage& set_down(const core::Arm& arm, const db::RobotGraspRecord& grasp,
                         const db::TableRegraspRecord& regrasp, const Stage& picked);
+  // A relay to the suction arm holding the tool: it sets the tool down where the scene has its
+  // place (put_tool_down), the board set down at the record's placement.
+  const Stage& tool_down_after_set_down(const db::TableRegraspRecord& regrasp, const Stage& set);
   // The gripper takes the board again where it was set down (take(), `again`).
   const Stage& repick(const core::Arm& arm, const db::RobotGraspRecord& grasp,
                       const db::TableRegraspRecord& regrasp, const Stage& set);
@@ -579,6 +583,7 @@ class Run {
   std::map<std::int64_t, Stage> repicks_;
   std::map<std::int64_t, Stage> regrasp_presents_;
   std::map<std::int64_t, Stage> regrasp_leaves_;
+  std::map<std::int64_t, Stage> relay_tool_downs_;  // by table regrasp record
   // The suction way's, by (the delivery's suction grasp, goal).
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> suction_presents_;
   std::map<std::pair<std::int64_t, std::int64_t>, Stage> suction_leaves_;

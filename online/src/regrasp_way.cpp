@@ -1,6 +1,7 @@
 // The regrasp way: one arm's gripper picks the board where it lies (the direct way's pick), sets
-// it down on the table on another resting pose, lets go, takes it again with the grasp that
-// serves the goal and delivers it. Each stage memoised by its table regrasp record.
+// it down on the table on another resting pose, lets go, and it (or, for a relay, the other arm
+// once the first is home) takes it again with the grasp that serves the goal and delivers it.
+// Each stage memoised by its table regrasp record.
 
 #include <iterator>
 
@@ -14,7 +15,10 @@ std::string Run::regrasp_chain(const db::HandoverCandidateRecord& goal,
   const auto first_it = robot_grasps_.find(regrasp.pick_grasp_id);
   const auto again_it = robot_grasps_.find(regrasp.robot_grasp_id);
   const core::Arm* arm = arm_named(regrasp.arm);
-  if (first_it == robot_grasps_.end() || again_it == robot_grasps_.end() || arm == nullptr) {
+  const core::Arm* again_arm = arm_named(regrasp.repick_arm.empty() ? regrasp.arm
+                                                                    : regrasp.repick_arm);
+  if (first_it == robot_grasps_.end() || again_it == robot_grasps_.end() || arm == nullptr ||
+      again_arm == nullptr) {
     return "the database's table regrasp refers to a missing record";
   }
   const db::RobotGraspRecord& first = first_it->second;
@@ -25,7 +29,9 @@ std::string Run::regrasp_chain(const db::HandoverCandidateRecord& goal,
   pick.arm = regrasp.arm;
   pick.joints_pick = regrasp.joints_pick;
   const bool sets_tool_down = arm == &suction_ && start_.tool_in_hand;
-  const Stage* stages[6] = {};
+  // A relay to the suction arm: it sets its tool down once the part is set down.
+  const bool relay_tool_down = arm != &suction_ && again_arm == &suction_ && start_.tool_in_hand;
+  const Stage* stages[7] = {};
   const auto plan_stages = [&] {
     stages[0] = sets_tool_down ? &tool_down() : nullptr;
     if (stages[0] != nullptr && !stages[0]->ok()) return;
@@ -33,13 +39,25 @@ std::string Run::regrasp_chain(const db::HandoverCandidateRecord& goal,
     if (!stages[1]->ok()) return;
     stages[2] = &set_down(*arm, first, regrasp, *stages[1]);
     if (!stages[2]->ok()) return;
-    stages[3] = &repick(*arm, again, regrasp, *stages[2]);
-    if (!stages[3]->ok()) return;
-    stages[4] = &regrasp_present(*arm, again, goal, regrasp, *stages[3]);
-    if (stages[4]->ok()) stages[5] = &regrasp_leave(*arm, goal, regrasp, *stages[4]);
+    const Stage* before = stages[2];
+    if (relay_tool_down) {
+      stages[3] = &tool_down_after_set_down(regrasp, *stages[2]);
+      if (!stages[3]->ok()) return;
+      before = stages[3];
+    }
+    // The stages from the repick on, after the set-down (and the tool's) in the chain.
+    const std::size_t k = relay_tool_down ? 4 : 3;
+    stages[k] = &repick(*again_arm, again, regrasp, *before);
+    if (!stages[k]->ok()) return;
+    stages[k + 1] = &regrasp_present(*again_arm, again, goal, regrasp, *stages[k]);
+    if (stages[k + 1]->ok()) {
+      stages[k + 2] = &regrasp_leave(*again_arm, goal, regrasp, *stages[k + 1]);
+    }
   };
-  plan_settled(stages, sets_tool_down ? 0 : 1, plan_stages);
-  return join_stages(stages, steps, end);
+  // The chain's stages only: settle() reads a null as a chain stopped before it.
+  const std::span<const Stage*> chain(stages, relay_tool_down ? 7 : 6);
+  plan_settled(chain, sets_tool_down ? 0 : 1, plan_stages);
+  return join_stages(chain, steps, end);
 }
 
 const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& grasp,
@@ -99,7 +117,27 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
   back.goal = *out;
   if (auto e = step(st, planner, arm, back, "set_down_retreat", "", ""); !e.empty()) {
     st.failure = e;
+    return st;
   }
+  // A relay: the arm goes home, out of the other arm's way.
+  if (!regrasp.repick_arm.empty() && regrasp.repick_arm != arm.spec.name) {
+    MotionRequest home = standing;
+    home.start = *out;
+    home.goal = arm.spec.home;
+    if (auto e = step(st, planner, arm, home, "set_down_arm_home", "", ""); !e.empty()) {
+      st.failure = e;
+    }
+  }
+  return st;
+}
+
+const Stage& Run::tool_down_after_set_down(const db::TableRegraspRecord& regrasp,
+                                            const Stage& set) {
+  const auto found = relay_tool_downs_.find(regrasp.id);
+  if (found != relay_tool_downs_.end()) return found->second;
+  Stage& st = relay_tool_downs_[regrasp.id];
+  st.end = set.end;
+  put_tool_down(st, regrasp.placement);
   return st;
 }
 

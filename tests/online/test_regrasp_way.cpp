@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <map>
 #include <string>
 
 #include "hila/core/mesh.hpp"
@@ -32,6 +33,7 @@ TEST(RegraspWay, ABracketTheGripperCannotDeliverAsItLiesIsSetDownAndTakenAgain) 
   // Few of the quick build's 60 candidates are comfortable for so small a part.
   settings.handover.candidates = 400;
   settings.handover.max_candidates = 400;
+  settings.handover.table_regrasp.relay = false;  // one arm does it all (relays: the test below)
 
   // Without regrasps on the table: no goal (the gripper picks it, but holds it nowhere the human
   // can take it).
@@ -119,4 +121,93 @@ TEST(RegraspWay, ABracketTheGripperCannotDeliverAsItLiesIsSetDownAndTakenAgain) 
   EXPECT_TRUE(closes[0].linear().isApprox(first.linear(), 1e-6));
   EXPECT_LT((closes[1].translation() - again.translation()).norm(), 1e-6);
   EXPECT_TRUE(closes[1].linear().isApprox(again.linear(), 1e-6));
+}
+
+// The relay: a bracket only the left arm's gripper picks where it lies (on the robot's left),
+// whose comfortable goals mostly the right arm's gripper serves (its target on the human's
+// right). The left arm sets it down where both arms reach and goes home; the right arm, having
+// set its tool down, takes it again and delivers it. Without relays the left arm does it all, at
+// the few goals it serves after a regrasp of its own.
+TEST(RegraspWay, ABracketOnlyTheOtherArmDeliversIsRelayedOnTheTable) {
+  const std::string dir = test::temp_dir("relay_way");
+  const std::string product = std::string(HILA_TEST_DATA_DIR) + "/relay_bracket/product.yaml";
+  offline::BuildSettings settings = test::quick_build_settings(7, 2);
+  settings.handover.candidates = 400;
+  settings.handover.max_candidates = 400;
+
+  settings.handover.table_regrasp.relay = false;
+  const std::string without = dir + "/without.hila";
+  offline::build_database(product, test::cell_path(), without, settings);
+  int goals_without = 0;
+  {
+    const db::Database database = db::Database::open(without);
+    const auto part = database.parts().front().id;
+    for (const auto& goal : database.handover_goals(part)) {
+      ++goals_without;
+      for (const auto& r : database.table_regrasps(goal.id)) EXPECT_EQ(r.repick_arm, r.arm);
+      EXPECT_TRUE(database.direct_grasps(goal.id).empty());
+    }
+  }
+
+  settings.handover.table_regrasp.relay = true;
+  const std::string db_path = dir + "/relay.hila";
+  offline::build_database(product, test::cell_path(), db_path, settings);
+  const auto model = online::PlannerModel::load(db_path, test::cell_path(), product);
+  const online::BoardRecords& records = *model->board_records("bracket");
+  ASSERT_FALSE(records.goals.empty()) << model->database().handover_stage(records.part.id)->failure;
+  int relays = 0;
+  for (const auto& goal : records.goals) {
+    for (const auto& r : records.table_regrasps.at(goal.id)) {
+      EXPECT_EQ(r.arm, "left");  // the only arm that picks it where it lies
+      relays += r.repick_arm == "right" ? 1 : 0;
+    }
+  }
+  EXPECT_GT(relays, 0);
+  EXPECT_GT(records.goals.size(), static_cast<std::size_t>(goals_without));
+
+  online::BoardPlanner planner(*model);
+  const online::Scene scene = online::nominal_scene(model->cell(), model->product());
+  const online::BoardPlan plan = planner.plan(scene, "bracket", in_seconds(60));
+  ASSERT_TRUE(plan.solved()) << plan.reason;
+  EXPECT_EQ(plan.mode, online::DeliveryMode::kRegrasp);
+  EXPECT_EQ(plan.picking_arm, "left");
+  EXPECT_EQ(plan.delivering_arm, "right");
+  EXPECT_TRUE(plan.validated);
+
+  // Each arm's steps start where it was; the events in order with the arm that does them; both
+  // arms home at the end. The left gripper closes where the bracket lies and lets go where it is
+  // set down, the right gripper closes there (FK of each arm).
+  const core::Cell& cell = model->cell();
+  std::map<std::string, Eigen::VectorXd> at(scene.robot.begin(), scene.robot.end());
+  std::string events;
+  std::vector<std::pair<std::string, core::Pose>> closes;
+  for (const auto& step : plan.steps) {
+    EXPECT_TRUE(step.q.front().isApprox(at.at(step.arm), 1e-9)) << step.name;
+    at[step.arm] = step.q.back();
+    EXPECT_TRUE(step.validation.valid()) << step.name;
+    EXPECT_GT(step.validation.samples, 0) << step.name;  // the validator's report is in
+    if (!step.event.empty()) events += step.arm + ":" + step.event + " ";
+    if (step.event == "gripper_close") {
+      const core::Arm& arm = cell.arm(step.arm);
+      closes.emplace_back(step.arm,
+                          core::arm_base_in_world(cell, arm) * arm.chain.fk(step.q.back()));
+    }
+  }
+  EXPECT_EQ(events, std::string(scene.tool_in_hand ? "right:tool_released " : "") +
+                        "left:gripper_close left:set_down right:gripper_close "
+                        "right:wait_for_human right:gripper_open ");
+  for (const auto& a : cell.arms()) {
+    EXPECT_LT((at.at(a.spec.name) - a.spec.home).norm(), 1e-9) << a.spec.name;
+  }
+  ASSERT_EQ(closes.size(), 2u);
+  const core::Pose initial = scene.initial_pose(model->product().part("bracket"));
+  const core::Pose first = initial * records.robot_grasps.at(plan.pick_grasp_id).tcp;
+  const core::Pose again = plan.set_down * records.robot_grasps.at(plan.robot_grasp_id).tcp;
+  EXPECT_EQ(closes[0].first, "left");
+  EXPECT_LT((closes[0].second.translation() - first.translation()).norm(), 1e-6);
+  EXPECT_EQ(closes[1].first, "right");
+  EXPECT_LT((closes[1].second.translation() - again.translation()).norm(), 1e-6);
+  EXPECT_TRUE(closes[1].second.linear().isApprox(again.linear(), 1e-6));
+  // Set down elsewhere than it lay.
+  EXPECT_GT((plan.set_down.translation() - initial.translation()).head<2>().norm(), 0.05);
 }

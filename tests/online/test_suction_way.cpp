@@ -115,6 +115,7 @@ TEST(SuctionWay, APanelNoExchangeServesIsPresentedOnTheCupOfTheArmThatPickedIt) 
     EXPECT_TRUE(step.q.front().isApprox(at, 1e-9)) << step.name;
     at = step.q.back();
     EXPECT_TRUE(step.validation.valid()) << step.name;
+    EXPECT_GT(step.validation.samples, 0) << step.name;  // the validator's report is in
     if (!step.event.empty()) events += step.event + " ";
     if (step.event == "wait_for_human") {
       const core::Pose board =

@@ -163,11 +163,12 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
                         {"slip_rh_deg", round_to(d.inclination_rh_deg, 0.01)}});
     }
     // Regrasps on the table: the grasp the arm picks it with, where it sets it down, the grasp it
-    // takes it again with and delivers.
+    // (or the other arm, for a relay) takes it again with and delivers.
     nlohmann::json regrasps = nlohmann::json::array();
     for (const auto& r : database.table_regrasps(c.id)) {
       regrasps.push_back({{"id", r.id},
                           {"arm", r.arm},
+                          {"taken_again_by", r.repick_arm.empty() ? r.arm : r.repick_arm},
                           {"pick_grasp", r.pick_grasp_id},
                           {"robot_grasp", r.robot_grasp_id},
                           {"set_down", pose_json(r.placement)}});
@@ -183,6 +184,11 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
                         {"shared_grasps", shared},
                         {"direct_grasps", direct},
                         {"table_regrasps", regrasps}};
+    nlohmann::json on_cup = nlohmann::json::array();
+    for (const auto& d : database.suction_deliveries(c.id)) {
+      on_cup.push_back({{"id", d.id}, {"arm", d.arm}, {"suction_grasp", d.suction_grasp_id}});
+    }
+    g["suction_deliveries"] = on_cup;
     if (!c.second_arm.empty()) {
       g["second_arm"] = c.second_arm;
       g["second_grasp"] = c.second_grasp_id;

@@ -147,6 +147,7 @@ struct Way {
   Kind kind = Kind::kDirect;
   std::string suction_arm;  // the exchange's
   std::string arm;          // the arm that delivers
+  std::string picking_arm;  // the regrasp's: the arm that sets it down (another for a relay)
   std::set<int> ranks;      // goals served
   std::set<int> connected;  // goals whose chain the regrasp graph connects (exchange)
   std::set<Id> gripper_grasps, suction_grasps, robot_handovers;
@@ -165,7 +166,8 @@ struct Way {
       case Kind::kDirect:
         return "direct by " + arm;
       case Kind::kRegrasp:
-        return "regrasp on table by " + arm;
+        return picking_arm == arm ? "regrasp on table by " + arm
+                                  : "relay on table " + picking_arm + " -> " + arm;
       case Kind::kSuction:
         return "on the cup by " + arm;
       case Kind::kExchange:
@@ -174,6 +176,11 @@ struct Way {
     return "exchange " + suction_arm + " -> " + arm;
   }
 };
+
+// The arm that takes a table regrasp's part again and delivers it.
+std::string again_arm(const db::TableRegraspRecord& r) {
+  return r.repick_arm.empty() ? r.arm : r.repick_arm;
+}
 
 std::string goal_node(int rank, const std::string& arm) {
   return "goal:" + std::to_string(rank) + ":" + arm;
@@ -277,9 +284,10 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
       picked[d.arm].insert(d.robot_grasp_id);
     }
     for (const auto& r : goal.regrasps) {
-      Way& w = ways[{"table", r.arm}];
+      Way& w = ways[{"table:" + r.arm, again_arm(r)}];
       w.kind = Way::Kind::kRegrasp;
-      w.arm = r.arm;
+      w.picking_arm = r.arm;
+      w.arm = again_arm(r);
       w.ranks.insert(rank);
       w.gripper_grasps.insert(r.pick_grasp_id);
       w.gripper_grasps.insert(r.robot_grasp_id);
@@ -344,14 +352,14 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
            {"position", {round_to(at.x(), 1e-5), round_to(at.y(), 1e-5), round_to(at.z(), 1e-5)}}});
       nodes.push_back({{"id", again},
                        {"kind", "taken_again"},
-                       {"arm", r.arm},
-                       {"label", "in the " + r.arm + " gripper again, grasp " +
+                       {"arm", again_arm(r)},
+                       {"label", "in the " + again_arm(r) + " gripper again, grasp " +
                                      std::to_string(r.robot_grasp_id)},
                        {"regrasp", r.id},
                        {"grasp", r.robot_grasp_id}});
       edges.push_back(edge_json("picked:" + r.arm, down, "set_down", "regrasp", r.arm, "gripper",
                                 {r.pick_grasp_id}, "online", nullptr, nullptr));
-      edges.push_back(edge_json(down, again, "gripper_pick", "regrasp", r.arm, "gripper",
+      edges.push_back(edge_json(down, again, "gripper_pick", "regrasp", again_arm(r), "gripper",
                                 {r.robot_grasp_id}, "online", nullptr, nullptr));
     }
   }
@@ -407,7 +415,7 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
     for (const auto& d : goal.direct) direct[d.arm].insert(d.robot_grasp_id);
     std::set<std::string> arms;
     for (const auto& [arm, grasps] : direct) arms.insert(arm);
-    for (const auto& r : goal.regrasps) arms.insert(r.arm);
+    for (const auto& r : goal.regrasps) arms.insert(again_arm(r));
     for (const auto& s : goal.shared) arms.insert(s.arm);
     std::set<std::string> cup_arms;
     for (const auto& d : goal.on_cup) cup_arms.insert(d.arm);
@@ -448,9 +456,9 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
                                 "gripper", grasps, "online", nullptr, nullptr));
     }
     for (const auto& r : goal.regrasps) {
-      edges.push_back(edge_json(taken_again_node(r.arm, r.id), goal_node(c.rank, r.arm), "transfer",
-                                "regrasp", r.arm, "gripper", {r.robot_grasp_id}, "online", nullptr,
-                                nullptr));
+      edges.push_back(edge_json(taken_again_node(r.arm, r.id), goal_node(c.rank, again_arm(r)),
+                                "transfer", "regrasp", again_arm(r), "gripper", {r.robot_grasp_id},
+                                "online", nullptr, nullptr));
     }
     for (const auto& s : goal.shared) {
       const Stored* transfer =
@@ -585,8 +593,11 @@ void print_text(const Graph& g, int shown_goals) {
       std::cout << "    direct by " << arm << ": " << count(grasps.size(), "gripper grasp") << " "
                 << id_list(grasps) << " (planned online)\n";
     }
-    std::map<std::string, std::vector<const db::TableRegraspRecord*>> regrasps;  // by arm
-    for (const auto& r : goal.regrasps) regrasps[r.arm].push_back(&r);
+    // By arm, "A -> B" for a relay.
+    std::map<std::string, std::vector<const db::TableRegraspRecord*>> regrasps;
+    for (const auto& r : goal.regrasps) {
+      regrasps[again_arm(r) == r.arm ? r.arm : r.arm + " -> " + again_arm(r)].push_back(&r);
+    }
     for (const auto& [arm, list] : regrasps) {
       std::string pairs;
       for (std::size_t i = 0; i < list.size() && i < 4; ++i) {
@@ -594,7 +605,8 @@ void print_text(const Graph& g, int shown_goals) {
                  std::to_string(list[i]->robot_grasp_id);
       }
       if (list.size() > 4) pairs += ", ...";
-      std::cout << "    regrasp on table by " << arm << ": " << count(list.size(), "set-down")
+      std::cout << "    " << (arm.find(" -> ") == std::string::npos ? "regrasp" : "relay")
+                << " on table by " << arm << ": " << count(list.size(), "set-down")
                 << " (grasps picked -> taken again: " << pairs << "; planned online)\n";
     }
     std::map<std::string, std::set<Id>> on_cup;  // arm -> suction grasps

@@ -112,7 +112,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
     if (plan.mode == online::DeliveryMode::kRegrasp) {
       j["mode"]["set_down"] = {{"board", pose_to_json(plan.set_down)},
                                {"pick_grasp", plan.pick_grasp_id},
-                               {"grasp_again", plan.robot_grasp_id}};
+                               {"grasp_again", plan.robot_grasp_id},
+                               {"taken_again_by", plan.delivering_arm}};
     }
     j["goal_rank"] = plan.goal_rank;
     j["candidate"] = plan.candidate_id;

@@ -22,6 +22,13 @@ struct TableRegraspSettings {
   // to the box's top over the part's centre of mass; a part on another part (a pile) is not set
   // down elsewhere.
   double support_tolerance = 0.002;
+  // Relays: where one arm's gripper picks the part but only the other arm's holds it at a
+  // comfortable goal, the first sets it down where both arms reach and the other takes it
+  // (relay_set_down_poses). `relay_spots` places on the part's table, on a grid `relay_spacing`
+  // m apart, nearest the farther arm base first.
+  bool relay = true;
+  int relay_spots = 4;
+  double relay_spacing = 0.05;
 };
 
 // Where a part lying on the table at `initial` can be set down for a regrasp: its centre of mass
@@ -29,6 +36,15 @@ struct TableRegraspSettings {
 // stable first) turned about the vertical; the initial pose itself is left out (a regrasp there
 // would be a direct pick). Empty when the part does not lie on a box obstacle of the cell.
 std::vector<core::Pose> table_set_down_poses(const core::Cell& cell, const core::TriangleMesh& mesh,
+                                             const Eigen::Vector3d& com, const core::Pose& initial,
+                                             const std::vector<db::PlacementRecord>& placements,
+                                             const TableRegraspSettings& settings);
+
+// Where a part lying on the table at `initial` can be set down for a relay between the arms: at
+// each of settings.relay_spots places of the same table (its centre of mass over a grid point,
+// those nearest the farther arm base first, at least 5 cm from where it lay), resting as
+// table_set_down_poses has it there. Empty when the part does not lie on a box obstacle.
+std::vector<core::Pose> relay_set_down_poses(const core::Cell& cell, const core::TriangleMesh& mesh,
                                              const Eigen::Vector3d& com, const core::Pose& initial,
                                              const std::vector<db::PlacementRecord>& placements,
                                              const TableRegraspSettings& settings);
