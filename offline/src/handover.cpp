@@ -896,6 +896,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   std::vector<int> rh_bodies = receiving_bodies;
   rh_bodies.push_back(scene.board);
   std::size_t searched = 0;  // candidates before this index have been searched
+  // Relays are searched only for a part no other way serves at any candidate: they take two arms
+  // and two more stages, and a relay goal ranked before a goal one arm serves would be tried first.
+  bool relays_allowed = false;
   auto search_shared = [&] {
     std::vector<int> comfortable;
     for (std::size_t i = searched; i < result.candidates.size(); ++i) {
@@ -1023,7 +1026,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       }
       // Relays: an arm that picks the part sets it down where the other arm takes it again.
       if (shared == 0 && direct == 0 && regrasps == 0 && settings.table_regrasp.enabled &&
-          settings.table_regrasp.relay) {
+          settings.table_regrasp.relay && relays_allowed) {
         for (DirectArm& d : direct_arms) {
           for (auto* group : {&direct_arms, &relay_only_arms}) {
             for (DirectArm& to : *group) {
@@ -1148,6 +1151,12 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   while (stage.goals < settings.min_goals && stage.candidates < settings.max_candidates &&
          stage.draws < settings.max_draws) {
     sample_candidates(std::min(settings.max_candidates, stage.candidates + settings.candidates));
+    search_shared();
+  }
+  if (stage.goals == 0 && settings.direct && settings.table_regrasp.enabled &&
+      settings.table_regrasp.relay && !relay_poses.empty() && !direct_arms.empty()) {
+    relays_allowed = true;
+    searched = 0;
     search_shared();
   }
   // No goal: the candidates down to comfort_floor, in two steps, the human's IK confirming each
