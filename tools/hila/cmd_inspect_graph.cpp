@@ -605,8 +605,9 @@ void print_text(const Graph& g, int shown_goals) {
                  std::to_string(list[i]->robot_grasp_id);
       }
       if (list.size() > 4) pairs += ", ...";
-      std::cout << "    " << (arm.find(" -> ") == std::string::npos ? "regrasp" : "relay")
-                << " on table by " << arm << ": " << count(list.size(), "set-down")
+      std::cout << "    "
+                << (arm.find(" -> ") == std::string::npos ? "regrasp on table by " : "relay on table ")
+                << arm << ": " << count(list.size(), "set-down")
                 << " (grasps picked -> taken again: " << pairs << "; planned online)\n";
     }
     std::map<std::string, std::set<Id>> on_cup;  // arm -> suction grasps
