@@ -899,6 +899,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // Relays are searched only for a part no other way serves at any candidate: they take two arms
   // and two more stages, and a relay goal ranked before a goal one arm serves would be tried first.
   bool relays_allowed = false;
+  // The relay pass: the candidates searched before for every other way, which found none.
+  bool relays_only = false;
   auto search_shared = [&] {
     std::vector<int> comfortable;
     for (std::size_t i = searched; i < result.candidates.size(); ++i) {
@@ -926,7 +928,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       };
       at_candidate();
       int shared = 0;
-      for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
+      for (int g = 0; g < static_cast<int>(grasps.robot.size()) && !relays_only; ++g) {
         const auto& poses = rr_of_grasp[static_cast<std::size_t>(g)];
         if (poses.empty()) continue;
         Receiving at_rh;
@@ -954,6 +956,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       restore_receiving();
       int direct = 0;
       for (const DirectArm& d : direct_arms) {
+        if (relays_only) break;
         if (d.tool_on_table) {
           core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
                                product.suction_tool_pose);
@@ -981,47 +984,51 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         at_candidate();
       }
       reset_state();
+      // Table regrasps of this candidate from `d`'s set-downs `downs`, taken again by `to` (d
+      // itself, or the other arm for a relay): up to direct_stored whose delivering grasp `to`
+      // also holds at the candidate.
       int regrasps = 0;
-      if (shared == 0 && direct == 0 && settings.table_regrasp.enabled) {
-        for (DirectArm& d : direct_arms) {
-          const auto& downs = set_downs_of(d);
-          if (downs.empty()) continue;
-          if (d.tool_on_table) {
-            core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
-                                 product.suction_tool_pose);
-          }
-          int stored = 0;
-          for (const auto& down : downs) {
-            for (const Receiving& again : down.repicks) {
-              Receiving at_rh;
-              if (!reach_with(*d.arm, d.base_inv, c.board, again.grasp, d.bodies, false, at_rh)) {
-                continue;
-              }
-              db::TableRegraspRecord r;
-              r.candidate_id = ci;
-              r.pick_grasp_id = down.pick.grasp;
-              r.robot_grasp_id = again.grasp;
-              r.arm = d.arm->spec.name;
-              r.repick_arm = d.arm->spec.name;
-              r.placement = down.board;
-              r.joints_pick = down.pick.joints;
-              r.joints_place = down.place.joints;
-              r.joints_repick = again.joints;
-              r.joints_rh = at_rh.joints;
-              r.inclination_pick_deg = down.pick.slip_deg;
-              r.inclination_place_deg = down.place.slip_deg;
-              r.inclination_repick_deg = again.slip_deg;
-              r.inclination_rh_deg = at_rh.slip_deg;
-              result.regrasps.push_back(r);
-              ++regrasps;
-              if (++stored >= settings.direct_stored) break;
-            }
-            if (stored >= settings.direct_stored) break;
-          }
-          restore_arm(*d.arm);
-          reset_state();
-          at_candidate();
+      auto store_set_downs = [&](const DirectArm& d, DirectArm& to,
+                                 const std::vector<DirectArm::SetDown>& downs) {
+        if (downs.empty()) return;
+        if (to.tool_on_table) {
+          core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                               product.suction_tool_pose);
         }
+        int stored = 0;
+        for (const auto& down : downs) {
+          for (const Receiving& again : down.repicks) {
+            Receiving at_rh;
+            if (!reach_with(*to.arm, to.base_inv, c.board, again.grasp, to.bodies, false, at_rh)) {
+              continue;
+            }
+            db::TableRegraspRecord r;
+            r.candidate_id = ci;
+            r.pick_grasp_id = down.pick.grasp;
+            r.robot_grasp_id = again.grasp;
+            r.arm = d.arm->spec.name;
+            r.repick_arm = to.arm->spec.name;
+            r.placement = down.board;
+            r.joints_pick = down.pick.joints;
+            r.joints_place = down.place.joints;
+            r.joints_repick = again.joints;
+            r.joints_rh = at_rh.joints;
+            r.inclination_pick_deg = down.pick.slip_deg;
+            r.inclination_place_deg = down.place.slip_deg;
+            r.inclination_repick_deg = again.slip_deg;
+            r.inclination_rh_deg = at_rh.slip_deg;
+            result.regrasps.push_back(r);
+            ++regrasps;
+            if (++stored >= settings.direct_stored) break;
+          }
+          if (stored >= settings.direct_stored) break;
+        }
+        restore_arm(*to.arm);
+        reset_state();
+        at_candidate();
+      };
+      if (shared == 0 && direct == 0 && settings.table_regrasp.enabled && !relays_only) {
+        for (DirectArm& d : direct_arms) store_set_downs(d, d, set_downs_of(d));
         reset_state();
       }
       // Relays: an arm that picks the part sets it down where the other arm takes it again.
@@ -1030,52 +1037,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         for (DirectArm& d : direct_arms) {
           for (auto* group : {&direct_arms, &relay_only_arms}) {
             for (DirectArm& to : *group) {
-              if (to.arm == d.arm) continue;
-              const auto& downs = relays_of(d, to);
-              if (downs.empty()) continue;
-              if (to.tool_on_table) {
-                core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
-                                     product.suction_tool_pose);
-              }
-              int stored = 0;
-              for (const auto& down : downs) {
-                for (const Receiving& again : down.repicks) {
-                  Receiving at_rh;
-                  if (!reach_with(*to.arm, to.base_inv, c.board, again.grasp, to.bodies, false,
-                                  at_rh)) {
-                    continue;
-                  }
-                  db::TableRegraspRecord r;
-                  r.candidate_id = ci;
-                  r.pick_grasp_id = down.pick.grasp;
-                  r.robot_grasp_id = again.grasp;
-                  r.arm = d.arm->spec.name;
-                  r.repick_arm = to.arm->spec.name;
-                  r.placement = down.board;
-                  r.joints_pick = down.pick.joints;
-                  r.joints_place = down.place.joints;
-                  r.joints_repick = again.joints;
-                  r.joints_rh = at_rh.joints;
-                  r.inclination_pick_deg = down.pick.slip_deg;
-                  r.inclination_place_deg = down.place.slip_deg;
-                  r.inclination_repick_deg = again.slip_deg;
-                  r.inclination_rh_deg = at_rh.slip_deg;
-                  result.regrasps.push_back(r);
-                  ++regrasps;
-                  if (++stored >= settings.direct_stored) break;
-                }
-                if (stored >= settings.direct_stored) break;
-              }
-              restore_arm(*to.arm);
-              reset_state();
-              at_candidate();
+              if (to.arm != d.arm) store_set_downs(d, to, relays_of(d, to));
             }
           }
         }
         reset_state();
       }
       int on_cup = 0;
-      if (shared == 0 && direct == 0 && regrasps == 0 && suction_deliverable) {
+      if (shared == 0 && direct == 0 && regrasps == 0 && suction_deliverable && !relays_only) {
         at_candidate();
         for (int s = 0; s < n_suction && on_cup < settings.direct_stored; ++s) {
           if (!pickable[static_cast<std::size_t>(s)]) continue;
@@ -1156,8 +1125,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   if (stage.goals == 0 && settings.direct && settings.table_regrasp.enabled &&
       settings.table_regrasp.relay && !relay_poses.empty() && !direct_arms.empty()) {
     relays_allowed = true;
+    relays_only = true;
     searched = 0;
     search_shared();
+    relays_only = false;
   }
   // No goal: the candidates down to comfort_floor, in two steps, the human's IK confirming each
   // as before (a candidate it found below the old threshold may pass the new one).

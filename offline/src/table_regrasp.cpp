@@ -80,7 +80,7 @@ std::vector<core::Pose> relay_set_down_poses(const core::Cell& cell, const core:
       Eigen::Vector3d at = table->pose * Eigen::Vector3d(-half.x() + i * settings.relay_spacing,
                                                          -half.y() + j * settings.relay_spacing,
                                                          half.z());
-      if ((at - over).head<2>().norm() < 0.05) continue;
+      if ((at - over).head<2>().norm() < settings.relay_spacing) continue;  // where it lay
       double farther = 0.0;
       for (const auto& arm : cell.arms()) {
         const Eigen::Vector3d base = core::arm_base_in_world(cell, arm).translation();

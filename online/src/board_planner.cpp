@@ -365,7 +365,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     attempt.rank = goal.rank;
     attempt.candidate_id = goal.id;
     attempt.mode = DeliveryMode::kRegrasp;
-    attempt.arm = r.repick_arm.empty() ? r.arm : r.repick_arm;
+    attempt.arm = r.repick_arm;
     attempt.robot_grasp_id = r.robot_grasp_id;
     std::vector<PlanStep> steps;
     ArmsState end;
@@ -376,7 +376,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     planned(goal, r.robot_grasp_id, steps, end);
     result.mode = DeliveryMode::kRegrasp;
     result.picking_arm = r.arm;
-    result.delivering_arm = r.repick_arm.empty() ? r.arm : r.repick_arm;
+    result.delivering_arm = r.repick_arm;
     result.suction_grasp_id = 0;
     result.pick_grasp_id = r.pick_grasp_id;
     result.set_down = r.placement;
@@ -455,7 +455,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
         for (const auto& r : regrasps->second) {
           if (std::chrono::steady_clock::now() >= deadline) return false;
           if (direct_within_payload.count(r.arm) == 0 ||
-              direct_within_payload.count(r.repick_arm.empty() ? r.arm : r.repick_arm) == 0) {
+              direct_within_payload.count(r.repick_arm) == 0) {
             continue;
           }
           if (try_regrasp(round, goal, r)) return true;

@@ -538,33 +538,33 @@ const Stage& Run::release(const db::RobotHandoverRecord& rr, const db::RobotGras
   Stage& st = releases_[key];
   st.end = receive(rr, grasp).end;
   const db::SuctionGraspRecord& cup = suction_grasps_.at(transfer(rr).cup);
-  const Eigen::VectorXd rr_q = arm_q(st, suction_);
-  const core::Pose rr_tcp = rr.board * cup.cup * world_.stage().cup_in_tcp.inverse();
-  const Eigen::Vector3d cup_axis = (rr.board * cup.cup).linear().col(2);
-  const auto back =
-      solutions(cell_, suction_, shifted(rr_tcp, -settings_.approach * cup_axis), rr_q);
+  st.failure = let_go_of_cup(st, cup, rr.board);
+  return st;
+}
+
+std::string Run::let_go_of_cup(Stage& st, const db::SuctionGraspRecord& cup,
+                               const core::Pose& board_world) {
+  const Eigen::VectorXd at_q = arm_q(st, suction_);
+  const core::Pose tcp = board_world * cup.cup * world_.stage().cup_in_tcp.inverse();
+  const Eigen::Vector3d cup_axis = (board_world * cup.cup).linear().col(2);
+  const auto back = solutions(cell_, suction_, shifted(tcp, -settings_.approach * cup_axis), at_q);
   MotionRequest leave;
-  leave.board_world = rr.board;
-  leave.start = rr_q;
+  leave.board_world = board_world;
+  leave.start = at_q;
   bool backed_off = false;
   if (!back.empty() && first_valid(st, suction_planner_, leave, {back.front()}) &&
-      suction_planner_.segment_valid(rr_q, back.front())) {
+      suction_planner_.segment_valid(at_q, back.front())) {
     leave.goal = back.front();
     if (auto e = step(st, suction_planner_, suction_, leave, "suction_retreat", "suction_off", "");
         !e.empty()) {
-      st.failure = e;
-      return st;
+      return e;
     }
     leave.start = back.front();
     backed_off = true;
   }
   leave.goal = suction_.spec.home;
-  if (auto e = step(st, suction_planner_, suction_, leave, "suction_arm_home",
-                    backed_off ? "" : "suction_off", "");
-      !e.empty()) {
-    st.failure = e;
-  }
-  return st;
+  return step(st, suction_planner_, suction_, leave, "suction_arm_home",
+              backed_off ? "" : "suction_off", "");
 }
 
 const Stage& Run::present(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp,

@@ -434,6 +434,12 @@ class Run {
   // directly) and goes home.
   const Stage& release(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp);
 
+  // Suction off with the board held at `board_world` on `cup` (by the other arm's gripper, or by
+  // the human): the suction arm backs off along the cup's axis where it can (else it leaves
+  // directly) and goes home. "" or the failure.
+  std::string let_go_of_cup(Stage& st, const db::SuctionGraspRecord& cup,
+                            const core::Pose& board_world);
+
   // 5. The slip-constrained transfer to the human.
   const Stage& present(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp,
                        const db::HandoverCandidateRecord& goal);

@@ -15,8 +15,7 @@ std::string Run::regrasp_chain(const db::HandoverCandidateRecord& goal,
   const auto first_it = robot_grasps_.find(regrasp.pick_grasp_id);
   const auto again_it = robot_grasps_.find(regrasp.robot_grasp_id);
   const core::Arm* arm = arm_named(regrasp.arm);
-  const core::Arm* again_arm = arm_named(regrasp.repick_arm.empty() ? regrasp.arm
-                                                                    : regrasp.repick_arm);
+  const core::Arm* again_arm = arm_named(regrasp.repick_arm);
   if (first_it == robot_grasps_.end() || again_it == robot_grasps_.end() || arm == nullptr ||
       again_arm == nullptr) {
     return "the database's table regrasp refers to a missing record";
@@ -120,7 +119,7 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
     return st;
   }
   // A relay: the arm goes home, out of the other arm's way.
-  if (!regrasp.repick_arm.empty() && regrasp.repick_arm != arm.spec.name) {
+  if (regrasp.repick_arm != arm.spec.name) {
     MotionRequest home = standing;
     home.start = *out;
     home.goal = arm.spec.home;

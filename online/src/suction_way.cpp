@@ -122,34 +122,8 @@ const Stage& Run::suction_leave(const db::SuctionDeliveryRecord& delivery,
   const Stage& presented = suction_present(delivery, goal);
   Stage& st = suction_leaves_[key];
   st.end = presented.end;
-  const db::SuctionGraspRecord& cup = suction_grasps_.at(presented.cup);
-  const Eigen::VectorXd rh_q = arm_q(st, suction_);
-  const core::Pose rh_tcp = goal.board * cup.cup * world_.stage().cup_in_tcp.inverse();
-  const Eigen::Vector3d cup_axis = (goal.board * cup.cup).linear().col(2);
-  const auto back =
-      solutions(cell_, suction_, shifted(rh_tcp, -settings_.approach * cup_axis), rh_q);
   // The human holds the board where it was presented.
-  MotionRequest leave;
-  leave.board_world = goal.board;
-  leave.start = rh_q;
-  bool backed_off = false;
-  if (!back.empty() && first_valid(st, suction_planner_, leave, {back.front()}) &&
-      suction_planner_.segment_valid(rh_q, back.front())) {
-    leave.goal = back.front();
-    if (auto e = step(st, suction_planner_, suction_, leave, "suction_retreat", "suction_off", "");
-        !e.empty()) {
-      st.failure = e;
-      return st;
-    }
-    leave.start = back.front();
-    backed_off = true;
-  }
-  leave.goal = suction_.spec.home;
-  if (auto e = step(st, suction_planner_, suction_, leave, "suction_arm_home",
-                    backed_off ? "" : "suction_off", "");
-      !e.empty()) {
-    st.failure = e;
-  }
+  st.failure = let_go_of_cup(st, suction_grasps_.at(presented.cup), goal.board);
   return st;
 }
 

@@ -168,7 +168,7 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
     for (const auto& r : database.table_regrasps(c.id)) {
       regrasps.push_back({{"id", r.id},
                           {"arm", r.arm},
-                          {"taken_again_by", r.repick_arm.empty() ? r.arm : r.repick_arm},
+                          {"taken_again_by", r.repick_arm},
                           {"pick_grasp", r.pick_grasp_id},
                           {"robot_grasp", r.robot_grasp_id},
                           {"set_down", pose_json(r.placement)}});

@@ -177,11 +177,6 @@ struct Way {
   }
 };
 
-// The arm that takes a table regrasp's part again and delivers it.
-std::string again_arm(const db::TableRegraspRecord& r) {
-  return r.repick_arm.empty() ? r.arm : r.repick_arm;
-}
-
 std::string goal_node(int rank, const std::string& arm) {
   return "goal:" + std::to_string(rank) + ":" + arm;
 }
@@ -284,10 +279,10 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
       picked[d.arm].insert(d.robot_grasp_id);
     }
     for (const auto& r : goal.regrasps) {
-      Way& w = ways[{"table:" + r.arm, again_arm(r)}];
+      Way& w = ways[{"table:" + r.arm, r.repick_arm}];
       w.kind = Way::Kind::kRegrasp;
       w.picking_arm = r.arm;
-      w.arm = again_arm(r);
+      w.arm = r.repick_arm;
       w.ranks.insert(rank);
       w.gripper_grasps.insert(r.pick_grasp_id);
       w.gripper_grasps.insert(r.robot_grasp_id);
@@ -352,14 +347,14 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
            {"position", {round_to(at.x(), 1e-5), round_to(at.y(), 1e-5), round_to(at.z(), 1e-5)}}});
       nodes.push_back({{"id", again},
                        {"kind", "taken_again"},
-                       {"arm", again_arm(r)},
-                       {"label", "in the " + again_arm(r) + " gripper again, grasp " +
+                       {"arm", r.repick_arm},
+                       {"label", "in the " + r.repick_arm + " gripper again, grasp " +
                                      std::to_string(r.robot_grasp_id)},
                        {"regrasp", r.id},
                        {"grasp", r.robot_grasp_id}});
       edges.push_back(edge_json("picked:" + r.arm, down, "set_down", "regrasp", r.arm, "gripper",
                                 {r.pick_grasp_id}, "online", nullptr, nullptr));
-      edges.push_back(edge_json(down, again, "gripper_pick", "regrasp", again_arm(r), "gripper",
+      edges.push_back(edge_json(down, again, "gripper_pick", "regrasp", r.repick_arm, "gripper",
                                 {r.robot_grasp_id}, "online", nullptr, nullptr));
     }
   }
@@ -415,7 +410,7 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
     for (const auto& d : goal.direct) direct[d.arm].insert(d.robot_grasp_id);
     std::set<std::string> arms;
     for (const auto& [arm, grasps] : direct) arms.insert(arm);
-    for (const auto& r : goal.regrasps) arms.insert(again_arm(r));
+    for (const auto& r : goal.regrasps) arms.insert(r.repick_arm);
     for (const auto& s : goal.shared) arms.insert(s.arm);
     std::set<std::string> cup_arms;
     for (const auto& d : goal.on_cup) cup_arms.insert(d.arm);
@@ -456,8 +451,8 @@ Graph build_graph(const db::Database& database, const db::PartRecord& part,
                                 "gripper", grasps, "online", nullptr, nullptr));
     }
     for (const auto& r : goal.regrasps) {
-      edges.push_back(edge_json(taken_again_node(r.arm, r.id), goal_node(c.rank, again_arm(r)),
-                                "transfer", "regrasp", again_arm(r), "gripper", {r.robot_grasp_id},
+      edges.push_back(edge_json(taken_again_node(r.arm, r.id), goal_node(c.rank, r.repick_arm),
+                                "transfer", "regrasp", r.repick_arm, "gripper", {r.robot_grasp_id},
                                 "online", nullptr, nullptr));
     }
     for (const auto& s : goal.shared) {
@@ -596,7 +591,7 @@ void print_text(const Graph& g, int shown_goals) {
     // By arm, "A -> B" for a relay.
     std::map<std::string, std::vector<const db::TableRegraspRecord*>> regrasps;
     for (const auto& r : goal.regrasps) {
-      regrasps[again_arm(r) == r.arm ? r.arm : r.arm + " -> " + again_arm(r)].push_back(&r);
+      regrasps[r.repick_arm == r.arm ? r.arm : r.arm + " -> " + r.repick_arm].push_back(&r);
     }
     for (const auto& [arm, list] : regrasps) {
       std::string pairs;

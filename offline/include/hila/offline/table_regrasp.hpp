@@ -42,7 +42,7 @@ std::vector<core::Pose> table_set_down_poses(const core::Cell& cell, const core:
 
 // Where a part lying on the table at `initial` can be set down for a relay between the arms: at
 // each of settings.relay_spots places of the same table (its centre of mass over a grid point,
-// those nearest the farther arm base first, at least 5 cm from where it lay), resting as
+// those nearest the farther arm base first, at least relay_spacing from where it lay), resting as
 // table_set_down_poses has it there. Empty when the part does not lie on a box obstacle.
 std::vector<core::Pose> relay_set_down_poses(const core::Cell& cell, const core::TriangleMesh& mesh,
                                              const Eigen::Vector3d& com, const core::Pose& initial,
