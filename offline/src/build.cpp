@@ -288,8 +288,9 @@ std::string settings_hash(const BuildSettings& s) {
        << h.direct_stored << ' ' << h.pick_lift << ' ' << h.pick_resolution << ' '
        << h.exchange_approach << ' ' << h.exchange_resolution << ' ' << h.table_regrasp.enabled
        << ' ' << h.table_regrasp.placements << ' ' << h.table_regrasp.yaws << ' '
-       << h.table_regrasp.support_tolerance << ' ' << h.swap_roles << ' ' << h.suction_delivery << ' ' << h.table_regrasp.relay << ' '
-       << h.table_regrasp.relay_spots << ' ' << h.table_regrasp.relay_spacing;
+       << h.table_regrasp.support_tolerance << ' ' << h.swap_roles << ' ' << h.suction_delivery
+       << ' ' << h.table_regrasp.relay << ' ' << h.table_regrasp.relay_spots << ' '
+       << h.table_regrasp.relay_spacing;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& t = s.tool_relay;
   text << "\ntool_relay " << t.spacing << ' ' << t.yaw_steps << ' ' << t.clearance;

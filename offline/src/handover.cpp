@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <random>
 
@@ -231,14 +232,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   reset_state();
 
   // --- Human grasps usable for this board -------------------------------------------------
-  std::vector<int> eligible;
+  // One hand holds the part at its one-hand-stable grasps; two hands at any pair of grasps far
+  // enough apart. The human takes it with one hand where that is comfortable, else with two.
+  std::vector<int> eligible, both_hands;
   for (std::size_t g = 0; g < grasps.human.size(); ++g) {
     if (grasps.human[g].one_hand_stable) eligible.push_back(static_cast<int>(g));
+    both_hands.push_back(static_cast<int>(g));
   }
   stage.two_hands = eligible.empty();
-  if (stage.two_hands) {
-    for (std::size_t g = 0; g < grasps.human.size(); ++g) eligible.push_back(static_cast<int>(g));
-  }
   auto human_hand_clear = [&](const core::Pose& board, int hand_slot, int grasp) {
     const auto& g = grasps.human[static_cast<std::size_t>(grasp)];
     place_hand(screen_data, screen_hands[hand_slot], board * g.hand,
@@ -268,13 +269,13 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         }
       }
       park_hand(screen_data, screen_hands[0]);
-      return best;
+      if (best.quality > settings.comfort_threshold) return best;
     }
     // Two hands: one grasp per arm, far enough apart, both clear.
     if (arms < 2) return best;
     std::vector<ScoredGrasp> lists[2];
     for (int a = 0; a < 2; ++a) {
-      for (const auto& s : score_grasps(comfort, a, board, grasps.human, eligible)) {
+      for (const auto& s : score_grasps(comfort, a, board, grasps.human, both_hands)) {
         if (lists[a].size() >= 10) break;
         if (human_hand_clear(board, a, s.grasp)) lists[a].push_back(s);
       }
@@ -718,6 +719,75 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       scene.cell.arm_bodies[static_cast<std::size_t>(scene.suction_arm)];
   suction_arm_and_tool.insert(suction_arm_and_tool.end(), scene.tool_bodies.begin(),
                               scene.tool_bodies.end());
+  // The suction arm holds the board at `board` on suction grasp s, clear of the cell, and its home
+  // (with the tool) is clear of the board there: an exchange here must not trap the suction arm,
+  // which goes home once the receiving arm holds the board. Leaves the arm and the tool posed at
+  // the hold.
+  auto hold_on_cup = [&](const core::Pose& board, int s, Eigen::VectorXd& suction_q) {
+    const core::Pose tcp =
+        board * grasps.suction[static_cast<std::size_t>(s)].cup * scene.cup_in_tcp.inverse();
+    const int n = suction_arm.ur_ik->solve(suction_base_inv * tcp, suction_arm.spec.home, ik);
+    if (n == 0) return false;
+    data.set_body_pose(scene.board, board);
+    core::set_tool_held(cell, scene, data, tcp);
+    bool held = false;
+    for (int k = 0; k < n && !held; ++k) {
+      cell.set_arm(robot_q, suction_arm, ik.q[static_cast<std::size_t>(k)]);
+      core::set_robot_state(cell, scene.cell, data, robot_q);
+      if (!core::in_collision(scene.cell.model, data, suction_bodies)) {
+        held = true;
+        suction_q = ik.q[static_cast<std::size_t>(k)];
+      }
+    }
+    if (!held) return false;
+    cell.set_arm(robot_q, suction_arm, suction_arm.spec.home);
+    core::set_robot_state(cell, scene.cell, data, robot_q);
+    core::set_tool_held(cell, scene, data, suction_home_tcp);
+    if (core::in_collision(scene.cell.model, data, suction_arm_and_tool)) {
+      ++trapping;
+      return false;
+    }
+    cell.set_arm(robot_q, suction_arm, suction_q);
+    core::set_robot_state(cell, scene.cell, data, robot_q);
+    core::set_tool_held(cell, scene, data, tcp);
+    return true;
+  };
+  // The receiving arm takes the board held at `board` (suction grasp s, the suction arm at
+  // suction_q) with each of `wanted` that has fewer than rr_per_grasp poses yet (its way in
+  // included); a robot-robot pose is kept when any does. Returns how many took it.
+  auto receive_held = [&](const core::Pose& board, int s, const Eigen::VectorXd& suction_q,
+                          const std::vector<int>& wanted) {
+    std::vector<Receiving> received;
+    for (const int g : wanted) {
+      // A grasp with its rr_per_grasp poses already is not looked at again (only those are
+      // stored): the way-in check makes each look costly.
+      if (static_cast<int>(rr_of_grasp[static_cast<std::size_t>(g)].size()) >=
+          settings.rr_per_grasp) {
+        continue;
+      }
+      Receiving r;
+      if (receive(board, g, receiving_bodies, true, r)) received.push_back(r);
+    }
+    restore_receiving();
+    if (received.empty()) return 0;
+    db::RobotHandoverRecord rr;
+    rr.board = board;
+    rr.suction_grasp_id = s;
+    rr.arm = suction_arm.spec.name;
+    rr.joints = suction_q;
+    for (const auto& r : received) {
+      auto& poses = rr_of_grasp[static_cast<std::size_t>(r.grasp)];
+      if (static_cast<int>(poses.size()) < settings.rr_per_grasp) {
+        poses.push_back(static_cast<int>(result.robot_handovers.size()));
+      }
+    }
+    result.robot_handovers.push_back(rr);
+    const int n = static_cast<int>(received.size());
+    rr_grasps.push_back(std::move(received));
+    return n;
+  };
+  std::vector<int> all_grasps(grasps.robot.size());
+  std::iota(all_grasps.begin(), all_grasps.end(), 0);
   for (const int combo : order) {
     if (examined >= settings.rr_poses || !exchange_failure.empty()) break;
     const int s = combo % n_suction;
@@ -727,65 +797,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     core::Pose board = core::Pose::Identity();
     board.linear() = orientations[static_cast<std::size_t>(o)];
     board.translation() = settings.rr_positions[static_cast<std::size_t>(p)];
-    const core::Pose tcp =
-        board * grasps.suction[static_cast<std::size_t>(s)].cup * scene.cup_in_tcp.inverse();
-    const int n = suction_arm.ur_ik->solve(suction_base_inv * tcp, suction_arm.spec.home, ik);
-    if (n == 0) continue;
-    data.set_body_pose(scene.board, board);
-    core::set_tool_held(cell, scene, data, tcp);
-    bool held = false;
     Eigen::VectorXd suction_q;
-    for (int k = 0; k < n && !held; ++k) {
-      cell.set_arm(robot_q, suction_arm, ik.q[static_cast<std::size_t>(k)]);
-      core::set_robot_state(cell, scene.cell, data, robot_q);
-      if (!core::in_collision(scene.cell.model, data, suction_bodies)) {
-        held = true;
-        suction_q = ik.q[static_cast<std::size_t>(k)];
-      }
-    }
-    // An exchange here must not trap the suction arm: once the receiving arm holds the board, the
-    // suction arm goes home, so its home (with the tool) must be clear of the board at this pose.
-    if (held) {
-      cell.set_arm(robot_q, suction_arm, suction_arm.spec.home);
-      core::set_robot_state(cell, scene.cell, data, robot_q);
-      core::set_tool_held(cell, scene, data, suction_home_tcp);
-      if (core::in_collision(scene.cell.model, data, suction_arm_and_tool)) {
-        held = false;
-        ++trapping;
-      }
-      cell.set_arm(robot_q, suction_arm, suction_q);
-      core::set_robot_state(cell, scene.cell, data, robot_q);
-      core::set_tool_held(cell, scene, data, tcp);
-    }
-    if (held) {
+    if (hold_on_cup(board, s, suction_q)) {
       ++examined;
-      std::vector<Receiving> received;
-      for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
-        // A grasp with its rr_per_grasp poses already is not looked at again (only those are
-        // stored): the way-in check makes each look costly.
-        if (static_cast<int>(rr_of_grasp[static_cast<std::size_t>(g)].size()) >=
-            settings.rr_per_grasp) {
-          continue;
-        }
-        Receiving r;
-        if (receive(board, g, receiving_bodies, true, r)) received.push_back(r);
-      }
-      restore_receiving();
-      if (!received.empty()) {
-        db::RobotHandoverRecord rr;
-        rr.board = board;
-        rr.suction_grasp_id = s;
-        rr.arm = suction_arm.spec.name;
-        rr.joints = suction_q;
-        for (const auto& r : received) {
-          auto& poses = rr_of_grasp[static_cast<std::size_t>(r.grasp)];
-          if (static_cast<int>(poses.size()) < settings.rr_per_grasp) {
-            poses.push_back(static_cast<int>(result.robot_handovers.size()));
-          }
-        }
-        result.robot_handovers.push_back(rr);
-        rr_grasps.push_back(std::move(received));
-      }
+      receive_held(board, s, suction_q, all_grasps);
     }
     reset_state();
   }
@@ -890,6 +905,92 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
                                      .cwiseMin(chain.upper_limits());
     return core::best_comfort(chain, hand, seed, ik_settings);
   };
+  // A candidate the human's own IK finds uncomfortable at the grasps the maps chose may be
+  // comfortable at others: a map bin holds the best Q of hand orientations up to ~35 degrees
+  // apart (ComfortMapSettings::orientations), which the wrist may not all reach. The human's
+  // grasps by the maps' Q (up to 12 per arm, as choose_human, clear of the cell) confirmed by the
+  // arm's IK above the threshold: one hand where one does, else the best pair far enough apart and
+  // clear together. The candidate takes the best by the IK's Q; false when none is confirmed.
+  auto rechoose_human = [&](int ci) {
+    auto& c = result.candidates[static_cast<std::size_t>(ci)];
+    HumanChoice& h = choices[static_cast<std::size_t>(ci)];
+    struct Confirmed {
+      int grasp;
+      double quality;
+    };
+    const int arms = std::min(comfort.arm_count(), 2);
+    // Per arm, the grasps of `from` the IK confirms.
+    auto confirm = [&](const std::vector<int>& from, std::vector<Confirmed>(&out)[2]) {
+      for (int a = 0; a < arms; ++a) {
+        int tried = 0;
+        for (const auto& sg : score_grasps(comfort, a, c.board, grasps.human, from)) {
+          if (++tried > 12) break;
+          if (!human_hand_clear(c.board, a, sg.grasp)) continue;
+          const core::ComfortResult r = solve_human(c.board, a, sg.grasp);
+          if (r.reachable && r.quality > threshold) out[a].push_back({sg.grasp, r.quality});
+        }
+        park_hand(screen_data, screen_hands[a]);
+      }
+    };
+    screen_data.set_body_pose(screen_board, c.board);
+    HumanChoice best;
+    if (!eligible.empty()) {
+      std::vector<Confirmed> one[2];
+      confirm(eligible, one);
+      for (int a = 0; a < arms; ++a) {
+        for (const Confirmed& k : one[a]) {
+          if (k.quality <= best.quality) continue;
+          best.quality = best.arm_quality = k.quality;
+          best.arm = a;
+          best.grasp = k.grasp;
+        }
+      }
+    }
+    if (best.grasp < 0 && arms == 2) {
+      std::vector<Confirmed> two[2];
+      confirm(both_hands, two);
+      for (const Confirmed& k0 : two[0]) {
+        for (const Confirmed& k1 : two[1]) {
+          const double q = std::min(k0.quality, k1.quality);
+          if (q <= best.quality) continue;
+          const auto& g0 = grasps.human[static_cast<std::size_t>(k0.grasp)];
+          const auto& g1 = grasps.human[static_cast<std::size_t>(k1.grasp)];
+          if ((g0.hand.translation() - g1.hand.translation()).norm() <
+              settings.two_hand_separation) {
+            continue;
+          }
+          place_hand(screen_data, screen_hands[0], c.board * g0.hand,
+                     g0.aperture + kHandOpeningMargin);
+          place_hand(screen_data, screen_hands[1], c.board * g1.hand,
+                     g1.aperture + kHandOpeningMargin);
+          if (core::in_collision(screen, screen_data, screen_hands[0].all())) continue;
+          best.quality = q;
+          best.arm = 0;
+          best.grasp = k0.grasp;
+          best.arm_quality = k0.quality;
+          best.second_arm = 1;
+          best.second_grasp = k1.grasp;
+          best.second_quality = k1.quality;
+        }
+      }
+      park_hand(screen_data, screen_hands[0]);
+      park_hand(screen_data, screen_hands[1]);
+    }
+    screen_data.set_body_pose(screen_board, kParked);
+    if (best.grasp < 0) return false;
+    best.default_quality = h.default_quality;
+    h = best;
+    c.quality = best.quality;
+    c.human_arm = comfort.arm_name(best.arm);
+    c.human_grasp_id = best.grasp;
+    c.human_quality = best.arm_quality;
+    c.second_grasp_id = best.second_grasp;
+    if (best.second_grasp >= 0) {
+      c.second_arm = comfort.arm_name(best.second_arm);
+      c.second_quality = best.second_quality;
+    }
+    return true;
+  };
   int verified = 0;
   int human_ik_rejected = 0;  // candidates a way served that the human's own IK then rejected
   // At the robot-human pose the receiving arm and the board it holds move against the rest.
@@ -901,217 +1002,233 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   bool relays_allowed = false;
   // The relay pass: the candidates searched before for every other way, which found none.
   bool relays_only = false;
-  auto search_shared = [&] {
+  // The human's grasps are chosen again by IK (rechoose_human) only for a part no way serves at
+  // any candidate the maps' grasps pass: where it has goals, they are kept as the maps rank them.
+  bool rechoose_allowed = false;
+  std::vector<int> ik_rejected;  // candidates the human's IK rejected at the maps' grasps
+  // `only`: these candidates alone (those still unserved), else those from `searched` on.
+  auto search_shared = [&](const std::vector<int>* only = nullptr) {
     std::vector<int> comfortable;
-    for (std::size_t i = searched; i < result.candidates.size(); ++i) {
-      if (result.candidates[i].status == "no_shared_grasp")
+    for (std::size_t i = only ? 0 : searched; i < result.candidates.size(); ++i) {
+      if (result.candidates[i].status == "no_shared_grasp" &&
+          (!only || std::find(only->begin(), only->end(), static_cast<int>(i)) != only->end())) {
         comfortable.push_back(static_cast<int>(i));
+      }
     }
-    searched = result.candidates.size();
+    if (!only) searched = result.candidates.size();
     std::stable_sort(comfortable.begin(), comfortable.end(), [&](int a, int b) {
       return result.candidates[static_cast<std::size_t>(a)].distance <
              result.candidates[static_cast<std::size_t>(b)].distance;
     });
     for (const int ci : comfortable) {
-      auto& c = result.candidates[static_cast<std::size_t>(ci)];
-      const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
-      // The board at the candidate with the human's hands at their grasps (again after an arm's
-      // checks reset the scene).
-      const auto at_candidate = [&] {
-        data.set_body_pose(scene.board, c.board);
-        const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
-        place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
-        if (h.second_grasp >= 0) {
-          const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-          place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
-        }
-      };
-      at_candidate();
-      int shared = 0;
-      for (int g = 0; g < static_cast<int>(grasps.robot.size()) && !relays_only; ++g) {
-        const auto& poses = rr_of_grasp[static_cast<std::size_t>(g)];
-        if (poses.empty()) continue;
-        Receiving at_rh;
-        if (!receive(c.board, g, rh_bodies, false, at_rh)) continue;
-        ++shared;
-        // One record per rr pose: the regrasp graph takes the next when a pose's suction
-        // transfer is cut in the roadmap.
-        for (const int rr : poses) {
-          const auto& at_rr = rr_grasps[static_cast<std::size_t>(rr)];
-          const auto it = std::find_if(at_rr.begin(), at_rr.end(),
-                                       [&](const Receiving& r) { return r.grasp == g; });
-          db::SharedGraspRecord s;
-          s.candidate_id = ci;
-          s.robot_grasp_id = g;
-          s.robot_handover_id = rr;
-          s.arm = receiving_arm.spec.name;
-          s.joints_rr = it->joints;
-          s.joints_rh = at_rh.joints;
-          s.inclination_rr_deg = it->slip_deg;
-          s.inclination_rh_deg = at_rh.slip_deg;
-          result.shared.push_back(s);
-        }
-        if (shared >= settings.shared_stored) break;  // membership in 𝕊 is settled
-      }
-      restore_receiving();
-      int direct = 0;
-      for (const DirectArm& d : direct_arms) {
-        if (relays_only) break;
-        if (d.tool_on_table) {
-          core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
-                               product.suction_tool_pose);
-        }
-        int stored = 0;
-        for (const Receiving& at_pick : d.picks) {
-          Receiving at_rh;
-          if (!reach_with(*d.arm, d.base_inv, c.board, at_pick.grasp, d.bodies, false, at_rh)) {
-            continue;
+      bool rechosen = false;  // the human's grasps chosen again by their IK (rechoose_human)
+      for (bool search_again = true; search_again;) {
+        search_again = false;
+        auto& c = result.candidates[static_cast<std::size_t>(ci)];
+        const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
+        // The board at the candidate with the human's hands at their grasps (again after an arm's
+        // checks reset the scene).
+        const auto at_candidate = [&] {
+          data.set_body_pose(scene.board, c.board);
+          const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
+          place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
+          if (h.second_grasp >= 0) {
+            const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+            place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
           }
-          db::DirectGraspRecord r;
-          r.candidate_id = ci;
-          r.robot_grasp_id = at_pick.grasp;
-          r.arm = d.arm->spec.name;
-          r.joints_pick = at_pick.joints;
-          r.joints_rh = at_rh.joints;
-          r.inclination_pick_deg = at_pick.slip_deg;
-          r.inclination_rh_deg = at_rh.slip_deg;
-          result.direct.push_back(r);
-          ++direct;
-          if (++stored >= settings.direct_stored) break;
-        }
-        restore_arm(*d.arm);
-        reset_state();
+        };
         at_candidate();
-      }
-      reset_state();
-      // Table regrasps of this candidate from `d`'s set-downs `downs`, taken again by `to` (d
-      // itself, or the other arm for a relay): up to direct_stored whose delivering grasp `to`
-      // also holds at the candidate.
-      int regrasps = 0;
-      auto store_set_downs = [&](const DirectArm& d, DirectArm& to,
-                                 const std::vector<DirectArm::SetDown>& downs) {
-        if (downs.empty()) return;
-        if (to.tool_on_table) {
-          core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
-                               product.suction_tool_pose);
+        int shared = 0;
+        for (int g = 0; g < static_cast<int>(grasps.robot.size()) && !relays_only; ++g) {
+          const auto& poses = rr_of_grasp[static_cast<std::size_t>(g)];
+          if (poses.empty()) continue;
+          Receiving at_rh;
+          if (!receive(c.board, g, rh_bodies, false, at_rh)) continue;
+          ++shared;
+          // One record per rr pose: the regrasp graph takes the next when a pose's suction
+          // transfer is cut in the roadmap.
+          for (const int rr : poses) {
+            const auto& at_rr = rr_grasps[static_cast<std::size_t>(rr)];
+            const auto it = std::find_if(at_rr.begin(), at_rr.end(),
+                                         [&](const Receiving& r) { return r.grasp == g; });
+            db::SharedGraspRecord s;
+            s.candidate_id = ci;
+            s.robot_grasp_id = g;
+            s.robot_handover_id = rr;
+            s.arm = receiving_arm.spec.name;
+            s.joints_rr = it->joints;
+            s.joints_rh = at_rh.joints;
+            s.inclination_rr_deg = it->slip_deg;
+            s.inclination_rh_deg = at_rh.slip_deg;
+            result.shared.push_back(s);
+          }
+          if (shared >= settings.shared_stored) break;  // membership in 𝕊 is settled
         }
-        int stored = 0;
-        for (const auto& down : downs) {
-          for (const Receiving& again : down.repicks) {
+        restore_receiving();
+        int direct = 0;
+        for (const DirectArm& d : direct_arms) {
+          if (relays_only) break;
+          if (d.tool_on_table) {
+            core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                                 product.suction_tool_pose);
+          }
+          int stored = 0;
+          for (const Receiving& at_pick : d.picks) {
             Receiving at_rh;
-            if (!reach_with(*to.arm, to.base_inv, c.board, again.grasp, to.bodies, false, at_rh)) {
+            if (!reach_with(*d.arm, d.base_inv, c.board, at_pick.grasp, d.bodies, false, at_rh)) {
               continue;
             }
-            db::TableRegraspRecord r;
+            db::DirectGraspRecord r;
             r.candidate_id = ci;
-            r.pick_grasp_id = down.pick.grasp;
-            r.robot_grasp_id = again.grasp;
+            r.robot_grasp_id = at_pick.grasp;
             r.arm = d.arm->spec.name;
-            r.repick_arm = to.arm->spec.name;
-            r.placement = down.board;
-            r.joints_pick = down.pick.joints;
-            r.joints_place = down.place.joints;
-            r.joints_repick = again.joints;
+            r.joints_pick = at_pick.joints;
             r.joints_rh = at_rh.joints;
-            r.inclination_pick_deg = down.pick.slip_deg;
-            r.inclination_place_deg = down.place.slip_deg;
-            r.inclination_repick_deg = again.slip_deg;
+            r.inclination_pick_deg = at_pick.slip_deg;
             r.inclination_rh_deg = at_rh.slip_deg;
-            result.regrasps.push_back(r);
-            ++regrasps;
+            result.direct.push_back(r);
+            ++direct;
             if (++stored >= settings.direct_stored) break;
           }
-          if (stored >= settings.direct_stored) break;
+          restore_arm(*d.arm);
+          reset_state();
+          at_candidate();
         }
-        restore_arm(*to.arm);
         reset_state();
-        at_candidate();
-      };
-      if (shared == 0 && direct == 0 && settings.table_regrasp.enabled && !relays_only) {
-        for (DirectArm& d : direct_arms) store_set_downs(d, d, set_downs_of(d));
-        reset_state();
-      }
-      // Relays: an arm that picks the part sets it down where the other arm takes it again.
-      if (shared == 0 && direct == 0 && regrasps == 0 && settings.table_regrasp.enabled &&
-          settings.table_regrasp.relay && relays_allowed) {
-        for (DirectArm& d : direct_arms) {
-          for (auto* group : {&direct_arms, &relay_only_arms}) {
-            for (DirectArm& to : *group) {
-              if (to.arm != d.arm) store_set_downs(d, to, relays_of(d, to));
+        // Table regrasps of this candidate from `d`'s set-downs `downs`, taken again by `to` (d
+        // itself, or the other arm for a relay): up to direct_stored whose delivering grasp `to`
+        // also holds at the candidate.
+        int regrasps = 0;
+        auto store_set_downs = [&](const DirectArm& d, DirectArm& to,
+                                   const std::vector<DirectArm::SetDown>& downs) {
+          if (downs.empty()) return;
+          if (to.tool_on_table) {
+            core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
+                                 product.suction_tool_pose);
+          }
+          int stored = 0;
+          for (const auto& down : downs) {
+            for (const Receiving& again : down.repicks) {
+              Receiving at_rh;
+              if (!reach_with(*to.arm, to.base_inv, c.board, again.grasp, to.bodies, false,
+                              at_rh)) {
+                continue;
+              }
+              db::TableRegraspRecord r;
+              r.candidate_id = ci;
+              r.pick_grasp_id = down.pick.grasp;
+              r.robot_grasp_id = again.grasp;
+              r.arm = d.arm->spec.name;
+              r.repick_arm = to.arm->spec.name;
+              r.placement = down.board;
+              r.joints_pick = down.pick.joints;
+              r.joints_place = down.place.joints;
+              r.joints_repick = again.joints;
+              r.joints_rh = at_rh.joints;
+              r.inclination_pick_deg = down.pick.slip_deg;
+              r.inclination_place_deg = down.place.slip_deg;
+              r.inclination_repick_deg = again.slip_deg;
+              r.inclination_rh_deg = at_rh.slip_deg;
+              result.regrasps.push_back(r);
+              ++regrasps;
+              if (++stored >= settings.direct_stored) break;
+            }
+            if (stored >= settings.direct_stored) break;
+          }
+          restore_arm(*to.arm);
+          reset_state();
+          at_candidate();
+        };
+        if (shared == 0 && direct == 0 && settings.table_regrasp.enabled && !relays_only) {
+          for (DirectArm& d : direct_arms) store_set_downs(d, d, set_downs_of(d));
+          reset_state();
+        }
+        // Relays: an arm that picks the part sets it down where the other arm takes it again.
+        if (shared == 0 && direct == 0 && regrasps == 0 && settings.table_regrasp.enabled &&
+            settings.table_regrasp.relay && relays_allowed) {
+          for (DirectArm& d : direct_arms) {
+            for (auto* group : {&direct_arms, &relay_only_arms}) {
+              for (DirectArm& to : *group) {
+                if (to.arm != d.arm) store_set_downs(d, to, relays_of(d, to));
+              }
             }
           }
+          reset_state();
         }
-        reset_state();
-      }
-      int on_cup = 0;
-      if (shared == 0 && direct == 0 && regrasps == 0 && suction_deliverable && !relays_only) {
-        at_candidate();
-        for (int s = 0; s < n_suction && on_cup < settings.direct_stored; ++s) {
-          if (!pickable[static_cast<std::size_t>(s)]) continue;
-          const core::Pose tcp = c.board * grasps.suction[static_cast<std::size_t>(s)].cup *
-                                 scene.cup_in_tcp.inverse();
-          const int n = suction_arm.ur_ik->solve(suction_base_inv * tcp, suction_arm.spec.home, ik);
-          for (int k = 0; k < n; ++k) {
-            cell.set_arm(robot_q, suction_arm, ik.q[static_cast<std::size_t>(k)]);
-            core::set_robot_state(cell, scene.cell, data, robot_q);
-            core::set_tool_held(cell, scene, data, tcp);
-            if (core::in_collision(scene.cell.model, data, suction_bodies)) continue;
-            db::SuctionDeliveryRecord r;
-            r.candidate_id = ci;
-            r.suction_grasp_id = s;
-            r.arm = suction_arm.spec.name;
-            r.joints_rh = ik.q[static_cast<std::size_t>(k)];
-            result.suction_deliveries.push_back(r);
-            ++on_cup;
-            break;
+        int on_cup = 0;
+        if (shared == 0 && direct == 0 && regrasps == 0 && suction_deliverable && !relays_only) {
+          at_candidate();
+          for (int s = 0; s < n_suction && on_cup < settings.direct_stored; ++s) {
+            if (!pickable[static_cast<std::size_t>(s)]) continue;
+            const core::Pose tcp = c.board * grasps.suction[static_cast<std::size_t>(s)].cup *
+                                   scene.cup_in_tcp.inverse();
+            const int n =
+                suction_arm.ur_ik->solve(suction_base_inv * tcp, suction_arm.spec.home, ik);
+            for (int k = 0; k < n; ++k) {
+              cell.set_arm(robot_q, suction_arm, ik.q[static_cast<std::size_t>(k)]);
+              core::set_robot_state(cell, scene.cell, data, robot_q);
+              core::set_tool_held(cell, scene, data, tcp);
+              if (core::in_collision(scene.cell.model, data, suction_bodies)) continue;
+              db::SuctionDeliveryRecord r;
+              r.candidate_id = ci;
+              r.suction_grasp_id = s;
+              r.arm = suction_arm.spec.name;
+              r.joints_rh = ik.q[static_cast<std::size_t>(k)];
+              result.suction_deliveries.push_back(r);
+              ++on_cup;
+              break;
+            }
+          }
+          reset_state();
+        }
+        if (shared == 0 && direct == 0 && regrasps == 0 && on_cup == 0) continue;
+        // The first goals are confirmed by direct IK of the human arm(s): the map's orientation
+        // bins are coarse, so a bin's Q may come from a neighbouring hand orientation.
+        if (verified < settings.human_ik_goals) {
+          const core::ComfortResult first = solve_human(c.board, h.arm, h.grasp);
+          core::ComfortResult second;
+          if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
+          const double q =
+              h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
+          if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) || q <= threshold) {
+            // The ways were found with the human's hands at the maps' grasps: they go.
+            std::erase_if(result.shared,
+                          [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; });
+            std::erase_if(result.direct,
+                          [&](const db::DirectGraspRecord& r) { return r.candidate_id == ci; });
+            std::erase_if(result.regrasps,
+                          [&](const db::TableRegraspRecord& r) { return r.candidate_id == ci; });
+            std::erase_if(result.suction_deliveries,
+                          [&](const db::SuctionDeliveryRecord& r) { return r.candidate_id == ci; });
+            // Comfortable at grasps the human's IK confirms: the ways are searched again with the
+            // hands there.
+            if (rechoose_allowed && !rechosen && rechoose_human(ci)) {
+              rechosen = true;
+              search_again = true;
+              continue;
+            }
+            // Not comfortable after all: out of S.
+            c.status = "uncomfortable";
+            c.quality = q;
+            ++human_ik_rejected;
+            if (threshold == settings.comfort_threshold) --stage.comfortable;
+            if (!rechoose_allowed) ik_rejected.push_back(ci);
+            continue;
+          }
+          ++verified;
+          // Below the stated threshold the goal says how comfortable the human's own IK found it
+          // where that is less than the maps' Q: the plan reports it as delivered below.
+          if (threshold < settings.comfort_threshold) c.quality = std::min(c.quality, q);
+          c.human_joints = first.joints;
+          c.human_quality = first.quality;
+          if (h.second_grasp >= 0) {
+            c.second_joints = second.joints;
+            c.second_quality = second.quality;
           }
         }
-        reset_state();
+        c.status = "goal";
+        ++stage.goals;
       }
-      if (shared == 0 && direct == 0 && regrasps == 0 && on_cup == 0) continue;
-      // The first goals are confirmed by direct IK of the human arm(s): the map's orientation bins
-      // are coarse, so a bin's Q may come from a neighbouring hand orientation.
-      if (verified < settings.human_ik_goals) {
-        const core::ComfortResult first = solve_human(c.board, h.arm, h.grasp);
-        core::ComfortResult second;
-        if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
-        const double q =
-            h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
-        if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) || q <= threshold) {
-          // Not comfortable after all: out of S, and its shared grasps go.
-          c.status = "uncomfortable";
-          c.quality = q;
-          ++human_ik_rejected;
-          if (threshold == settings.comfort_threshold) --stage.comfortable;
-          result.shared.erase(
-              std::remove_if(result.shared.begin(), result.shared.end(),
-                             [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; }),
-              result.shared.end());
-          result.direct.erase(
-              std::remove_if(result.direct.begin(), result.direct.end(),
-                             [&](const db::DirectGraspRecord& r) { return r.candidate_id == ci; }),
-              result.direct.end());
-          result.regrasps.erase(
-              std::remove_if(result.regrasps.begin(), result.regrasps.end(),
-                             [&](const db::TableRegraspRecord& r) { return r.candidate_id == ci; }),
-              result.regrasps.end());
-          std::erase_if(result.suction_deliveries,
-                        [&](const db::SuctionDeliveryRecord& r) { return r.candidate_id == ci; });
-          continue;
-        }
-        ++verified;
-        // Below the stated threshold the goal says how comfortable the human's own IK found it
-        // where that is less than the maps' Q: the plan reports it as delivered below.
-        if (threshold < settings.comfort_threshold) c.quality = std::min(c.quality, q);
-        c.human_joints = first.joints;
-        c.human_quality = first.quality;
-        if (h.second_grasp >= 0) {
-          c.second_joints = second.joints;
-          c.second_quality = second.quality;
-        }
-      }
-      c.status = "goal";
-      ++stage.goals;
     }
     reset_state();
   };
@@ -1121,6 +1238,18 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
          stage.draws < settings.max_draws) {
     sample_candidates(std::min(settings.max_candidates, stage.candidates + settings.candidates));
     search_shared();
+  }
+  // No goal: the candidates the human's IK rejected, with the human's grasps chosen again by IK.
+  rechoose_allowed = true;
+  if (stage.goals == 0 && !ik_rejected.empty()) {
+    for (const int ci : ik_rejected) {
+      auto& c = result.candidates[static_cast<std::size_t>(ci)];
+      c.status = "no_shared_grasp";
+      c.quality = choices[static_cast<std::size_t>(ci)].quality;
+      --human_ik_rejected;
+      if (threshold == settings.comfort_threshold) ++stage.comfortable;
+    }
+    search_shared(&ik_rejected);
   }
   if (stage.goals == 0 && settings.direct && settings.table_regrasp.enabled &&
       settings.table_regrasp.relay && !relay_poses.empty() && !direct_arms.empty()) {

@@ -89,10 +89,10 @@ struct HandoverSettings {
 struct HandoverResult {
   db::HandoverStageRecord stage;
   std::vector<db::RobotHandoverRecord> robot_handovers;
-  std::vector<db::HandoverCandidateRecord> candidates;  // in sample order
-  std::vector<db::SharedGraspRecord> shared;            // for the goals, by rank
-  std::vector<db::DirectGraspRecord> direct;            // for the goals, by rank
-  std::vector<db::TableRegraspRecord> regrasps;         // for the goals, by rank
+  std::vector<db::HandoverCandidateRecord> candidates;        // in sample order
+  std::vector<db::SharedGraspRecord> shared;                  // for the goals, by rank
+  std::vector<db::DirectGraspRecord> direct;                  // for the goals, by rank
+  std::vector<db::TableRegraspRecord> regrasps;               // for the goals, by rank
   std::vector<db::SuctionDeliveryRecord> suction_deliveries;  // for the goals, by rank
   double seconds = 0.0;
 };
