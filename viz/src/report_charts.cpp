@@ -265,4 +265,73 @@ std::string timeline_svg(const PlanFile& plan) {
   return s + "</svg>\n";
 }
 
+std::string ergonomics_svg(const std::vector<ReportErgonomics>& rows, double bent_forward_deg) {
+  // Boards in assembly order, the methods in the comparison's order.
+  constexpr const char* kMethods[] = {"hila", "table", "alone"};
+  constexpr double kBar = 9;
+  constexpr double kRow = 3 * kBar + 10;
+  std::map<std::pair<int, std::string>, std::map<std::string, const ReportErgonomics*>> boards;
+  double most = bent_forward_deg + 10.0;
+  for (const ReportErgonomics& r : rows) {
+    boards[{r.order, r.part}][r.method] = &r;
+    if (r.reachable) most = std::max(most, r.torso_flexion_deg);
+  }
+  most = 10.0 * std::ceil(most / 10.0);
+  const auto x_of = [&](double deg) { return kLabelWidth + kPlotWidth * std::max(deg, 0.0) / most; };
+  const double plot_bottom = kTopMargin + kRow * static_cast<double>(boards.size());
+  const double height = plot_bottom + kAxisHeight + 18 + 16 * 3;
+  std::string s = open_svg(height, "Torso flexion per board: hila against the baselines");
+  std::map<std::string, int> bent, shoulder, unreachable;
+  std::size_t i = 0;
+  for (const auto& [key, methods] : boards) {
+    const double top = kTopMargin + kRow * static_cast<double>(i++);
+    s += text(4, top + kRow / 2 + 2, std::to_string(key.first) + " " + key.second);
+    for (int k = 0; k < 3; ++k) {
+      const double y = top + 2 + kBar * k;
+      const auto it = methods.find(kMethods[k]);
+      if (it == methods.end()) {
+        s += text(kLabelWidth + 3, y + kBar - 1, std::string(kMethods[k]) + ": -", "start",
+                  " class=\"small note\"");
+        continue;
+      }
+      const ReportErgonomics& r = *it->second;
+      if (!r.reachable) {
+        ++unreachable[r.method];
+        s += text(kLabelWidth + 3, y + kBar - 1, r.method + ": unreachable", "start",
+                  " class=\"small note\"");
+        continue;
+      }
+      bent[r.method] += r.torso_flexion_deg >= bent_forward_deg ? 1 : 0;
+      shoulder[r.method] += r.shoulder_elevated ? 1 : 0;
+      const double w = x_of(r.torso_flexion_deg) - kLabelWidth;
+      s += rect(kLabelWidth, y, w, kBar - 1, kPalette[k],
+                key.second + ", " + r.method + ": torso " + num(r.torso_flexion_deg, 0) +
+                    " deg, elbow " + (r.shoulder_elevated ? "at or above" : "below") +
+                    " the shoulder, reach " + num(r.reach, 2) + " m, re-orientation " +
+                    num(r.reorientation_deg, 0) + " deg, Q " + num(r.quality, 3));
+      s += text(kLabelWidth + w + 3, y + kBar - 1,
+                num(r.torso_flexion_deg, 0) + (r.shoulder_elevated ? " ▲ shoulder" : ""), "start",
+                " class=\"small\"");
+    }
+  }
+  const double bend = x_of(bent_forward_deg);
+  s += line(bend, kTopMargin, bend, plot_bottom, "class=\"board\"");
+  std::vector<double> ticks;
+  for (double d = 0; d <= most + 1e-9; d += most > 60 ? 20 : 10) ticks.push_back(d);
+  s += axis(plot_bottom, ticks, x_of, 0,
+            "torso flexion (deg); dashed: bent forward from " + num(bent_forward_deg, 0) +
+                " deg; ▲ elbow at or above the shoulder");
+  for (int k = 0; k < 3; ++k) {
+    const std::string m = kMethods[k];
+    const double y = plot_bottom + kAxisHeight + 8 + 16.0 * k;
+    s += rect(kLabelWidth, y, 10, 10, kPalette[k], m);
+    s += text(kLabelWidth + 14, y + 9,
+              m + ": " + std::to_string(bent[m]) + " bent forward, " +
+                  std::to_string(shoulder[m]) + " with shoulder work, " +
+                  std::to_string(unreachable[m]) + " unreachable",
+              "start", " class=\"small\"");
+  }
+  return s + "</svg>\n";
+}
+
 }  // namespace hila::viz

@@ -72,6 +72,8 @@ const char* report_viewer_script() {
   var clock = new THREE.Clock();
 
   var sceneMenu = document.getElementById('scene');
+  var clipMenu = document.getElementById('clip');
+  var clips = [];
   var playButton = document.getElementById('play');
   var slider = document.getElementById('time');
   var timeText = document.getElementById('time-text');
@@ -139,6 +141,15 @@ const char* report_viewer_script() {
     controls.update();
   }
 
+  function playClip(index, time) {
+    var clip = clips[index];
+    mixer.stopAllAction();
+    duration = clip.duration;
+    mixer.clipAction(clip).play();
+    mixer.setTime(Math.min(time, duration));
+    slider.max = duration;
+  }
+
   function open(index) {
     var source = sources[index];
     if (!source) {
@@ -160,12 +171,20 @@ const char* report_viewer_script() {
       frameView(gltf.scene);
       mixer = null;
       duration = 0;
-      if (gltf.animations.length > 0) {
-        var clip = gltf.animations[0];
-        duration = clip.duration;
+      // The animations: the first ("plan": the whole plan) plays; the menu picks another (a
+      // board's own).
+      clips = gltf.animations;
+      clipMenu.textContent = '';
+      clips.forEach(function (c, i) {
+        var option = document.createElement('option');
+        option.value = i;
+        option.textContent = c.name || ('animation ' + i);
+        clipMenu.appendChild(option);
+      });
+      clipMenu.hidden = clips.length < 2;
+      if (clips.length > 0) {
         mixer = new THREE.AnimationMixer(gltf.scene);
-        mixer.clipAction(clip).play();
-        mixer.setTime(fixedTime !== null ? Math.min(fixedTime, duration) : 0);
+        playClip(0, fixedTime !== null ? fixedTime : 0);
       }
       slider.max = duration;
       slider.disabled = playButton.disabled = !mixer;
@@ -187,6 +206,11 @@ const char* report_viewer_script() {
     sceneMenu.appendChild(option);
   });
   sceneMenu.addEventListener('change', function () { open(Number(sceneMenu.value)); });
+  clipMenu.addEventListener('change', function () {
+    if (!mixer) return;
+    playClip(Number(clipMenu.value), 0);
+    showTime(0);
+  });
   playButton.addEventListener('click', function () {
     playing = !playing;
     playButton.textContent = playing ? 'pause' : 'play';

@@ -20,6 +20,21 @@ struct ReportPart {
   std::string failure;               // why the part has no goal ("" when it has one)
 };
 
+// One board's ergonomics by one method as the database stores it (`hila report ergonomics`):
+// "hila" (the handover), "table" (laid flat on the table in front of the human) or "alone" (the
+// human from the stack).
+struct ReportErgonomics {
+  std::string part;
+  int order = 0;
+  std::string method;
+  bool reachable = false;
+  double torso_flexion_deg = 0.0;  // least forward bend needed
+  bool shoulder_elevated = false;  // elbow at or above the shoulder
+  double reach = 0.0;              // m, shoulder to hand
+  double reorientation_deg = 0.0;  // rotation left to bring the board to its target
+  double quality = 0.0;            // comfort Q of the posture
+};
+
 // The report's 3D scenes: glTF 2.0 binaries (.glb) as hila::viz writes them.
 struct ReportScene {
   std::string title;  // shown in the viewer's scene menu
@@ -38,7 +53,8 @@ struct ReportInput {
   std::string product;
   std::string database;  // as given on the command line
   std::vector<ReportPart> parts;
-  std::vector<ReportScene> scenes;  // the viewer opens the last; a scene's animation plays
+  std::vector<ReportErgonomics> ergonomics;  // empty: no ergonomics chart
+  std::vector<ReportScene> scenes;  // the viewer opens the last; its first animation plays
   const PlanFile* plan = nullptr;   // the timeline chart's plan; nullptr: none
   ThreeJs three;
 };
@@ -59,6 +75,11 @@ std::string theta_c_svg(const std::vector<ReportPart>& parts);
 std::string stages_svg(const std::vector<ReportPart>& parts);
 std::string goal_quality_svg(const std::vector<ReportPart>& parts);
 std::string timeline_svg(const PlanFile& plan);
+// Per board the torso flexion each method needs (bars: hila, table, alone; the EAWS bend at
+// `bent_forward_deg` dashed), an elbow at or above the shoulder and unreachable boards marked,
+// and the methods' counts of bent-forward and shoulder work below.
+std::string ergonomics_svg(const std::vector<ReportErgonomics>& rows,
+                           double bent_forward_deg = 20.0);
 
 // Base64 (RFC 4648, with padding) of `bytes`.
 std::string base64(const std::string& bytes);
