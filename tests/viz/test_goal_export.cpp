@@ -41,9 +41,12 @@ viz::GoalsView random_goals(const core::Cell& cell, const core::ProductSpec& pro
     if (i % 3 != 2) {
       const core::Arm& suction = cell.arms().at(static_cast<std::size_t>(i % 2));
       const core::Arm& receiving = cell.arms().at(static_cast<std::size_t>(1 - i % 2));
-      g.exchange = viz::ExchangeView{random_pose(rng), suction.spec.name,
-                                     random_joints(suction.chain, rng), receiving.spec.name,
-                                     random_joints(receiving.chain, rng), 0.01 + 0.005 * i};
+      g.exchange = viz::ExchangeView{random_pose(rng),
+                                     suction.spec.name,
+                                     random_joints(suction.chain, rng),
+                                     receiving.spec.name,
+                                     random_joints(receiving.chain, rng),
+                                     0.01 + 0.005 * i};
     }
     view.goals.push_back(g);
   }
@@ -118,9 +121,11 @@ TEST_F(GoalExport, TheHumanAtTheForwardKinematicsOfTheStoredPosture) {
                                     [&](const auto& a) { return a.spec.name == arm_name; });
       ASSERT_NE(arm, cell_->human_arms().end());
       const core::Pose base =
-          *view_.human_stance * links[static_cast<std::size_t>(human.link_index(arm->spec.base_link))];
-      EXPECT_LT(pose_error(in_goal(goal, "human/" + arm->spec.tip_link), base * arm->chain.fk(joints)),
-                1e-9)
+          *view_.human_stance *
+          links[static_cast<std::size_t>(human.link_index(arm->spec.base_link))];
+      EXPECT_LT(
+          pose_error(in_goal(goal, "human/" + arm->spec.tip_link), base * arm->chain.fk(joints)),
+          1e-9)
           << goal << " " << arm_name;
     }
   }
@@ -166,9 +171,8 @@ TEST_F(GoalExport, ThePartsColourRisesWithQ) {
     const int node = nodes_.at("goal:" + std::to_string(g.rank) + "/part");
     const int mesh = gltf_.nodes[static_cast<std::size_t>(node)].mesh;
     const int material = gltf_.meshes.at(static_cast<std::size_t>(mesh)).primitives.at(0).material;
-    by_q.emplace_back(
-        g.quality,
-        gltf_.materials.at(static_cast<std::size_t>(material)).pbrMetallicRoughness.baseColorFactor);
+    by_q.emplace_back(g.quality, gltf_.materials.at(static_cast<std::size_t>(material))
+                                     .pbrMetallicRoughness.baseColorFactor);
   }
   std::sort(by_q.begin(), by_q.end());
   for (std::size_t i = 1; i < by_q.size(); ++i) {

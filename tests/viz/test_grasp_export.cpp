@@ -145,16 +145,17 @@ TEST_F(GraspExport, TheGrippersLinksAtTheGraspsJawOpening) {
     cell_->set_jaw(q, arm, std::clamp(g.jaw_width, gripper.jaw_min, gripper.jaw_max));
     robot.link_poses(q, links);
     const core::Pose tcp_to_world =
-        view_.part_pose * g.tcp * links[static_cast<std::size_t>(robot.link_index(arm.spec.tip_link))].inverse();
+        view_.part_pose * g.tcp *
+        links[static_cast<std::size_t>(robot.link_index(arm.spec.tip_link))].inverse();
     const std::string name = "grasp:" + std::to_string(g.id) + "/";
     int found = 0;
     for (std::size_t l = 0; l < links.size(); ++l) {
       const auto it = nodes_.find(name + robot.links()[l].name);
       if (it == nodes_.end()) continue;
       ++found;
-      EXPECT_LT(pose_error(state_.world[static_cast<std::size_t>(it->second)],
-                           tcp_to_world * links[l]),
-                1e-9)
+      EXPECT_LT(
+          pose_error(state_.world[static_cast<std::size_t>(it->second)], tcp_to_world * links[l]),
+          1e-9)
           << name << robot.links()[l].name;
     }
     EXPECT_GE(found, 6) << name;  // flange, sensor, palm, two fingers, two pads, TCP

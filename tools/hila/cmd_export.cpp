@@ -109,8 +109,7 @@ CheckedDatabase open_part_database(const ExportPartOptions& opt) {
   const std::string cell_file = opt.cell_file.empty() ? default_cell_path() : opt.cell_file;
   const std::string product_file =
       opt.product_file.empty() ? default_product_path() : opt.product_file;
-  check_output_path("-o", opt.output,
-                    database_input_files(opt.database, cell_file, product_file));
+  check_output_path("-o", opt.output, database_input_files(opt.database, cell_file, product_file));
   return open_checked_database(opt.database, cell_file, product_file);
 }
 
@@ -120,8 +119,8 @@ int run_export_grasps(const ExportPartOptions& opt) {
   const std::string glb = viz::grasps_glb(*d.cell, view);
   write_file_atomically(opt.output, glb);
   std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes, " << view.gripper.size()
-            << " gripper grasp(s), " << view.suction.size() << " suction grasp(s) of "
-            << opt.part << ")\n";
+            << " gripper grasp(s), " << view.suction.size() << " suction grasp(s) of " << opt.part
+            << ")\n";
   return 0;
 }
 

@@ -130,7 +130,8 @@ int run_report_html(const ReportHtmlOptions& opt) {
     if (!part.goal_quality.empty()) {
       input.scenes.push_back(
           {"goals: " + part.name + " (the best " +
-               std::to_string(std::min(static_cast<std::size_t>(kReportGoals), part.goal_quality.size())) +
+               std::to_string(
+                   std::min(static_cast<std::size_t>(kReportGoals), part.goal_quality.size())) +
                ", by Q)",
            viz::goals_glb(*checked.cell, goals_view(checked, part.name, kReportGoals))});
     }

@@ -80,9 +80,9 @@ viz::GoalsView goals_view(const CheckedDatabase& d, const std::string& part, int
     for (const db::SharedGraspRecord& shared : d.database.shared_grasps(goal.id)) {
       const auto h = handovers.find(shared.robot_handover_id);
       if (h == handovers.end()) continue;
-      v.exchange = viz::ExchangeView{h->second.board,  h->second.arm,
-                                     h->second.joints, shared.arm,
-                                     shared.joints_rr, jaw_width[shared.robot_grasp_id]};
+      v.exchange =
+          viz::ExchangeView{h->second.board, h->second.arm,    h->second.joints,
+                            shared.arm,      shared.joints_rr, jaw_width[shared.robot_grasp_id]};
       break;
     }
     view.goals.push_back(std::move(v));

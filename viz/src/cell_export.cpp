@@ -49,7 +49,8 @@ std::vector<int> add_model_nodes(GltfBuilder& builder, const core::RobotModel& m
       mesh = options.meshes->at(key);
     } else {
       std::vector<Primitive> primitives;
-      for (const core::GeometrySpec& g : l.collisions) primitives.push_back({geometry_mesh(g), material});
+      for (const core::GeometrySpec& g : l.collisions)
+        primitives.push_back({geometry_mesh(g), material});
       mesh = builder.add_mesh(name, primitives);
       if (options.meshes) (*options.meshes)[key] = mesh;
     }

@@ -109,17 +109,17 @@ std::string goals_glb(const core::Cell& cell, const GoalsView& view,
       cell.set_arm(robot_q, suction, e.suction_joints);
       cell.set_jaw(robot_q, suction, cell.spec().suction.handle_width);
       cell.set_arm(robot_q, receiving, e.receiving_joints);
-      cell.set_jaw(robot_q, receiving,
-                   std::clamp(e.jaw_opening, cell.spec().gripper.jaw_min,
-                              cell.spec().gripper.jaw_max));
+      cell.set_jaw(
+          robot_q, receiving,
+          std::clamp(e.jaw_opening, cell.spec().gripper.jaw_min, cell.spec().gripper.jaw_max));
     }
     const std::vector<int> robot_nodes = add_model_nodes(
         builder, cell.robot(), robot_q, name + "/robot/", "", root, core::Pose::Identity(),
         [&](int link) { return gripper.count(link) ? m.gripper : m.robot; }, {-1, &meshes});
     if (goal.exchange) {
       const core::Arm& suction = cell.arm(goal.exchange->suction_arm);
-      const int tip = robot_nodes[static_cast<std::size_t>(
-          cell.robot().link_index(suction.spec.tip_link))];
+      const int tip =
+          robot_nodes[static_cast<std::size_t>(cell.robot().link_index(suction.spec.tip_link))];
       add_model_nodes(builder, tool, tool.neutral_configuration(), name + "/tool/", "", tip,
                       cell.spec().suction.handle_in_tcp * root_in_handle,
                       [&](int) { return m.tool; }, {-1, &meshes});

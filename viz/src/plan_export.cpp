@@ -306,7 +306,8 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
           times.push_back(tf);
           const core::Pose local = joint.origin * core::joint_motion(joint, value);
           if (prismatic) {
-            for (int c = 0; c < 3; ++c) values.push_back(static_cast<float>(local.translation()[c]));
+            for (int c = 0; c < 3; ++c)
+              values.push_back(static_cast<float>(local.translation()[c]));
           } else {
             Eigen::Quaterniond r(local.linear());
             if (r.dot(previous) < 0.0) r.coeffs() *= -1.0;  // the same rotation, no flips

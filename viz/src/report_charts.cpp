@@ -277,7 +277,9 @@ std::string ergonomics_svg(const std::vector<ReportErgonomics>& rows, double ben
     if (r.reachable) most = std::max(most, r.torso_flexion_deg);
   }
   most = 10.0 * std::ceil(most / 10.0);
-  const auto x_of = [&](double deg) { return kLabelWidth + kPlotWidth * std::max(deg, 0.0) / most; };
+  const auto x_of = [&](double deg) {
+    return kLabelWidth + kPlotWidth * std::max(deg, 0.0) / most;
+  };
   const double plot_bottom = kTopMargin + kRow * static_cast<double>(boards.size());
   const double height = plot_bottom + kAxisHeight + 18 + 16 * 3;
   std::string s = open_svg(height, "Torso flexion per board: hila against the baselines");
@@ -326,9 +328,8 @@ std::string ergonomics_svg(const std::vector<ReportErgonomics>& rows, double ben
     const double y = plot_bottom + kAxisHeight + 8 + 16.0 * k;
     s += rect(kLabelWidth, y, 10, 10, kPalette[k], m);
     s += text(kLabelWidth + 14, y + 9,
-              m + ": " + std::to_string(bent[m]) + " bent forward, " +
-                  std::to_string(shoulder[m]) + " with shoulder work, " +
-                  std::to_string(unreachable[m]) + " unreachable",
+              m + ": " + std::to_string(bent[m]) + " bent forward, " + std::to_string(shoulder[m]) +
+                  " with shoulder work, " + std::to_string(unreachable[m]) + " unreachable",
               "start", " class=\"small\"");
   }
   return s + "</svg>\n";

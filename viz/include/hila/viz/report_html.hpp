@@ -54,8 +54,8 @@ struct ReportInput {
   std::string database;  // as given on the command line
   std::vector<ReportPart> parts;
   std::vector<ReportErgonomics> ergonomics;  // empty: no ergonomics chart
-  std::vector<ReportScene> scenes;  // the viewer opens the last; its first animation plays
-  const PlanFile* plan = nullptr;   // the timeline chart's plan; nullptr: none
+  std::vector<ReportScene> scenes;           // the viewer opens the last; its first animation plays
+  const PlanFile* plan = nullptr;            // the timeline chart's plan; nullptr: none
   ThreeJs three;
 };
 
