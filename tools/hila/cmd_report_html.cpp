@@ -20,8 +20,23 @@ namespace hila::tools {
 
 namespace {
 
-// Goals shown per part.
+// Goals shown per part; gripper grasps drawn per part (a thousand per part would make the page
+// about 20 MB: `hila export grasps` writes them all).
 constexpr int kReportGoals = 5;
+constexpr std::size_t kReportGrasps = 120;
+
+// At most `count` of the view's gripper grasps, evenly spread over their θc order (the lowest and
+// the highest kept).
+void thin_grasps(viz::GraspsView& view, std::size_t count) {
+  auto& grasps = view.gripper;
+  if (grasps.size() <= count || count < 2) return;
+  std::stable_sort(grasps.begin(), grasps.end(),
+                   [](const auto& a, const auto& b) { return a.theta_c_deg < b.theta_c_deg; });
+  std::vector<viz::GripperGraspView> kept;
+  for (std::size_t i = 0; i < count; ++i)
+    kept.push_back(grasps[i * (grasps.size() - 1) / (count - 1)]);
+  grasps = std::move(kept);
+}
 
 // three.js's files under its folder (libjs-three's layout; the npm package's is the same).
 constexpr const char* kThreeFiles[] = {"build/three.min.js", "examples/js/loaders/GLTFLoader.js",
@@ -125,8 +140,13 @@ int run_report_html(const ReportHtmlOptions& opt) {
                           cell_scene_glb(cell_file, product_file)});
   // Each part's grasps and its best goals (as `export grasps` and `export goals` write them).
   for (const viz::ReportPart& part : input.parts) {
-    input.scenes.push_back({"grasps: " + part.name + " (gripper by θc, suction by margin)",
-                            viz::grasps_glb(*checked.cell, grasps_view(checked, part.name, ""))});
+    viz::GraspsView grasps = grasps_view(checked, part.name, "");
+    const std::size_t all = grasps.gripper.size();
+    thin_grasps(grasps, kReportGrasps);
+    input.scenes.push_back({"grasps: " + part.name + " (" + std::to_string(grasps.gripper.size()) +
+                                " of " + std::to_string(all) +
+                                " gripper grasps by θc, the suction cups by margin)",
+                            viz::grasps_glb(*checked.cell, grasps)});
     if (!part.goal_quality.empty()) {
       input.scenes.push_back(
           {"goals: " + part.name + " (the best " +

@@ -69,6 +69,13 @@ std::string goals_glb(const core::Cell& cell, const GoalsView& view,
           .inverse() *
       tool_links[static_cast<std::size_t>(tool.root_link())];
 
+  // Q spans a narrow band (the comfort threshold to a few tenths): the colour scale runs from the
+  // lowest Q shown (red) to the highest (green).
+  double q_low = 1.0, q_high = 0.0;
+  for (const GoalView& goal : view.goals) {
+    q_low = std::min(q_low, goal.quality);
+    q_high = std::max(q_high, goal.quality);
+  }
   for (std::size_t k = 0; k < view.goals.size(); ++k) {
     const GoalView& goal = view.goals[k];
     const std::string name = "goal:" + std::to_string(goal.rank);
@@ -78,7 +85,8 @@ std::string goals_glb(const core::Cell& cell, const GoalsView& view,
 
     char label[32];
     std::snprintf(label, sizeof label, "Q %.3f", goal.quality);
-    const int q_material = builder.add_material(label, scale_colour(goal.quality));
+    const int q_material = builder.add_material(
+        label, scale_colour(q_high > q_low ? (goal.quality - q_low) / (q_high - q_low) : 1.0));
     builder.add_node(name + "/part", root, goal.board,
                      add_part_mesh(builder, name + "/part", *view.mesh, q_material));
 

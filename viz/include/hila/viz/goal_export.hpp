@@ -47,12 +47,12 @@ struct GoalsView {
 
 // The goals as a glTF 2.0 binary (.glb): per goal a node "goal:RANK" at k * offset (k: its
 // index in `goals`) holding, in world coordinates: the part "goal:RANK/part" at the goal's pose
-// (material "Q V", scale_colour(Q): red 0 to green 1), the human "goal:RANK/human/LINK" at the
-// stance in the receiving posture, the table "goal:RANK/obstacle/NAME", the robot
-// "goal:RANK/robot/LINK" at the exchange's joints (the receiving jaws at its opening; home
-// without an exchange), the suction tool in the suction arm's gripper "goal:RANK/tool/LINK" and
-// the part at the exchange pose "goal:RANK/exchange". Throws core::InputError for an unknown
-// arm, joints of the wrong size or a missing mesh.
+// (material "Q V", scale_colour of Q from the lowest Q of `goals`, red, to the highest, green),
+// the human "goal:RANK/human/LINK" at the stance in the receiving posture, the table
+// "goal:RANK/obstacle/NAME", the robot "goal:RANK/robot/LINK" at the exchange's joints (the
+// receiving jaws at its opening; home without an exchange), the suction tool in the suction
+// arm's gripper "goal:RANK/tool/LINK" and the part at the exchange pose "goal:RANK/exchange".
+// Throws core::InputError for an unknown arm, joints of the wrong size or a missing mesh.
 std::string goals_glb(const core::Cell& cell, const GoalsView& view,
                       const GoalsSettings& settings = {});
 
