@@ -83,7 +83,7 @@ std::vector<viz::ReportErgonomics> report_ergonomics(const db::Database& databas
   for (const db::PartRecord& part : database.parts()) {
     for (const db::ErgonomicsRecord& e : database.ergonomics(part.id)) {
       rows.push_back({part.name, part.assembly_order, e.method, e.reachable, e.torso_flexion_deg,
-                      e.shoulder_elevated, e.reach, e.reorientation_deg, e.quality});
+                      e.shoulder_elevated, e.reach, e.reorientation_deg, e.quality, e.arm});
     }
   }
   return rows;

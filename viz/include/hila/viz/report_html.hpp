@@ -33,6 +33,7 @@ struct ReportErgonomics {
   double reach = 0.0;              // m, shoulder to hand
   double reorientation_deg = 0.0;  // rotation left to bring the board to its target
   double quality = 0.0;            // comfort Q of the posture
+  std::string arm;                 // the human arm used
 };
 
 // The report's 3D scenes: glTF 2.0 binaries (.glb) as hila::viz writes them.
@@ -75,9 +76,10 @@ std::string theta_c_svg(const std::vector<ReportPart>& parts);
 std::string stages_svg(const std::vector<ReportPart>& parts);
 std::string goal_quality_svg(const std::vector<ReportPart>& parts);
 std::string timeline_svg(const PlanFile& plan);
-// Per board the torso flexion each method needs (bars: hila, table, alone; the EAWS bend at
-// `bent_forward_deg` dashed), an elbow at or above the shoulder and unreachable boards marked,
-// and the methods' counts of bent-forward and shoulder work below.
+// Three charts of the ergonomics per board, each with a bar per method (hila, table, alone; an
+// unreachable board named): the torso flexion needed (the EAWS bend at `bent_forward_deg`
+// dashed, ▲ for an elbow at or above the shoulder; below, each method's counts), the reach
+// (below, the means of reach and comfort Q) and the re-orientation left (below, its mean).
 std::string ergonomics_svg(const std::vector<ReportErgonomics>& rows,
                            double bent_forward_deg = 20.0);
 
