@@ -133,6 +133,11 @@ int run_export_goals(const ExportPartOptions& opt) {
   for (const auto& g : view.goals) exchanges += g.exchange ? 1 : 0;
   std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes, " << view.goals.size()
             << " goal(s) of " << opt.part << ", " << exchanges << " with a robot-robot exchange)\n";
+  if (view.goals.empty()) {
+    const db::HandoverStageRecord* stage = d.database.handover_stage(d.database.part(opt.part).id);
+    std::cout << "  " << opt.part << " has no handover goal"
+              << (stage && !stage->failure.empty() ? ": " + stage->failure : std::string()) << "\n";
+  }
   return 0;
 }
 
