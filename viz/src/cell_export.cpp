@@ -80,9 +80,6 @@ Eigen::VectorXd robot_configuration(const core::Cell& cell, const Eigen::VectorX
   return robot_q;
 }
 
-namespace {
-
-// Links from each arm's flange on (the gripper and its fingers).
 std::set<int> gripper_links(const core::Cell& cell) {
   const core::RobotModel& robot = cell.robot();
   std::set<int> links;
@@ -99,8 +96,6 @@ std::set<int> gripper_links(const core::Cell& cell) {
   }
   return links;
 }
-
-}  // namespace
 
 CellNodes add_cell_nodes(GltfBuilder& builder, const core::Cell& cell, const CellView& view) {
   CellNodes out;

@@ -5,6 +5,7 @@
 #include <array>
 #include <functional>
 #include <map>
+#include <set>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -55,6 +56,9 @@ std::array<double, 4> scale_colour(double fraction);
 
 // A link's local transform in its parent link's frame for the configuration `q`.
 core::Pose link_local_pose(const core::RobotModel& model, int link, const Eigen::VectorXd& q);
+
+// Links from each arm's flange on (the gripper and its fingers: material "gripper").
+std::set<int> gripper_links(const core::Cell& cell);
 
 // The robot's, human's and obstacles' nodes; `robot_links` and `human_links` per link.
 struct CellNodes {

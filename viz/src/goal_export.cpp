@@ -26,24 +26,6 @@ const core::HumanArm& human_arm(const core::Cell& cell, const std::string& name)
                          "no such arm");
 }
 
-// Links from each arm's flange on (drawn in the gripper's colour).
-std::set<int> flange_subtrees(const core::Cell& cell) {
-  const core::RobotModel& robot = cell.robot();
-  std::set<int> links;
-  for (const core::Arm& arm : cell.arms()) {
-    std::vector<int> open{robot.link_index(arm.spec.flange_link)};
-    while (!open.empty()) {
-      const int link = open.back();
-      open.pop_back();
-      links.insert(link);
-      for (int j : robot.links()[static_cast<std::size_t>(link)].child_joints) {
-        open.push_back(robot.joints()[static_cast<std::size_t>(j)].child_link);
-      }
-    }
-  }
-  return links;
-}
-
 }  // namespace
 
 std::string goals_glb(const core::Cell& cell, const GoalsView& view,
@@ -54,7 +36,7 @@ std::string goals_glb(const core::Cell& cell, const GoalsView& view,
   GltfBuilder builder;
   const Materials m = add_materials(builder);
   MeshCache meshes;
-  const std::set<int> gripper = flange_subtrees(cell);
+  const std::set<int> gripper = gripper_links(cell);
   const int part_mesh = add_part_mesh(builder, "part/" + view.part, *view.mesh, m.held);
   std::map<std::string, int> obstacle_meshes;
   for (const core::BoxObstacle& box : cell.spec().obstacles) {
