@@ -40,7 +40,8 @@ const char* report_viewer_script() {
 (function () {
   'use strict';
   var root = document.documentElement;
-  // The URL's hash: t=SECONDS shows the animation paused there; scene=N opens scene N.
+  // The URL's hash: t=SECONDS shows the animation paused there; scene=N opens scene N;
+  // clip=NAME plays the animation of that name (a board's own).
   var hash = {};
   location.hash.replace(/^#/, '').split('&').forEach(function (kv) {
     var p = kv.split('=');
@@ -183,8 +184,11 @@ const char* report_viewer_script() {
       });
       clipMenu.hidden = clips.length < 2;
       if (clips.length > 0) {
+        // #clip=NAME: that animation (a board's), else the first.
+        var first = Math.max(0, clips.findIndex(function (c) { return c.name === hash.clip; }));
+        clipMenu.value = first;
         mixer = new THREE.AnimationMixer(gltf.scene);
-        playClip(0, fixedTime !== null ? fixedTime : 0);
+        playClip(first, fixedTime !== null ? fixedTime : 0);
       }
       slider.max = duration;
       slider.disabled = playButton.disabled = !mixer;

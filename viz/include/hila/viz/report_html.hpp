@@ -62,8 +62,9 @@ struct ReportInput {
 
 // The report as one self-contained HTML page (no network, no server: the scripts and the .glb
 // files are inlined, the .glb as base64). The viewer reads the URL's hash: "#t=SECONDS" shows
-// the animation paused at that time (for screenshots); "#scene=N" opens scene N (0-based). The
-// page sets <body data-status> to "ready" once the scene is drawn, or "error" with the message in
+// the animation paused at that time (for screenshots); "#scene=N" opens scene N (0-based);
+// "#clip=NAME" plays the scene's animation NAME (a board's own) instead of its first. The page
+// sets <body data-status> to "ready" once the scene is drawn, or "error" with the message in
 // #errors (also for errors the page's scripts log with console.error), and data-canvas-filled to
 // the fraction of sampled canvas pixels that differ from the background.
 std::string report_html(const ReportInput& input);
