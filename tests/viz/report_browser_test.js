@@ -4,7 +4,8 @@
 // (software WebGL). Checks: the page is at most 20 MB and loads nothing from the network; it
 // reaches data-status "ready" with no error logged (uncaught exceptions, console.error, the
 // GLTFLoader's); its canvas is not blank (the page's own pixel count and the screenshot's); the
-// screenshots at two animation times (#t=SECONDS) differ in the viewer.
+// screenshots at two animation times (#t=SECONDS) differ in the viewer; the animation menu lists
+// "plan" and the boards' own; the first grasps and goals scenes (#scene=N) are drawn.
 // Usage: report_browser_test.js HILA_EXE SOURCE_DIR [--report report.html (skips the build)]
 // Exits 77 (ctest SKIP_RETURN_CODE) when no Chromium is installed.
 'use strict';
@@ -182,6 +183,31 @@ function viewerStats(png, other) {
     if (s.colours < 50 || s.filled < 0.05) fail('a screenshot\'s viewer is blank');
   }
   if (sb.differ < 0.002) fail('the screenshots at the two times do not differ');
+
+  // The plan's animations in the menu: the whole plan first, then each planned board's own.
+  const clipMenu = /<select id="clip"[^>]*>(.*?)<\/select>/.exec(dom.stdout);
+  const clipNames = clipMenu ? [...clipMenu[1].matchAll(/<option[^>]*>([^<]*)</g)].map((m) => m[1])
+                             : [];
+  console.log('animations: ' + clipNames.join(', '));
+  if (clipNames[0] !== 'plan' || clipNames.length < 2) fail('no per-board animations in the menu');
+
+  // The first grasps and goals scenes load and draw.
+  const titles = [...html.matchAll(/<script type="application\/octet-stream" class="scene" data-title="([^"]*)"/g)]
+                     .map((m) => m[1]);
+  for (const kind of ['grasps: ', 'goals: ']) {
+    const index = titles.findIndex((t) => t.startsWith(kind));
+    if (index < 0) fail('no ' + kind + 'scene in the page');
+    const r = await browse(['--dump-dom', 'file://' + report + '#scene=' + index]);
+    if (r.error) fail('chromium: ' + r.error.message + '\n' + r.stderr.slice(-2000));
+    const logged = consoleErrors(r.stderr);
+    if (logged.length) fail(titles[index] + ': the page logged errors:\n' + logged.join('\n'));
+    const sceneStatus = /<html[^>]*\bdata-status="([^"]*)"/.exec(r.stdout);
+    const filled = Number((/data-canvas-filled="([^"]*)"/.exec(r.stdout) || [])[1]);
+    console.log(titles[index] + ': ' + (sceneStatus ? sceneStatus[1] : 'no status') + ', ' +
+                (100 * filled).toFixed(1) + ' % drawn');
+    if (!sceneStatus || sceneStatus[1] !== 'ready') fail(titles[index] + ': not ready');
+    if (!(filled > 0.02)) fail(titles[index] + ': the canvas is blank');
+  }
   if (reportArg < 0) fs.rmSync(work, {recursive: true, force: true});
   console.log('PASS');
 })();

@@ -9,6 +9,21 @@
 namespace hila::test {
 namespace {
 
+// A scene without nodes (a part without goals) or without anything still reads back.
+TEST(GltfBuilder, AnEmptySceneReadsBack) {
+  viz::GltfBuilder with_a_mesh;
+  with_a_mesh.add_mesh("box", {{core::make_box_mesh(Eigen::Vector3d(0.1, 0.2, 0.3)),
+                                with_a_mesh.add_material("red", {1.0, 0.0, 0.0, 1.0})}});
+  const viz::GltfBuilder empty;
+  for (const viz::GltfBuilder* builder :
+       std::vector<const viz::GltfBuilder*>{&with_a_mesh, &empty}) {
+    const tinygltf::Model model = load_glb(builder->glb());
+    ASSERT_EQ(model.scenes.size(), 1u);
+    EXPECT_TRUE(model.scenes[0].nodes.empty());
+    EXPECT_TRUE(model.nodes.empty());
+  }
+}
+
 TEST(GltfBuilder, NodesMeshesAndChannelsReadBack) {
   viz::GltfBuilder builder;
   const int red = builder.add_material("red", {1.0, 0.0, 0.0, 1.0});

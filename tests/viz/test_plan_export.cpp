@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "gltf_reading.hpp"
@@ -142,7 +143,8 @@ class PlanExport : public ::testing::Test {
 };
 
 TEST_F(PlanExport, OneAnimationEndingAtThePlansDuration) {
-  ASSERT_EQ(gltf_.animations.size(), 1u);
+  ASSERT_GE(gltf_.animations.size(), 1u);
+  EXPECT_EQ(gltf_.animations[0].name, "plan");
   double end = 0.0;
   for (const auto& [key, track] : tracks_) end = std::max<double>(end, track.times.back());
   EXPECT_EQ(static_cast<float>(end), static_cast<float>(tiny_.plan.duration()));
@@ -253,6 +255,88 @@ TEST_F(PlanExport, BoardsFollowTheEvents) {
     check_at(offset, tiny_.start.assembly_frame * part.target);
     check_at(tiny_.plan.duration(), tiny_.start.assembly_frame * part.target);
   }
+}
+
+// Besides "plan", one animation per solved board named after it, over the board's span of the
+// plan file (0 to its duration): the joints at its time stamps and between are the plan's, and
+// every board copy shows as in "plan" at the same moment of the whole plan.
+TEST_F(PlanExport, OneAnimationPerSolvedBoardOverItsSpan) {
+  std::vector<std::string> expected{"plan"};
+  for (const auto& b : tiny_.plan.boards) {
+    if (b.solved()) expected.push_back(b.board);
+  }
+  ASSERT_EQ(expected.size(), 3u);  // the tiny plan's third board is not solved
+  std::vector<std::string> names;
+  for (const auto& a : gltf_.animations) names.push_back(a.name);
+  ASSERT_EQ(names, expected);
+
+  double offset = 0.0;
+  int animation = 0, checked = 0;
+  for (const auto& b : tiny_.plan.boards) {
+    if (!b.solved()) continue;
+    ++animation;
+    const auto tracks = animation_tracks(gltf_, animation);
+    float begin = std::numeric_limits<float>::infinity(), end = -begin;
+    for (const auto& [key, track] : tracks) {
+      begin = std::min(begin, track.times.front());
+      end = std::max(end, track.times.back());
+    }
+    EXPECT_EQ(begin, 0.0f) << b.board;
+    EXPECT_EQ(end, static_cast<float>(b.duration)) << b.board;
+    // Every arm joint and every board copy whose visibility changes in "plan" is keyed here.
+    EXPECT_EQ(tracks.size(), tracks_.size()) << b.board;
+
+    // (plan time from the board's start, glTF time): the time stamps and the midpoints between,
+    // the glTF times from the float keys as in JointAnglesAtEveryTimeStampAndBetween.
+    std::vector<std::pair<double, double>> times{{b.duration, static_cast<float>(b.duration)}};
+    for (const auto& s : b.steps) {
+      for (std::size_t i = 0; i < s.time.size(); ++i) {
+        const float k0 = static_cast<float>(s.time[i]);
+        times.emplace_back(s.time[i], k0);
+        if (i + 1 == s.time.size()) continue;
+        const float k1 = static_cast<float>(s.time[i + 1]);
+        times.emplace_back(0.5 * (s.time[i] + s.time[i + 1]), k0 + 0.5 * (double{k1} - k0));
+      }
+    }
+    for (const auto& [t, t_gltf] : times) {
+      const Eigen::VectorXd q = plan_configuration(*cell_, tiny_.plan, offset + t);
+      for (const core::Arm& arm : cell_->arms()) {
+        for (int k = 0; k < arm.chain.dof(); ++k) {
+          const int variable = arm.chain.model_variables()[static_cast<std::size_t>(k)];
+          const int j = cell_->robot().variable_joints()[static_cast<std::size_t>(variable)];
+          const core::Joint& joint = cell_->robot().joints()[static_cast<std::size_t>(j)];
+          const int node = nodes_.at(
+              "robot/" + cell_->robot().links()[static_cast<std::size_t>(joint.child_link)].name);
+          const auto track = tracks.find({node, "rotation"});
+          ASSERT_NE(track, tracks.end()) << joint.name;
+          const Eigen::VectorXd r = sample(track->second, t_gltf);
+          const Eigen::AngleAxisd aa(
+              joint.origin.linear().transpose() *
+              Eigen::Quaterniond(r[3], r[0], r[1], r[2]).normalized().toRotationMatrix());
+          const double angle = aa.axis().dot(joint.axis) >= 0.0 ? aa.angle() : -aa.angle();
+          EXPECT_NEAR(std::remainder(angle - q[variable], 2.0 * core::kPi), 0.0, kJointTolerance)
+              << b.board << ": " << joint.name << " at " << t << " s";
+          ++checked;
+        }
+      }
+    }
+    // At the time stamps inside the span (its ends are where "plan"'s STEP keys switch copies),
+    // every board shows where "plan" shows it at the same moment of the whole plan.
+    for (const auto& s : b.steps) {
+      for (const double t : s.time) {
+        if (!(t > 0.0 && t < b.duration)) continue;
+        const NodeState here = node_states(gltf_, &tracks, static_cast<float>(t));
+        const NodeState whole = node_states(gltf_, &tracks_, static_cast<float>(offset + t));
+        for (const auto& other : tiny_.plan.boards) {
+          EXPECT_LT(pose_error(visible_board(here, other.board), visible_board(whole, other.board)),
+                    kJointTolerance)
+              << other.board << " in " << b.board << "'s animation at " << t << " s";
+        }
+      }
+    }
+    offset += b.duration;
+  }
+  EXPECT_GT(checked, 500);
 }
 
 TEST_F(PlanExport, ToolStaysOnTheTableWithoutToolSteps) {

@@ -2,9 +2,11 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "db_scenes.hpp"
 #include "hila/core/error.hpp"
 #include "hila/viz/cell_export.hpp"
 #include "io_checks.hpp"
+#include "option_checks.hpp"
 #include "scene_exports.hpp"
 
 namespace hila::tools {
@@ -22,6 +24,17 @@ struct ExportPlanOptions {
   std::string database;
   std::string plan_file;
   std::string scene;  // empty: the scene the plan file names
+  std::string output;
+};
+
+// `export grasps` and `export goals`: a part of a database.
+struct ExportPartOptions {
+  std::string database;
+  std::string part;
+  std::string cell_file;     // the database's cell (empty: the bundled one)
+  std::string product_file;  // the database's product (empty: the bundled one)
+  std::string arm;           // grasps: whose gripper (empty: the first arm)
+  int count = 10;            // goals: how many, best first
   std::string output;
 };
 
@@ -92,10 +105,60 @@ int run_export_plan(const ExportPlanOptions& opt) {
   return 0;
 }
 
+CheckedDatabase open_part_database(const ExportPartOptions& opt) {
+  const std::string cell_file = opt.cell_file.empty() ? default_cell_path() : opt.cell_file;
+  const std::string product_file =
+      opt.product_file.empty() ? default_product_path() : opt.product_file;
+  check_output_path("-o", opt.output, database_input_files(opt.database, cell_file, product_file));
+  return open_checked_database(opt.database, cell_file, product_file);
+}
+
+int run_export_grasps(const ExportPartOptions& opt) {
+  const CheckedDatabase d = open_part_database(opt);
+  const viz::GraspsView view = grasps_view(d, opt.part, opt.arm);
+  const std::string glb = viz::grasps_glb(*d.cell, view);
+  write_file_atomically(opt.output, glb);
+  std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes, " << view.gripper.size()
+            << " gripper grasp(s), " << view.suction.size() << " suction grasp(s) of " << opt.part
+            << ")\n";
+  return 0;
+}
+
+int run_export_goals(const ExportPartOptions& opt) {
+  const CheckedDatabase d = open_part_database(opt);
+  const viz::GoalsView view = goals_view(d, opt.part, opt.count);
+  const std::string glb = viz::goals_glb(*d.cell, view);
+  write_file_atomically(opt.output, glb);
+  int exchanges = 0;
+  for (const auto& g : view.goals) exchanges += g.exchange ? 1 : 0;
+  std::cout << "wrote " << opt.output << " (" << glb.size() << " bytes, " << view.goals.size()
+            << " goal(s) of " << opt.part << ", " << exchanges << " with a robot-robot exchange)\n";
+  if (view.goals.empty()) {
+    const db::HandoverStageRecord* stage = d.database.handover_stage(d.database.part(opt.part).id);
+    std::cout << "  " << opt.part << " has no handover goal"
+              << (stage && !stage->failure.empty() ? ": " + stage->failure : std::string()) << "\n";
+  }
+  return 0;
+}
+
+// The options `export grasps` and `export goals` share.
+CLI::App* add_part_subcommand(CLI::App& cmd, const std::string& name,
+                              const std::string& description, ExportPartOptions& opt) {
+  auto* sub = cmd.add_subcommand(name, description);
+  sub->add_option("--db", opt.database, "the product database")->required();
+  sub->add_option("--part", opt.part, "the part (its name in the product)")->required();
+  sub->add_option("--cell", opt.cell_file, "the database's cell YAML (default: the bundled)");
+  sub->add_option("--product", opt.product_file,
+                  "the database's product YAML (default: the cabinet)");
+  sub->add_option("-o,--output", opt.output, "the .glb to write")->required();
+  return sub;
+}
+
 }  // namespace
 
 void add_export_command(CLI::App& app, Action& action) {
-  auto* cmd = app.add_subcommand("export", "write the cell or a plan as glTF 2.0 binary (.glb)");
+  auto* cmd = app.add_subcommand(
+      "export", "write the cell, a plan, a part's grasps or goals as glTF 2.0 binary (.glb)");
   cmd->require_subcommand(1);
 
   auto cell_opt = std::make_shared<ExportCellOptions>();
@@ -121,6 +184,28 @@ void add_export_command(CLI::App& app, Action& action) {
   plan->add_option("-o,--output", plan_opt->output, "the .glb to write")->required();
   plan->callback(
       [plan_opt, &action] { action = [plan_opt] { return run_export_plan(*plan_opt); }; });
+
+  auto grasps_opt = std::make_shared<ExportPartOptions>();
+  auto* grasps = add_part_subcommand(
+      *cmd, "grasps",
+      "a part with the gripper at each of its grasps (coloured by theta_c) and the suction tool "
+      "at each suction grasp (coloured by holding margin)",
+      *grasps_opt);
+  grasps->add_option("--arm", grasps_opt->arm, "whose gripper to draw (default: the first arm)");
+  grasps->callback(
+      [grasps_opt, &action] { action = [grasps_opt] { return run_export_grasps(*grasps_opt); }; });
+
+  auto goals_opt = std::make_shared<ExportPartOptions>();
+  auto* goals = add_part_subcommand(
+      *cmd, "goals",
+      "a part's best handover goals side by side: the part (coloured by Q), the human receiving "
+      "it, the robot at the goal's robot-robot exchange",
+      *goals_opt);
+  goals->add_option("--count", goals_opt->count, "how many goals, best first")
+      ->check(int_in(1, 1000))
+      ->capture_default_str();
+  goals->callback(
+      [goals_opt, &action] { action = [goals_opt] { return run_export_goals(*goals_opt); }; });
 }
 
 }  // namespace hila::tools

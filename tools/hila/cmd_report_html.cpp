@@ -1,5 +1,6 @@
 #include "cmd_report_html.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -7,9 +8,9 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "db_scenes.hpp"
 #include "hila/core/error.hpp"
 #include "hila/db/database.hpp"
-#include "hila/online/planner_model.hpp"
 #include "hila/viz/cell_export.hpp"
 #include "hila/viz/report_html.hpp"
 #include "io_checks.hpp"
@@ -18,6 +19,24 @@
 namespace hila::tools {
 
 namespace {
+
+// Goals shown per part; gripper grasps drawn per part (a thousand per part would make the page
+// about 20 MB: `hila export grasps` writes them all).
+constexpr int kReportGoals = 5;
+constexpr std::size_t kReportGrasps = 120;
+
+// At most `count` of the view's gripper grasps, evenly spread over their θc order (the lowest and
+// the highest kept).
+void thin_grasps(viz::GraspsView& view, std::size_t count) {
+  auto& grasps = view.gripper;
+  if (grasps.size() <= count || count < 2) return;
+  std::stable_sort(grasps.begin(), grasps.end(),
+                   [](const auto& a, const auto& b) { return a.theta_c_deg < b.theta_c_deg; });
+  std::vector<viz::GripperGraspView> kept;
+  for (std::size_t i = 0; i < count; ++i)
+    kept.push_back(grasps[i * (grasps.size() - 1) / (count - 1)]);
+  grasps = std::move(kept);
+}
 
 // three.js's files under its folder (libjs-three's layout; the npm package's is the same).
 constexpr const char* kThreeFiles[] = {"build/three.min.js", "examples/js/loaders/GLTFLoader.js",
@@ -58,6 +77,18 @@ std::vector<viz::ReportPart> report_parts(const db::Database& database) {
   return parts;
 }
 
+// What `hila report ergonomics` compares: every board by every method.
+std::vector<viz::ReportErgonomics> report_ergonomics(const db::Database& database) {
+  std::vector<viz::ReportErgonomics> rows;
+  for (const db::PartRecord& part : database.parts()) {
+    for (const db::ErgonomicsRecord& e : database.ergonomics(part.id)) {
+      rows.push_back({part.name, part.assembly_order, e.method, e.reachable, e.torso_flexion_deg,
+                      e.shoulder_elevated, e.reach, e.reorientation_deg, e.quality, e.arm});
+    }
+  }
+  return rows;
+}
+
 // The cell with the product: tool on its stand, parts at their targets and initial poses.
 std::string cell_scene_glb(const std::string& cell_file, const std::string& product_file) {
   const auto cell = core::Cell::load(cell_file);
@@ -82,7 +113,6 @@ int run_report_html(const ReportHtmlOptions& opt) {
     inputs.insert(inputs.end(), plan->inputs.begin(), plan->inputs.end());
     check_output_path("-o", opt.output, inputs);
   }
-  const db::Database database = db::Database::open(opt.database);
   // The cell and product the plan's scene names, else the ones given (default: the bundled).
   const std::string cell_file =
       plan ? plan->files.cell : (opt.cell_file.empty() ? default_cell_path() : opt.cell_file);
@@ -94,19 +124,38 @@ int run_report_html(const ReportHtmlOptions& opt) {
   }
   check_output_path("-o", opt.output, inputs);
 
-  // Checks that the database was built from these files (the plan's scene's are checked when
-  // the plan is exported).
-  if (!plan) online::PlannerModel::load(opt.database, cell_file, product_file);
+  // Checks that the database was built from these files (with a plan, the scene's).
+  const CheckedDatabase checked = open_checked_database(opt.database, cell_file, product_file);
+  const db::Database& database = checked.database;
 
   viz::ReportInput input;
   input.product = database.meta().product_name;
   input.database = opt.database;
   input.parts = report_parts(database);
+  input.ergonomics = report_ergonomics(database);
   input.three = {read_text(opt.three_dir + "/" + kThreeFiles[0], "three.js"),
                  read_text(opt.three_dir + "/" + kThreeFiles[1], "three.js GLTFLoader"),
                  read_text(opt.three_dir + "/" + kThreeFiles[2], "three.js OrbitControls")};
   input.scenes.push_back({"cell: " + input.product + " at its targets and on the table",
                           cell_scene_glb(cell_file, product_file)});
+  // Each part's grasps and its best goals (as `export grasps` and `export goals` write them).
+  for (const viz::ReportPart& part : input.parts) {
+    viz::GraspsView grasps = grasps_view(checked, part.name, "");
+    const std::size_t all = grasps.gripper.size();
+    thin_grasps(grasps, kReportGrasps);
+    input.scenes.push_back({"grasps: " + part.name + " (" + std::to_string(grasps.gripper.size()) +
+                                " of " + std::to_string(all) +
+                                " gripper grasps by θc, the suction cups by margin)",
+                            viz::grasps_glb(*checked.cell, grasps)});
+    if (!part.goal_quality.empty()) {
+      input.scenes.push_back(
+          {"goals: " + part.name + " (the best " +
+               std::to_string(
+                   std::min(static_cast<std::size_t>(kReportGoals), part.goal_quality.size())) +
+               ", by Q)",
+           viz::goals_glb(*checked.cell, goals_view(checked, part.name, kReportGoals))});
+    }
+  }
   if (plan) {
     input.scenes.push_back({"plan: " + opt.plan_file, plan_scene_glb(*plan)});
     input.plan = &plan->plan;

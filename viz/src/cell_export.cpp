@@ -1,5 +1,7 @@
 #include "hila/viz/cell_export.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <set>
 
@@ -33,25 +35,39 @@ core::Pose link_local_pose(const core::RobotModel& model, int link, const Eigen:
 std::vector<int> add_model_nodes(GltfBuilder& builder, const core::RobotModel& model,
                                  const Eigen::VectorXd& q, const std::string& prefix,
                                  const std::string& suffix, int parent, const core::Pose& root_pose,
-                                 const std::function<int(int link)>& material_of) {
+                                 const std::function<int(int link)>& material_of,
+                                 const ModelNodeOptions& options) {
   std::vector<int> nodes(model.links().size(), -1);
   // Joints are in topological order: a parent link's node exists before its children's.
   auto add = [&](int link, int parent_node, const core::Pose& local) {
     const core::Link& l = model.links()[static_cast<std::size_t>(link)];
-    std::vector<Primitive> primitives;
-    for (const core::GeometrySpec& g : l.collisions) {
-      primitives.push_back({geometry_mesh(g), material_of(link)});
-    }
     const std::string name = prefix + l.name + suffix;
-    const int mesh = builder.add_mesh(name, primitives);
+    const int material = material_of(link);
+    const auto key = std::make_tuple(&model, link, material);
+    int mesh = -1;
+    if (options.meshes && options.meshes->count(key)) {
+      mesh = options.meshes->at(key);
+    } else {
+      std::vector<Primitive> primitives;
+      for (const core::GeometrySpec& g : l.collisions)
+        primitives.push_back({geometry_mesh(g), material});
+      mesh = builder.add_mesh(name, primitives);
+      if (options.meshes) (*options.meshes)[key] = mesh;
+    }
     nodes[static_cast<std::size_t>(link)] = builder.add_node(name, parent_node, local, mesh);
   };
-  add(model.root_link(), parent, root_pose);
+  add(options.root_link >= 0 ? options.root_link : model.root_link(), parent, root_pose);
   for (const core::Joint& joint : model.joints()) {
-    add(joint.child_link, nodes[static_cast<std::size_t>(joint.parent_link)],
-        link_local_pose(model, joint.child_link, q));
+    const int parent_node = nodes[static_cast<std::size_t>(joint.parent_link)];
+    if (parent_node < 0) continue;  // outside the subtree
+    add(joint.child_link, parent_node, link_local_pose(model, joint.child_link, q));
   }
   return nodes;
+}
+
+std::array<double, 4> scale_colour(double fraction) {
+  const double f = std::isfinite(fraction) ? std::clamp(fraction, 0.0, 1.0) : 0.0;
+  return {0.9 * (1.0 - f) + 0.05, 0.75 * f + 0.05, 0.08, 1.0};
 }
 
 Eigen::VectorXd robot_configuration(const core::Cell& cell, const Eigen::VectorXd& robot_q) {
@@ -64,9 +80,6 @@ Eigen::VectorXd robot_configuration(const core::Cell& cell, const Eigen::VectorX
   return robot_q;
 }
 
-namespace {
-
-// Links from each arm's flange on (the gripper and its fingers).
 std::set<int> gripper_links(const core::Cell& cell) {
   const core::RobotModel& robot = cell.robot();
   std::set<int> links;
@@ -83,8 +96,6 @@ std::set<int> gripper_links(const core::Cell& cell) {
   }
   return links;
 }
-
-}  // namespace
 
 CellNodes add_cell_nodes(GltfBuilder& builder, const core::Cell& cell, const CellView& view) {
   CellNodes out;

@@ -12,6 +12,9 @@ GltfBuilder::GltfBuilder() {
   model_.asset.generator = "hila export";
   model_.buffers.emplace_back();
   model_.scenes.emplace_back();
+  // Named: tinygltf writes a scene without nodes or name as null, which no loader accepts (a
+  // part without goals has an empty scene).
+  model_.scenes[0].name = "hila";
   model_.defaultScene = 0;
 }
 
@@ -163,6 +166,7 @@ void GltfBuilder::add_channel(int animation, int node, const std::string& path,
 std::string GltfBuilder::glb() const {
   tinygltf::Model model = model_;
   model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4, 0);
+  if (model.buffers[0].data.empty()) model.buffers.clear();  // a GLB's BIN chunk may not be empty
   std::ostringstream out;
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToStream(&model, out, false, true)) {

@@ -84,6 +84,53 @@ bool visibility_keys(double begin, double end, std::vector<float>& times,
   return true;
 }
 
+// A node whose visibility changes: shown from `begin` to `end` (the whole plan's time).
+struct Shown {
+  int node = -1;
+  double begin = 0.0;
+  double end = 0.0;
+};
+
+// An animation's span of the whole plan: "plan" (0 to kForever) or a board's.
+struct Window {
+  std::string name;
+  double begin = 0.0;
+  double end = 0.0;
+};
+
+// STEP scale keys of `shown` over the board's window, in the window's time (0 to its length):
+// a key at its start and end and at each change between.
+void window_visibility_keys(const Shown& shown, const Window& window, std::vector<float>& times,
+                            std::vector<float>& values) {
+  auto visible = [&](double t) { return shown.begin <= t && t < shown.end ? 1.0f : 0.0f; };
+  auto key = [&](double t) {
+    const float tf = static_cast<float>(t - window.begin);
+    if (!times.empty() && !(tf > times.back())) return;
+    const float v = visible(t);
+    times.push_back(tf);
+    values.insert(values.end(), {v, v, v});
+  };
+  key(window.begin);
+  for (double change : {shown.begin, shown.end}) {
+    if (change > window.begin && change < window.end) key(change);
+  }
+  key(window.end);
+}
+
+// The arm's joints at `time` (the whole plan's), linear between its keys, held before the first
+// and after the last.
+Eigen::VectorXd joints_at(const std::vector<std::pair<double, Eigen::VectorXd>>& keys,
+                          double time) {
+  const auto after = std::upper_bound(keys.begin(), keys.end(), time,
+                                      [](double t, const auto& key) { return t < key.first; });
+  if (after == keys.begin()) return keys.front().second;
+  if (after == keys.end()) return keys.back().second;
+  const auto& [t0, q0] = *(after - 1);
+  const auto& [t1, q1] = *after;
+  const double f = (time - t0) / (t1 - t0);  // t1 > time >= t0
+  return (1.0 - f) * q0 + f * q1;
+}
+
 }  // namespace
 
 std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
@@ -113,6 +160,8 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
         cell.robot().link_index(cell.arm(arm).spec.tip_link))];
   };
 
+  std::vector<Shown> shown;     // nodes whose visibility changes during the plan
+  std::vector<Window> windows;  // the solved boards' spans
   PlanPlayer player(cell, start_q);
   // Each arm's keys: (time in the whole plan, the arm's joints).
   std::map<std::string, std::vector<std::pair<double, Eigen::VectorXd>>> keys;
@@ -208,11 +257,9 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
                                                            : held_mesh;
       const int node = builder.add_node(p.name, p.parent, p.local, mesh);
       builder.set_node_scale(node, p.begin <= 0.0 ? 1.0 : 0.0);
-      if (times.size() > 1) {
-        if (builder.model().animations.empty()) builder.add_animation("plan");
-        builder.add_channel(0, node, "scale", times, values, "STEP");
-      }
+      if (times.size() > 1) shown.push_back({node, p.begin, p.end});
     }
+    if (b.solved() && b.duration > 0.0) windows.push_back({b.board, offset, end});
     offset = end;
   }
   tool_phase_until(kForever);
@@ -221,13 +268,26 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
     if (!visibility_keys(p.begin, p.end, times, values)) continue;
     const int root = add_tool_nodes(builder, cell, p.parent, p.local, p.name, m.tool);
     builder.set_node_scale(root, p.begin <= 0.0 ? 1.0 : 0.0);
-    if (times.size() > 1) {
-      if (builder.model().animations.empty()) builder.add_animation("plan");
-      builder.add_channel(0, root, "scale", times, values, "STEP");
+    if (times.size() > 1) shown.push_back({root, p.begin, p.end});
+  }
+  // The whole plan first, then one animation per board over its own span.
+  windows.insert(windows.begin(), {"plan", 0.0, kForever});
+  if (shown.empty() && keys.empty()) windows.clear();  // nothing moves: no animation
+  for (const Window& w : windows) {
+    const int animation = builder.add_animation(w.name);
+    for (const Shown& v : shown) {
+      std::vector<float> times, values;
+      if (w.end == kForever) {
+        visibility_keys(v.begin, v.end, times, values);
+      } else {
+        window_visibility_keys(v, w, times, values);
+      }
+      builder.add_channel(animation, v.node, "scale", times, values, "STEP");
     }
   }
 
-  // The arms' joints: the child link node of each joint, keyed at every time stamp.
+  // The arms' joints: the child link node of each joint, keyed at every time stamp (a board's
+  // animation: at its start, its end and the stamps between).
   for (const auto& [arm_name, arm_keys] : keys) {
     const core::Arm& arm = cell.arm(arm_name);
     for (int k = 0; k < arm.chain.dof(); ++k) {
@@ -235,26 +295,39 @@ std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
       const int j = cell.robot().variable_joints()[static_cast<std::size_t>(variable)];
       const core::Joint& joint = cell.robot().joints()[static_cast<std::size_t>(j)];
       const bool prismatic = joint.type == core::JointType::Prismatic;
-      std::vector<float> times, values;
-      Eigen::Quaterniond previous = Eigen::Quaterniond::Identity();
-      for (const auto& [t, q] : arm_keys) {
-        const float tf = static_cast<float>(t);
-        if (!times.empty() && !(tf > times.back())) continue;  // a step's start: the last's end
-        times.push_back(tf);
-        const core::Pose local = joint.origin * core::joint_motion(joint, q[k]);
-        if (prismatic) {
-          for (int c = 0; c < 3; ++c) values.push_back(static_cast<float>(local.translation()[c]));
+      const int node = nodes.robot_links[static_cast<std::size_t>(joint.child_link)];
+      for (std::size_t a = 0; a < windows.size(); ++a) {
+        const Window& w = windows[a];
+        std::vector<float> times, values;
+        Eigen::Quaterniond previous = Eigen::Quaterniond::Identity();
+        auto key = [&](double t, double value) {
+          const float tf = static_cast<float>(t);
+          if (!times.empty() && !(tf > times.back())) return;  // a step's start: the last's end
+          times.push_back(tf);
+          const core::Pose local = joint.origin * core::joint_motion(joint, value);
+          if (prismatic) {
+            for (int c = 0; c < 3; ++c)
+              values.push_back(static_cast<float>(local.translation()[c]));
+          } else {
+            Eigen::Quaterniond r(local.linear());
+            if (r.dot(previous) < 0.0) r.coeffs() *= -1.0;  // the same rotation, no flips
+            previous = r;
+            values.insert(values.end(), {static_cast<float>(r.x()), static_cast<float>(r.y()),
+                                         static_cast<float>(r.z()), static_cast<float>(r.w())});
+          }
+        };
+        if (w.end == kForever) {
+          for (const auto& [t, q] : arm_keys) key(t, q[k]);
         } else {
-          Eigen::Quaterniond r(local.linear());
-          if (r.dot(previous) < 0.0) r.coeffs() *= -1.0;  // the same rotation, no flips
-          previous = r;
-          values.insert(values.end(), {static_cast<float>(r.x()), static_cast<float>(r.y()),
-                                       static_cast<float>(r.z()), static_cast<float>(r.w())});
+          key(0.0, joints_at(arm_keys, w.begin)[k]);
+          for (const auto& [t, q] : arm_keys) {
+            if (t > w.begin && t < w.end) key(t - w.begin, q[k]);
+          }
+          key(w.end - w.begin, joints_at(arm_keys, w.end)[k]);
         }
+        builder.add_channel(static_cast<int>(a), node, prismatic ? "translation" : "rotation",
+                            times, values, "LINEAR");
       }
-      if (builder.model().animations.empty()) builder.add_animation("plan");
-      builder.add_channel(0, nodes.robot_links[static_cast<std::size_t>(joint.child_link)],
-                          prismatic ? "translation" : "rotation", times, values, "LINEAR");
     }
   }
   return builder.glb();

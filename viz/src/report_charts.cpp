@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <sstream>
@@ -263,6 +264,145 @@ std::string timeline_svg(const PlanFile& plan) {
     ++k;
   }
   return s + "</svg>\n";
+}
+
+namespace {
+
+// One ergonomics measure of a board by a method: its value, the bar's end-of-bar note.
+struct ErgonomicsMeasure {
+  std::string title;  // the chart's
+  std::string axis;   // the axis label
+  int decimals = 0;
+  double floor = 1.0;    // the axis reaches at least this
+  double dashed = -1.0;  // a dashed line at this value (< 0: none)
+  std::function<double(const ReportErgonomics&)> value;
+  std::function<std::string(const ReportErgonomics&)> mark;  // after the value ("" none)
+  // Below the plot, per method (its reachable rows).
+  std::function<std::string(const std::vector<const ReportErgonomics*>&)> summary;
+};
+
+// Per board (assembly order) three bars, hila, table, alone, of `m`; an unreachable board named.
+std::string ergonomics_chart(const std::vector<ReportErgonomics>& rows,
+                             const ErgonomicsMeasure& m) {
+  constexpr const char* kMethods[] = {"hila", "table", "alone"};
+  constexpr double kBar = 9;
+  constexpr double kRow = 3 * kBar + 10;
+  std::map<std::pair<int, std::string>, std::map<std::string, const ReportErgonomics*>> boards;
+  std::map<std::string, std::vector<const ReportErgonomics*>> reached;
+  std::map<std::string, int> unreachable;
+  double most = m.floor;
+  for (const ReportErgonomics& r : rows) {
+    boards[{r.order, r.part}][r.method] = &r;
+    if (r.reachable) {
+      most = std::max(most, m.value(r));
+      reached[r.method].push_back(&r);
+    } else {
+      ++unreachable[r.method];
+    }
+  }
+  const double magnitude = std::pow(10.0, std::floor(std::log10(most)));
+  const double tick =
+      most / magnitude > 5 ? 2 * magnitude : magnitude / (most / magnitude > 2 ? 1 : 2);
+  most = tick * std::ceil(most / tick);
+  const auto x_of = [&](double v) { return kLabelWidth + kPlotWidth * std::max(v, 0.0) / most; };
+  const double plot_bottom = kTopMargin + kRow * static_cast<double>(boards.size());
+  const double height = plot_bottom + kAxisHeight + 8 + 16 * 3;
+  std::string s = open_svg(height, m.title);
+  std::size_t i = 0;
+  for (const auto& [key, methods] : boards) {
+    const double top = kTopMargin + kRow * static_cast<double>(i++);
+    s += text(4, top + kRow / 2 + 2, std::to_string(key.first) + " " + key.second);
+    for (int k = 0; k < 3; ++k) {
+      const double y = top + 2 + kBar * k;
+      const auto it = methods.find(kMethods[k]);
+      if (it == methods.end() || !it->second->reachable) {
+        s += text(kLabelWidth + 3, y + kBar - 1,
+                  std::string(kMethods[k]) + (it == methods.end() ? ": -" : ": unreachable"),
+                  "start", " class=\"small note\"");
+        continue;
+      }
+      const ReportErgonomics& r = *it->second;
+      const double w = x_of(m.value(r)) - kLabelWidth;
+      s += rect(kLabelWidth, y, w, kBar - 1, kPalette[k],
+                key.second + ", " + r.method + ": torso " + num(r.torso_flexion_deg, 0) +
+                    " deg, elbow " + (r.shoulder_elevated ? "at or above" : "below") +
+                    " the shoulder, reach " + num(r.reach, 2) + " m, re-orientation " +
+                    num(r.reorientation_deg, 0) + " deg, Q " + num(r.quality, 3) + " (arm " +
+                    r.arm + ")");
+      s += text(kLabelWidth + w + 3, y + kBar - 1, num(m.value(r), m.decimals) + m.mark(r), "start",
+                " class=\"small\"");
+    }
+  }
+  if (m.dashed >= 0.0) {
+    s += line(x_of(m.dashed), kTopMargin, x_of(m.dashed), plot_bottom, "class=\"board\"");
+  }
+  std::vector<double> ticks;
+  for (double v = 0; v <= most + 1e-9 * most; v += tick) ticks.push_back(v);
+  s += axis(plot_bottom, ticks, x_of, tick < 1 ? (tick < 0.1 ? 2 : 1) : 0, m.axis);
+  for (int k = 0; k < 3; ++k) {
+    const std::string method = kMethods[k];
+    const double y = plot_bottom + kAxisHeight + 6 + 16.0 * k;
+    s += rect(kLabelWidth, y, 10, 10, kPalette[k], method);
+    s += text(kLabelWidth + 14, y + 9,
+              method + ": " + m.summary(reached[method]) + ", " +
+                  std::to_string(unreachable[method]) + " unreachable",
+              "start", " class=\"small\"");
+  }
+  return s + "</svg>\n";
+}
+
+std::string mean_of(const std::vector<const ReportErgonomics*>& rows,
+                    double ReportErgonomics::*field, int decimals, const std::string& unit) {
+  double sum = 0.0;
+  for (const ReportErgonomics* r : rows) sum += r->*field;
+  return "mean " + (rows.empty() ? std::string("-") : num(sum / rows.size(), decimals)) + unit;
+}
+
+}  // namespace
+
+std::string ergonomics_svg(const std::vector<ReportErgonomics>& rows, double bent_forward_deg) {
+  ErgonomicsMeasure torso{
+      "Torso flexion per board: hila against the baselines",
+      "torso flexion (deg); dashed: bent forward from " + num(bent_forward_deg, 0) +
+          " deg; ▲ elbow at or above the shoulder",
+      0,
+      bent_forward_deg + 10.0,
+      bent_forward_deg,
+      [](const ReportErgonomics& r) { return r.torso_flexion_deg; },
+      [](const ReportErgonomics& r) { return std::string(r.shoulder_elevated ? " ▲" : ""); },
+      [&](const std::vector<const ReportErgonomics*>& reached) {
+        int bent = 0, shoulder = 0;
+        for (const ReportErgonomics* r : reached) {
+          bent += r->torso_flexion_deg >= bent_forward_deg ? 1 : 0;
+          shoulder += r->shoulder_elevated ? 1 : 0;
+        }
+        return std::to_string(bent) + " bent forward, " + std::to_string(shoulder) +
+               " with the elbow at or above the shoulder";
+      }};
+  ErgonomicsMeasure reach{"Reach per board: hila against the baselines",
+                          "reach, shoulder to hand (m)",
+                          2,
+                          0.5,
+                          -1.0,
+                          [](const ReportErgonomics& r) { return r.reach; },
+                          [](const ReportErgonomics&) { return std::string(); },
+                          [](const std::vector<const ReportErgonomics*>& reached) {
+                            return mean_of(reached, &ReportErgonomics::reach, 2, " m") +
+                                   ", comfort Q " +
+                                   mean_of(reached, &ReportErgonomics::quality, 3, "");
+                          }};
+  ErgonomicsMeasure turn{"Re-orientation left per board: hila against the baselines",
+                         "rotation left to bring the board to its target (deg)",
+                         0,
+                         10.0,
+                         -1.0,
+                         [](const ReportErgonomics& r) { return r.reorientation_deg; },
+                         [](const ReportErgonomics&) { return std::string(); },
+                         [](const std::vector<const ReportErgonomics*>& reached) {
+                           return mean_of(reached, &ReportErgonomics::reorientation_deg, 0, " deg");
+                         }};
+  return ergonomics_chart(rows, torso) + ergonomics_chart(rows, reach) +
+         ergonomics_chart(rows, turn);
 }
 
 }  // namespace hila::viz

@@ -147,6 +147,7 @@ std::string report_html(const ReportInput& input) {
   page += "<pre id=\"errors\" hidden></pre>\n<div id=\"viewer\"></div>\n";
   page +=
       "<div id=\"controls\"><select id=\"scene\" aria-label=\"scene\"></select>"
+      "<select id=\"clip\" aria-label=\"animation\" hidden></select>"
       "<button id=\"play\">pause</button>"
       "<input id=\"time\" type=\"range\" min=\"0\" max=\"0\" step=\"0.01\" value=\"0\" "
       "aria-label=\"time\"><span id=\"time-text\"></span>"
@@ -160,6 +161,10 @@ std::string report_html(const ReportInput& input) {
   page += "<h2>θc per robot grasp</h2>\n" + theta_c_svg(input.parts);
   page += "<h2>Handover candidates, |S| and |𝕊|</h2>\n" + stages_svg(input.parts);
   page += "<h2>Human comfort Q of the ranked goals</h2>\n" + goal_quality_svg(input.parts);
+  if (!input.ergonomics.empty()) {
+    page += "<h2>Ergonomics: hila against the table and the human alone</h2>\n" +
+            ergonomics_svg(input.ergonomics);
+  }
   for (std::size_t i = 0; i < input.scenes.size(); ++i) {
     page += "<script type=\"application/octet-stream\" class=\"scene\" data-title=\"" +
             escape(input.scenes[i].title) + "\">" + base64(input.scenes[i].glb) + "</script>\n";

@@ -40,7 +40,8 @@ const char* report_viewer_script() {
 (function () {
   'use strict';
   var root = document.documentElement;
-  // The URL's hash: t=SECONDS shows the animation paused there; scene=N opens scene N.
+  // The URL's hash: t=SECONDS shows the animation paused there; scene=N opens scene N;
+  // clip=NAME plays the animation of that name (a board's own).
   var hash = {};
   location.hash.replace(/^#/, '').split('&').forEach(function (kv) {
     var p = kv.split('=');
@@ -72,6 +73,8 @@ const char* report_viewer_script() {
   var clock = new THREE.Clock();
 
   var sceneMenu = document.getElementById('scene');
+  var clipMenu = document.getElementById('clip');
+  var clips = [];
   var playButton = document.getElementById('play');
   var slider = document.getElementById('time');
   var timeText = document.getElementById('time-text');
@@ -139,6 +142,15 @@ const char* report_viewer_script() {
     controls.update();
   }
 
+  function playClip(index, time) {
+    var clip = clips[index];
+    mixer.stopAllAction();
+    duration = clip.duration;
+    mixer.clipAction(clip).play();
+    mixer.setTime(Math.min(time, duration));
+    slider.max = duration;
+  }
+
   function open(index) {
     var source = sources[index];
     if (!source) {
@@ -160,12 +172,23 @@ const char* report_viewer_script() {
       frameView(gltf.scene);
       mixer = null;
       duration = 0;
-      if (gltf.animations.length > 0) {
-        var clip = gltf.animations[0];
-        duration = clip.duration;
+      // The animations: the first ("plan": the whole plan) plays; the menu picks another (a
+      // board's own).
+      clips = gltf.animations;
+      clipMenu.textContent = '';
+      clips.forEach(function (c, i) {
+        var option = document.createElement('option');
+        option.value = i;
+        option.textContent = c.name || ('animation ' + i);
+        clipMenu.appendChild(option);
+      });
+      clipMenu.hidden = clips.length < 2;
+      if (clips.length > 0) {
+        // #clip=NAME: that animation (a board's), else the first.
+        var first = Math.max(0, clips.findIndex(function (c) { return c.name === hash.clip; }));
+        clipMenu.value = first;
         mixer = new THREE.AnimationMixer(gltf.scene);
-        mixer.clipAction(clip).play();
-        mixer.setTime(fixedTime !== null ? Math.min(fixedTime, duration) : 0);
+        playClip(first, fixedTime !== null ? fixedTime : 0);
       }
       slider.max = duration;
       slider.disabled = playButton.disabled = !mixer;
@@ -187,6 +210,11 @@ const char* report_viewer_script() {
     sceneMenu.appendChild(option);
   });
   sceneMenu.addEventListener('change', function () { open(Number(sceneMenu.value)); });
+  clipMenu.addEventListener('change', function () {
+    if (!mixer) return;
+    playClip(Number(clipMenu.value), 0);
+    showTime(0);
+  });
   playButton.addEventListener('click', function () {
     playing = !playing;
     playButton.textContent = playing ? 'pause' : 'play';

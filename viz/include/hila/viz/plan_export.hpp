@@ -35,6 +35,10 @@ struct PlanStart {
 //   table until picked), "held/B#i" (a child of the holding arm's TCP link node, from the grasp
 //   event on), "placed/B#i" (where it was let go, in the world), "finished/B" (at its target in
 //   the assembly frame from the board's end; an unsolved board from its start), "tool/LINK#i".
+// Besides "plan", one animation per solved board, named after the board, over that board's span:
+// its times run from 0 to the board's duration (the plan file's times of the board), with the
+// same channels keyed at its start, its end and the time stamps between, so that each board can
+// be played on its own. No animation when nothing moves.
 // The jaws stay open and the human stays in the neutral posture. Throws core::InputError for a
 // board or arm the cell or product does not know, or joints of the wrong size.
 std::string plan_glb(const core::Cell& cell, const core::ProductSpec& product,
