@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "hila/core/comfort.hpp"
 #include "hila/core/product.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/handover.hpp"
@@ -35,18 +36,23 @@ const offline::HumanComfort& comfort() {
   return c;
 }
 
-offline::BoardGrasps board_grasps(std::size_t index) {
+// `human_samples`: fewer than the build's default keeps the cabinet's tests quick.
+offline::BoardGrasps board_grasps(const core::ProductSpec& of, std::size_t index,
+                                  int human_samples = 400) {
   const auto cell = test::reference_cell();
-  const auto& part = product().parts[index];
+  const auto& part = of.parts[index];
   const auto analysis = offline::analyze_part(part.name, part.mesh, part.mass);
   offline::BoardGrasps g;
   g.robot = offline::plan_robot_grasps(analysis.mesh, analysis, part.mass, *cell, {});
   g.suction = offline::plan_suction_grasps(analysis.mesh, analysis, part.mass, *cell, {});
   offline::HumanGraspSettings human;
-  human.samples = 400;
+  human.samples = human_samples;
   g.human = offline::plan_human_grasps(analysis.mesh, analysis, part.mass, *cell, human);
   g.com = analysis.mass_properties.com;
   return g;
+}
+offline::BoardGrasps board_grasps(std::size_t index) {
+  return board_grasps(product(), index);
 }
 
 // Oriented box of a board (its mesh's bounding box in the part frame, placed in the world).
@@ -226,9 +232,9 @@ void check_stage(std::size_t index) {
     const auto& g = grasps.robot[static_cast<std::size_t>(d.robot_grasp_id)];
     const core::Arm& arm = cell->arm(d.arm);
     const core::Pose base = core::arm_base_in_world(*cell, arm);
-    EXPECT_LT(((base * arm.chain.fk(d.joints_pick)).matrix() - (part.initial * g.tcp).matrix())
-                  .norm(),
-              1e-6);
+    EXPECT_LT(
+        ((base * arm.chain.fk(d.joints_pick)).matrix() - (part.initial * g.tcp).matrix()).norm(),
+        1e-6);
     EXPECT_LT(((base * arm.chain.fk(d.joints_rh)).matrix() - (c.board * g.tcp).matrix()).norm(),
               1e-6);
     EXPECT_TRUE(slip_ok(part.initial, g));
@@ -271,6 +277,55 @@ TEST(Handover, OneHandBoardWithTwoFinishedBoards) {
 
 TEST(Handover, TwoHandLateralBesideTheBase) {
   check_stage(1);  // lateral_right: 1.8 kg, two hands, a tight slip limit
+}
+
+// The top of the generated product gen1_p12 (tests/data/wide_top): a 0.73 kg board one hand
+// holds at a single grasp, where the human's own IK rejects every candidate a way serves. It is
+// handed over for two hands, at grasps the human's IK reaches comfortably: each goal's stored
+// postures put both hands on their grasps (forward kinematics), at least two_hand_separation
+// apart, and their Q recomputed from the joints is the stored one, above the threshold.
+TEST(Handover, AWideBoardOneHandHoldsOnlyAtAnEdgeIsHandedOverForTwoHands) {
+  const auto cell = test::reference_cell();
+  const core::ProductSpec wide =
+      core::load_product(std::string(HILA_TEST_DATA_DIR) + "/wide_top/product.yaml");
+  std::size_t index = 0;
+  while (wide.parts[index].name != "top") ++index;
+  const auto grasps = board_grasps(wide, index, offline::HumanGraspSettings{}.samples);
+  const auto one_hand = std::count_if(grasps.human.begin(), grasps.human.end(),
+                                      [](const auto& g) { return g.one_hand_stable; });
+  ASSERT_GT(one_hand, 0);  // one hand holds it: not a two-hand part by the soft-finger check
+  const offline::HandoverSettings settings;
+  const auto result = offline::plan_handover_goals(*cell, wide, index, grasps, comfort(), settings);
+  ASSERT_EQ(result.stage.failure, "");
+  ASSERT_GT(result.stage.goals, 0);
+  EXPECT_FALSE(result.stage.two_hands);
+  int confirmed = 0;
+  for (const auto& c : result.candidates) {
+    if (c.status != "goal" || c.human_joints.size() == 0) continue;
+    ++confirmed;
+    ASSERT_GE(c.second_grasp_id, 0) << "goal " << c.rank << " is taken with one hand";
+    const auto& g0 = grasps.human[static_cast<std::size_t>(c.human_grasp_id)];
+    const auto& g1 = grasps.human[static_cast<std::size_t>(c.second_grasp_id)];
+    EXPECT_GE((g0.hand.translation() - g1.hand.translation()).norm(), settings.two_hand_separation);
+    const std::pair<std::string, std::pair<const Eigen::VectorXd*, const core::Pose*>> hands[2] = {
+        {c.human_arm, {&c.human_joints, &g0.hand}}, {c.second_arm, {&c.second_joints, &g1.hand}}};
+    const double stored_q[2] = {c.human_quality, c.second_quality};
+    for (int k = 0; k < 2; ++k) {
+      int arm = 0;
+      while (comfort().arm_name(arm) != hands[k].first) ++arm;
+      const auto& chain = cell->human_arms()[static_cast<std::size_t>(arm)].chain;
+      const Eigen::VectorXd& q = *hands[k].second.first;
+      const core::Pose hand = comfort().arm_base(arm) * chain.fk(q);
+      const core::Pose want = c.board * *hands[k].second.second;
+      EXPECT_LT((hand.translation() - want.translation()).norm(), 1e-4);
+      EXPECT_LT(Eigen::AngleAxisd(hand.linear().transpose() * want.linear()).angle(), 1e-4);
+      const double recomputed =
+          core::comfort_index(chain.jacobian(q), core::characteristic_length(chain));
+      EXPECT_NEAR(recomputed, stored_q[k], 1e-9);
+      EXPECT_GT(recomputed, settings.comfort_threshold);
+    }
+  }
+  EXPECT_GT(confirmed, 0);
 }
 
 TEST(Handover, SameSeedSameGoals) {
