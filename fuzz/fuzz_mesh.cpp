@@ -1,6 +1,7 @@
-// libFuzzer target: the mesh reader (core::load_mesh, assimp). assimp picks its importer by the
-// file's extension, so the input's first byte chooses it (byte % 3: .stl, .obj, .ply, the formats
-// hila writes) and the rest is the file; fuzz/run prefixes the seed meshes accordingly.
+// libFuzzer target: the mesh reader (core::load_mesh: its checks, then assimp). assimp picks its
+// importer by the file's extension, so the input's first byte chooses it (byte % 3: .stl, .obj,
+// .ply, the three load_mesh reads) and the rest is the file; fuzz/run prefixes the seed meshes
+// accordingly.
 #include <array>
 
 #include "fuzz_input.hpp"

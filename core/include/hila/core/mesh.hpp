@@ -16,9 +16,10 @@ struct TriangleMesh {
   Eigen::Vector3d max_corner() const;
 };
 
-// Reads any assimp-readable mesh (STL, OBJ, PLY, glTF, ...), merges all its meshes, applies
-// `unit_scale` (metres per file unit, e.g. 0.001 for millimetres) and joins identical vertices.
-// Throws InputError for a missing/unreadable file, an empty mesh or non-finite coordinates.
+// Reads an STL, OBJ or PLY mesh (by its extension, any case) with assimp, merges all its meshes,
+// applies `unit_scale` (metres per file unit, e.g. 0.001 for millimetres) and joins identical
+// vertices. Throws InputError for a missing/unreadable file, another extension, a file assimp 5.2
+// would mishandle (src/mesh_checks.hpp), an empty mesh or non-finite coordinates.
 TriangleMesh load_mesh(const std::string& path, double unit_scale);
 
 // An axis-aligned box centred at the origin (12 outward-facing triangles).
