@@ -248,6 +248,38 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     return clear;
   };
 
+  // The best pair of `lists` (one grasp per arm, best first, each hand clear alone) for two
+  // hands: far enough apart and clear together, Q the weaker hand's; `best` improved in place.
+  auto choose_pair = [&](const core::Pose& board, const std::vector<ScoredGrasp>(&lists)[2],
+                         HumanChoice& best) {
+    for (const auto& s0 : lists[0]) {
+      for (const auto& s1 : lists[1]) {
+        const double q = std::min(s0.quality, s1.quality);
+        const double q0 = std::min(s0.default_quality, s1.default_quality);
+        if (q <= best.quality && q0 <= best.default_quality) continue;
+        const auto& g0 = grasps.human[static_cast<std::size_t>(s0.grasp)];
+        const auto& g1 = grasps.human[static_cast<std::size_t>(s1.grasp)];
+        if ((g0.hand.translation() - g1.hand.translation()).norm() < settings.two_hand_separation) {
+          continue;
+        }
+        place_hand(screen_data, screen_hands[0], board * g0.hand, g0.aperture + kHandOpeningMargin);
+        place_hand(screen_data, screen_hands[1], board * g1.hand, g1.aperture + kHandOpeningMargin);
+        if (core::in_collision(screen, screen_data, screen_hands[0].all())) continue;
+        best.default_quality = std::max(best.default_quality, q0);
+        if (q > best.quality) {
+          best.quality = q;
+          best.arm = 0;
+          best.grasp = s0.grasp;
+          best.arm_quality = s0.quality;
+          best.second_arm = 1;
+          best.second_grasp = s1.grasp;
+          best.second_quality = s1.quality;
+        }
+      }
+    }
+    park_hand(screen_data, screen_hands[0]);
+    park_hand(screen_data, screen_hands[1]);
+  };
   auto choose_human = [&](const core::Pose& board) {
     HumanChoice best;
     screen_data.set_body_pose(screen_board, board);
@@ -280,33 +312,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         if (human_hand_clear(board, a, s.grasp)) lists[a].push_back(s);
       }
     }
-    for (const auto& s0 : lists[0]) {
-      for (const auto& s1 : lists[1]) {
-        const double q = std::min(s0.quality, s1.quality);
-        const double q0 = std::min(s0.default_quality, s1.default_quality);
-        if (q <= best.quality && q0 <= best.default_quality) continue;
-        const auto& g0 = grasps.human[static_cast<std::size_t>(s0.grasp)];
-        const auto& g1 = grasps.human[static_cast<std::size_t>(s1.grasp)];
-        if ((g0.hand.translation() - g1.hand.translation()).norm() < settings.two_hand_separation) {
-          continue;
-        }
-        place_hand(screen_data, screen_hands[0], board * g0.hand, g0.aperture + kHandOpeningMargin);
-        place_hand(screen_data, screen_hands[1], board * g1.hand, g1.aperture + kHandOpeningMargin);
-        if (core::in_collision(screen, screen_data, screen_hands[0].all())) continue;
-        best.default_quality = std::max(best.default_quality, q0);
-        if (q > best.quality) {
-          best.quality = q;
-          best.arm = 0;
-          best.grasp = s0.grasp;
-          best.arm_quality = s0.quality;
-          best.second_arm = 1;
-          best.second_grasp = s1.grasp;
-          best.second_quality = s1.quality;
-        }
-      }
-    }
-    park_hand(screen_data, screen_hands[0]);
-    park_hand(screen_data, screen_hands[1]);
+    choose_pair(board, lists, best);
     return best;
   };
 
@@ -914,20 +920,16 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   auto rechoose_human = [&](int ci) {
     auto& c = result.candidates[static_cast<std::size_t>(ci)];
     HumanChoice& h = choices[static_cast<std::size_t>(ci)];
-    struct Confirmed {
-      int grasp;
-      double quality;
-    };
     const int arms = std::min(comfort.arm_count(), 2);
-    // Per arm, the grasps of `from` the IK confirms.
-    auto confirm = [&](const std::vector<int>& from, std::vector<Confirmed>(&out)[2]) {
+    // Per arm, the grasps of `from` the IK confirms, with the IK's Q.
+    auto confirm = [&](const std::vector<int>& from, std::vector<ScoredGrasp>(&out)[2]) {
       for (int a = 0; a < arms; ++a) {
         int tried = 0;
         for (const auto& sg : score_grasps(comfort, a, c.board, grasps.human, from)) {
           if (++tried > 12) break;
           if (!human_hand_clear(c.board, a, sg.grasp)) continue;
           const core::ComfortResult r = solve_human(c.board, a, sg.grasp);
-          if (r.reachable && r.quality > threshold) out[a].push_back({sg.grasp, r.quality});
+          if (r.reachable && r.quality > threshold) out[a].push_back({r.quality, 0.0, sg.grasp});
         }
         park_hand(screen_data, screen_hands[a]);
       }
@@ -935,10 +937,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     screen_data.set_body_pose(screen_board, c.board);
     HumanChoice best;
     if (!eligible.empty()) {
-      std::vector<Confirmed> one[2];
+      std::vector<ScoredGrasp> one[2];
       confirm(eligible, one);
       for (int a = 0; a < arms; ++a) {
-        for (const Confirmed& k : one[a]) {
+        for (const ScoredGrasp& k : one[a]) {
           if (k.quality <= best.quality) continue;
           best.quality = best.arm_quality = k.quality;
           best.arm = a;
@@ -947,34 +949,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       }
     }
     if (best.grasp < 0 && arms == 2) {
-      std::vector<Confirmed> two[2];
+      std::vector<ScoredGrasp> two[2];
       confirm(both_hands, two);
-      for (const Confirmed& k0 : two[0]) {
-        for (const Confirmed& k1 : two[1]) {
-          const double q = std::min(k0.quality, k1.quality);
-          if (q <= best.quality) continue;
-          const auto& g0 = grasps.human[static_cast<std::size_t>(k0.grasp)];
-          const auto& g1 = grasps.human[static_cast<std::size_t>(k1.grasp)];
-          if ((g0.hand.translation() - g1.hand.translation()).norm() <
-              settings.two_hand_separation) {
-            continue;
-          }
-          place_hand(screen_data, screen_hands[0], c.board * g0.hand,
-                     g0.aperture + kHandOpeningMargin);
-          place_hand(screen_data, screen_hands[1], c.board * g1.hand,
-                     g1.aperture + kHandOpeningMargin);
-          if (core::in_collision(screen, screen_data, screen_hands[0].all())) continue;
-          best.quality = q;
-          best.arm = 0;
-          best.grasp = k0.grasp;
-          best.arm_quality = k0.quality;
-          best.second_arm = 1;
-          best.second_grasp = k1.grasp;
-          best.second_quality = k1.quality;
-        }
-      }
-      park_hand(screen_data, screen_hands[0]);
-      park_hand(screen_data, screen_hands[1]);
+      choose_pair(c.board, two, best);
     }
     screen_data.set_body_pose(screen_board, kParked);
     if (best.grasp < 0) return false;
