@@ -261,8 +261,43 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
   }
   EXPECT_GT(alone_bent, 0);
   EXPECT_EQ(e["verdicts_hila_vs"]["alone"]["bent_forward"], "eliminated");
+  // RULA and REBA of each way's posture (the build's, evaluated again: every one reproduced
+  // with the default settings), and their distributions adding up to the boards scored.
+  std::map<std::string, int> scored;
+  for (const auto& b : e["boards"]) {
+    for (const char* method : {"hila", "table", "alone"}) {
+      const auto& m = b[method];
+      if (!m["reachable"].get<bool>()) continue;
+      SCOPED_TRACE(b["part"].get<std::string>() + " " + method);
+      ASSERT_TRUE(m.contains("rula")) << m.dump();
+      ++scored[method];
+      EXPECT_GE(m["rula"]["grand"].get<int>(), 1);
+      EXPECT_LE(m["rula"]["grand"].get<int>(), 7);
+      EXPECT_GE(m["reba"]["score"].get<int>(), 1);
+      EXPECT_LE(m["reba"]["score"].get<int>(), 15);
+      EXPECT_GT(m["load_kg"].get<double>(), 0.0);
+    }
+  }
+  for (const char* method : {"hila", "table", "alone"}) {
+    SCOPED_TRACE(method);
+    const auto& s = e["summary"][method];
+    EXPECT_EQ(s["scored"].get<int>(), scored[method]);
+    EXPECT_EQ(scored[method], s["boards"].get<int>() - s["unreachable"].get<int>());
+    for (const char* distribution :
+         {"rula_grand", "rula_action_level", "reba_score", "reba_risk"}) {
+      int sum = 0;
+      for (const auto& [key, n] : s[distribution].items()) sum += n.get<int>();
+      EXPECT_EQ(sum, scored[method]) << distribution << ": " << s[distribution].dump();
+    }
+    double mean = 0.0;
+    for (const auto& [key, n] : s["rula_grand"].items()) mean += std::stoi(key) * n.get<int>();
+    EXPECT_NEAR(s["mean_rula_grand"].get<double>(), mean / scored[method], 1e-12);
+  }
+  EXPECT_GT(scored["hila"], 0);
   const CommandRun report_text = run("report ergonomics " + out);
   EXPECT_NE(report_text.out.find("bent forward eliminated"), std::string::npos) << report_text.out;
+  EXPECT_NE(report_text.out.find("hila  RULA grand (boards by score) "), std::string::npos)
+      << report_text.out;
 
   const CommandRun digest1 = run("inspect " + out + " digest");
   ASSERT_EQ(digest1.status, 0);
