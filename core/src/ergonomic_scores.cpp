@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "hila/core/cell.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/pose.hpp"
 #include "hila/core/robot_model.hpp"
@@ -385,6 +386,29 @@ RebaInputs reba_inputs_from_posture(const RobotModel& human, const Eigen::Vector
   in.wrist_deviated_or_twisted =
       std::abs(a.wrist_deviation) > kNeutralBandDeg || a.forearm_rotation_near_end;
   return in;
+}
+
+Eigen::VectorXd human_posture(
+    const Cell& cell, const std::vector<std::pair<std::string, Eigen::VectorXd>>& arm_joints) {
+  Eigen::VectorXd q = cell.human_neutral();
+  for (const auto& [name, joints] : arm_joints) {
+    const auto& arms = cell.human_arms();
+    const auto arm = std::find_if(arms.begin(), arms.end(),
+                                  [&](const HumanArm& h) { return h.spec.name == name; });
+    if (arm == arms.end()) {
+      std::string names;
+      for (const HumanArm& h : arms) names += (names.empty() ? "" : ", ") + h.spec.name;
+      throw InputError(cell.spec().file, "human.arms", "one of: " + names, "'" + name + "'");
+    }
+    const auto& vars = arm->chain.model_variables();
+    if (joints.size() != static_cast<Eigen::Index>(vars.size()) || !joints.allFinite()) {
+      throw InputError(cell.spec().file, "human arm '" + name + "' joints",
+                       std::to_string(vars.size()) + " finite values",
+                       std::to_string(joints.size()) + (joints.allFinite() ? "" : " (not finite)"));
+    }
+    for (std::size_t i = 0; i < vars.size(); ++i) q[vars[i]] = joints[static_cast<Eigen::Index>(i)];
+  }
+  return q;
 }
 
 }  // namespace hila::core

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "hila/core/robot_model.hpp"
 #include "hila/core/comfort.hpp"
+#include "hila/core/robot_model.hpp"
 #include "hila/offline/handover.hpp"
 
 namespace hila::offline {
@@ -133,7 +133,8 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
 std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
                                                       const HumanComfort& comfort,
                                                       const ErgonomicsInputs& in,
-                                                      const ErgonomicsSettings& settings) {
+                                                      const ErgonomicsSettings& settings,
+                                                      std::vector<Posture>* postures) {
   const auto& grasps = *in.human_grasps;
   std::vector<int> one_hand, all;
   for (std::size_t g = 0; g < grasps.size(); ++g) {
@@ -142,7 +143,9 @@ std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
   }
   // Two-hand boards: the posture of one hand (the better one) stands for both.
   const std::vector<int>& usable = one_hand.empty() ? all : one_hand;
+  if (postures != nullptr) postures->clear();
   auto record = [&](const std::string& method, const core::Pose& board, const Posture& p) {
+    if (postures != nullptr) postures->push_back(p);
     db::ErgonomicsRecord r;
     r.method = method;
     r.reachable = p.reachable;

@@ -766,3 +766,30 @@ TEST(ErgonomicScores, PostureMappingRejectsBadInput) {
       [&] { core::human_arm_angles(robot, Eigen::VectorXd::Zero(robot.num_variables()), "left"); },
       {"human joint", "'left_shoulder_flexion'"});
 }
+
+// A human arm's chain joints placed into the whole human configuration: the hand where the
+// chain's forward kinematics puts it (relative to the arm's base link), every other variable at
+// the neutral posture.
+TEST(ErgonomicScores, HumanPostureSetsTheNamedArmsChainJoints) {
+  const auto cell = test::reference_cell();
+  ASSERT_EQ(cell->human_arms().size(), 2u);
+  const core::HumanArm& left = cell->human_arms()[0];
+  const Eigen::VectorXd neutral = cell->human_neutral();
+  const Eigen::VectorXd arm_q =
+      (0.3 * left.chain.lower_limits() + 0.7 * left.chain.upper_limits()).eval();
+  const Eigen::VectorXd q = core::human_posture(*cell, {{left.spec.name, arm_q}});
+  ASSERT_EQ(q.size(), neutral.size());
+  std::vector<core::Pose> links;
+  cell->human().link_poses(q, links);
+  const core::Pose base = links[cell->human().link_index(left.spec.base_link)];
+  const core::Pose tip = links[cell->human().link_index(left.spec.tip_link)];
+  EXPECT_TRUE((base.inverse() * tip).isApprox(left.chain.fk(arm_q), 1e-9));
+  std::vector<bool> arm_variable(static_cast<std::size_t>(q.size()), false);
+  for (const int v : left.chain.model_variables()) arm_variable[static_cast<std::size_t>(v)] = true;
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    if (!arm_variable[static_cast<std::size_t>(i)]) EXPECT_EQ(q[i], neutral[i]) << i;
+  }
+  EXPECT_EQ(core::human_posture(*cell, {}), neutral);
+  EXPECT_THROW(core::human_posture(*cell, {{"middle", arm_q}}), core::InputError);
+  EXPECT_THROW(core::human_posture(*cell, {{"left", Eigen::VectorXd::Zero(2)}}), core::InputError);
+}

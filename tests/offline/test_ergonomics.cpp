@@ -125,3 +125,41 @@ TEST(Ergonomics, TableDropPoseLiesFlatOnTheTableAtTheSpot) {
   EXPECT_NEAR(0.5 * (lo.x() + hi.x()), settings.table_spot_x, 1e-6);
   EXPECT_NEAR(0.5 * (lo.y() + hi.y()), settings.table_spot_y, 1e-6);
 }
+
+// evaluate_ergonomics with `postures`: each record's posture beside it, in the same order, and
+// the same records as without; evaluated again with the same inputs and seed, the same records
+// (what `hila report ergonomics` relies on to find the stored postures' joints).
+TEST(Ergonomics, EvaluateReturnsEachRecordsPostureAndRepeatsItself) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  offline::ErgonomicsInputs in;
+  in.target = b.spec.target;
+  in.initial = b.spec.initial;
+  in.has_placement = true;
+  in.table_placement = b.analysis.placements.front().part_in_plane;
+  in.human_grasps = &b.grasps;
+  offline::ErgonomicsSettings settings;
+  settings.seed = 11;
+  std::vector<offline::Posture> postures{offline::Posture{}};  // cleared first
+  const auto with = offline::evaluate_ergonomics(*cell, comfort(), in, settings, &postures);
+  const auto without = offline::evaluate_ergonomics(*cell, comfort(), in, settings);
+  ASSERT_EQ(with.size(), 2u);  // table and alone (no goal)
+  ASSERT_EQ(postures.size(), with.size());
+  ASSERT_EQ(without.size(), with.size());
+  for (std::size_t i = 0; i < with.size(); ++i) {
+    SCOPED_TRACE(with[i].method);
+    const offline::Posture& p = postures[i];
+    EXPECT_EQ(p.reachable, with[i].reachable);
+    ASSERT_TRUE(p.reachable);
+    EXPECT_EQ(comfort().arm_name(p.arm), with[i].arm);
+    EXPECT_EQ(p.torso_flexion_deg, with[i].torso_flexion_deg);
+    EXPECT_EQ(p.quality, with[i].quality);
+    EXPECT_EQ(p.arm_joints.size(), cell->human_arms()[static_cast<std::size_t>(p.arm)].chain.dof());
+    EXPECT_EQ(without[i].method, with[i].method);
+    EXPECT_EQ(without[i].arm, with[i].arm);
+    EXPECT_EQ(without[i].torso_flexion_deg, with[i].torso_flexion_deg);
+    EXPECT_EQ(without[i].quality, with[i].quality);
+  }
+  EXPECT_EQ(with[0].method, "table");
+  EXPECT_EQ(with[1].method, "alone");
+}

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -261,8 +262,76 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
   }
   EXPECT_GT(alone_bent, 0);
   EXPECT_EQ(e["verdicts_hila_vs"]["alone"]["bent_forward"], "eliminated");
+  // RULA and REBA of each way's posture (the build's, evaluated again: every one reproduced
+  // with the default settings), and their distributions adding up to the boards scored.
+  std::map<std::string, int> scored;
+  for (const auto& b : e["boards"]) {
+    for (const char* method : {"hila", "table", "alone"}) {
+      const auto& m = b[method];
+      if (!m["reachable"].get<bool>()) continue;
+      SCOPED_TRACE(b["part"].get<std::string>() + " " + method);
+      ASSERT_TRUE(m.contains("rula")) << m.dump();
+      ++scored[method];
+      EXPECT_GE(m["rula"]["grand"].get<int>(), 1);
+      EXPECT_LE(m["rula"]["grand"].get<int>(), 7);
+      EXPECT_GE(m["reba"]["score"].get<int>(), 1);
+      EXPECT_LE(m["reba"]["score"].get<int>(), 15);
+      EXPECT_GT(m["load_kg"].get<double>(), 0.0);
+    }
+  }
+  for (const char* method : {"hila", "table", "alone"}) {
+    SCOPED_TRACE(method);
+    const auto& s = e["summary"][method];
+    EXPECT_EQ(s["scored"].get<int>(), scored[method]);
+    EXPECT_EQ(scored[method], s["boards"].get<int>() - s["unreachable"].get<int>());
+    for (const char* distribution :
+         {"rula_grand", "rula_action_level", "reba_score", "reba_risk"}) {
+      int sum = 0;
+      for (const auto& [key, n] : s[distribution].items()) sum += n.get<int>();
+      EXPECT_EQ(sum, scored[method]) << distribution << ": " << s[distribution].dump();
+    }
+    double mean = 0.0;
+    for (const auto& [key, n] : s["rula_grand"].items()) mean += std::stoi(key) * n.get<int>();
+    EXPECT_NEAR(s["mean_rula_grand"].get<double>(), mean / scored[method], 1e-12);
+  }
+  EXPECT_GT(scored["hila"], 0);
   const CommandRun report_text = run("report ergonomics " + out);
   EXPECT_NE(report_text.out.find("bent forward eliminated"), std::string::npos) << report_text.out;
+  EXPECT_NE(report_text.out.find("hila  RULA grand (boards by score) "), std::string::npos)
+      << report_text.out;
+  // The plan file: each solved board's receiving posture scored, a hand per arm of
+  // human_posture_rad, the board's RULA and REBA the worse hand's.
+  const CommandRun plan = run("plan --db " + out + " --scene " +
+                              test::data_path("cabinet/scene.yaml") + " --all --json");
+  const auto p = nlohmann::json::parse(json_part(plan.out));
+  int two_hand = 0, solved = 0;
+  for (const auto& b : p["boards"]) {
+    if (b["status"] != "solved") continue;
+    ++solved;
+    SCOPED_TRACE(b["board"].get<std::string>());
+    const auto& e = b["ergonomics"];
+    ASSERT_TRUE(e.contains("hands")) << e.dump();
+    ASSERT_EQ(e["hands"].size(), b["human_posture_rad"].size());
+    EXPECT_EQ(e["two_hands"].get<bool>(), e["hands"].size() == 2);
+    two_hand += e["two_hands"].get<bool>() ? 1 : 0;
+    int grand = 0, reba = 0;
+    for (const auto& h : e["hands"]) {
+      EXPECT_TRUE(b["human_posture_rad"].contains(h["side"].get<std::string>()));
+      grand = std::max(grand, h["rula"]["grand"].get<int>());
+      reba = std::max(reba, h["reba"]["score"].get<int>());
+      EXPECT_DOUBLE_EQ(h["reba"]["load_kg"].get<double>(), e["load_kg"].get<double>());
+      EXPECT_DOUBLE_EQ(h["rula"]["load_kg"].get<double>(),
+                       e["load_kg"].get<double>() / static_cast<double>(e["hands"].size()));
+    }
+    EXPECT_EQ(e["rula"]["grand"].get<int>(), grand);
+    EXPECT_EQ(e["reba"]["score"].get<int>(), reba);
+    EXPECT_GE(grand, 1);
+    EXPECT_LE(grand, 7);
+    EXPECT_GE(e["rula"]["action_level"].get<int>(), 1);
+    EXPECT_FALSE(e["reba"]["risk"].get<std::string>().empty());
+  }
+  EXPECT_GT(solved, 0) << plan.out;
+  EXPECT_GT(two_hand, 0);
 
   const CommandRun digest1 = run("inspect " + out + " digest");
   ASSERT_EQ(digest1.status, 0);

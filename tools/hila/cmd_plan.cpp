@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/online/board_planner.hpp"
+#include "hila/online/receiving_scores.hpp"
 #include "io_checks.hpp"
 #include "option_checks.hpp"
 
@@ -39,7 +40,86 @@ nlohmann::json pose_to_json(const core::Pose& pose) {
   return {{"xyz", {t.x(), t.y(), t.z()}}, {"quat_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
 }
 
-nlohmann::json plan_json(const online::BoardPlan& plan) {
+// A hand's RULA and REBA with every sub-score, and the arm angles they were scored from.
+nlohmann::json hand_scores_json(const online::HandScores& h) {
+  const core::RulaScore& r = h.rula;
+  const core::RebaScore& b = h.reba;
+  return {{"side", h.arm},
+          {"angles_deg",
+           {{"trunk_flexion", h.rula_inputs.trunk_flexion_deg},
+            {"upper_arm", h.rula_inputs.upper_arm_flexion_deg},
+            {"upper_arm_abducted", h.rula_inputs.upper_arm_abducted},
+            {"lower_arm", h.rula_inputs.lower_arm_flexion_deg},
+            {"arm_across_midline_or_out_to_side", h.rula_inputs.arm_across_midline_or_out_to_side},
+            {"wrist", h.rula_inputs.wrist_flexion_deg},
+            {"wrist_deviated", h.rula_inputs.wrist_deviated},
+            {"wrist_twist_near_end", h.rula_inputs.wrist_twist_near_end}}},
+          {"rula",
+           {{"grand", r.grand},
+            {"action_level", core::rula_action_level(r.grand)},
+            {"action", core::rula_action(r.grand)},
+            {"load_kg", h.rula_inputs.load_kg},
+            {"upper_arm", r.upper_arm},
+            {"lower_arm", r.lower_arm},
+            {"wrist", r.wrist},
+            {"wrist_twist", r.wrist_twist},
+            {"posture_a", r.posture_a},
+            {"muscle_use", r.muscle_use},
+            {"force_load", r.force_load},
+            {"score_c", r.score_c},
+            {"neck", r.neck},
+            {"trunk", r.trunk},
+            {"legs", r.legs},
+            {"posture_b", r.posture_b},
+            {"score_d", r.score_d}}},
+          {"reba",
+           {{"score", b.reba},
+            {"risk", core::reba_risk_level(b.reba)},
+            {"load_kg", h.reba_inputs.load_kg},
+            {"neck", b.neck},
+            {"trunk", b.trunk},
+            {"legs", b.legs},
+            {"posture_a", b.posture_a},
+            {"load_force", b.load_force},
+            {"score_a", b.score_a},
+            {"upper_arm", b.upper_arm},
+            {"lower_arm", b.lower_arm},
+            {"wrist", b.wrist},
+            {"posture_b", b.posture_b},
+            {"coupling", b.coupling},
+            {"score_b", b.score_b},
+            {"score_c", b.score_c},
+            {"activity", b.activity}}}};
+}
+
+// The receiving posture's RULA and REBA (docs/online.md): the board's scores (the worse hand's)
+// and each hand's. Scored here, after planning; a human model the scores cannot read says why.
+nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& plan,
+                               double load_kg) {
+  online::ReceivingScores s;
+  try {
+    s = online::receiving_scores(cell, plan, load_kg);
+  } catch (const core::InputError& e) {
+    return {{"error", e.what()}};
+  }
+  if (!s.scored) return {{"error", "no receiving posture"}};
+  nlohmann::json hands = nlohmann::json::array();
+  for (const auto& h : s.hands) hands.push_back(hand_scores_json(h));
+  return {{"load_kg", s.load_kg},
+          {"two_hands", s.two_hands},
+          {"rula",
+           {{"grand", s.rula().grand},
+            {"action_level", core::rula_action_level(s.rula().grand)},
+            {"action", core::rula_action(s.rula().grand)},
+            {"side", s.hands[static_cast<std::size_t>(s.worst_rula)].arm}}},
+          {"reba",
+           {{"score", s.reba().reba},
+            {"risk", core::reba_risk_level(s.reba().reba)},
+            {"side", s.hands[static_cast<std::size_t>(s.worst_reba)].arm}}},
+          {"hands", hands}};
+}
+
+nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, double load_kg) {
   nlohmann::json attempts = nlohmann::json::array();
   for (const auto& a : plan.attempts) {
     attempts.push_back({{"rank", a.rank},
@@ -129,6 +209,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan) {
     if (!plan.second_human_arm.empty())
       posture[plan.second_human_arm] = joints(plan.second_human_joints);
     j["human_posture_rad"] = posture;
+    j["ergonomics"] = ergonomics_json(cell, plan, load_kg);
     if (plan.mode == online::DeliveryMode::kExchange) {
       j["robot_handover"] = pose_to_json(plan.robot_handover);
     }
@@ -189,7 +270,7 @@ int run_plan(const PlanOptions& opt) {
     // Where the suction arm cannot take the tool where it is, the plan begins with the other arm
     // setting it down where it can (BoardPlan::tool_place).
     const online::BoardPlan plan = planner.plan(scene, board, deadline);
-    out["boards"].push_back(plan_json(plan));
+    out["boards"].push_back(plan_json(plan, model->cell(), model->product().part(board).mass));
     if (!opt.json) {
       std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;
       if (plan.solved()) {

@@ -2,9 +2,12 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace hila::core {
 
+class Cell;
 class RobotModel;
 
 // RULA (McAtamney & Corlett 1993, Applied Ergonomics 24(2):91-99) and REBA (Hignett & McAtamney
@@ -217,5 +220,12 @@ RulaInputs rula_inputs_from_posture(const RobotModel& human, const Eigen::Vector
 // for RULA, knees straight, both feet bearing weight; coupling and activity keep their defaults.
 RebaInputs reba_inputs_from_posture(const RobotModel& human, const Eigen::VectorXd& q,
                                     const std::string& side, double load_kg);
+
+// The human's whole configuration (cell.human()'s variables) at a posture given by arm, what
+// the functions above read: cell.human_neutral() with each named human arm's chain joints (rad,
+// in the chain's order: a handover goal's stored human_joints, second_joints) set. Throws
+// InputError for an arm the cell has not, or joints of the wrong count or not finite.
+Eigen::VectorXd human_posture(
+    const Cell& cell, const std::vector<std::pair<std::string, Eigen::VectorXd>>& arm_joints);
 
 }  // namespace hila::core

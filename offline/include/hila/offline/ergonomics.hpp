@@ -60,11 +60,13 @@ struct ErgonomicsInputs {
 // "hila" only with a goal, "table" only with a placement):
 // hila's first goal with its human grasp; the board laid flat at the table spot; the human alone
 // stepping sideways to face the stack and taking the board from it. Board-specific inputs only;
-// part_id is left unset.
+// part_id is left unset. With `postures`, also each record's posture (its arm's joints), in the
+// same order: what the database does not store, for `hila report ergonomics` to score.
 std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
                                                       const HumanComfort& comfort,
                                                       const ErgonomicsInputs& inputs,
-                                                      const ErgonomicsSettings& settings);
+                                                      const ErgonomicsSettings& settings,
+                                                      std::vector<Posture>* postures = nullptr);
 
 // The world pose of a board laid on the table at the spot with `placement` (part in plane).
 core::Pose table_drop_pose(const core::Cell& cell, const core::Pose& placement,

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hila/core/cell.hpp"
+#include "hila/core/ergonomic_scores.hpp"
+#include "hila/online/board_planner.hpp"
+
+namespace hila::online {
+
+// RULA and REBA of one hand of the human's receiving posture (docs/ergonomic_scores.md).
+struct HandScores {
+  std::string arm;  // the human arm ("left", "right"): the side scored
+  core::RulaInputs rula_inputs;
+  core::RulaScore rula;
+  core::RebaInputs reba_inputs;
+  core::RebaScore reba;
+};
+
+// The receiving posture of a planned board scored: each hand that takes it, the goal's hand
+// first, then the second hand of a two-hand goal.
+struct ReceivingScores {
+  bool scored = false;  // false: the plan has no human posture (not solved)
+  bool two_hands = false;
+  double load_kg = 0.0;  // the part's mass
+  std::vector<HandScores> hands;
+  // The hand with the higher RULA grand score and the one with the higher REBA score (the first
+  // hand on a tie): the board's scores.
+  int worst_rula = -1;
+  int worst_reba = -1;
+  const core::RulaScore& rula() const { return hands[static_cast<std::size_t>(worst_rula)].rula; }
+  const core::RebaScore& reba() const { return hands[static_cast<std::size_t>(worst_reba)].reba; }
+};
+
+// Scores the posture the planner hands the board over at: plan.human_joints on plan.human_arm
+// (and plan.second_human_joints on plan.second_human_arm), the rest of the human at
+// cell.human_neutral() (core::human_posture), holding `load_kg`. RULA scores each hand with its
+// share of the load (half with two hands), REBA with the whole load. Nothing scored (scored
+// false) for a plan without a posture. Throws core::InputError where the cell's human model is
+// not one of generate_human_urdf or its arms are not named "left" and "right"; meant for the
+// output edge, after planning.
+ReceivingScores receiving_scores(const core::Cell& cell, const BoardPlan& plan, double load_kg);
+
+}  // namespace hila::online
