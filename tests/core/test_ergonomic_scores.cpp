@@ -787,7 +787,9 @@ TEST(ErgonomicScores, HumanPostureSetsTheNamedArmsChainJoints) {
   std::vector<bool> arm_variable(static_cast<std::size_t>(q.size()), false);
   for (const int v : left.chain.model_variables()) arm_variable[static_cast<std::size_t>(v)] = true;
   for (Eigen::Index i = 0; i < q.size(); ++i) {
-    if (!arm_variable[static_cast<std::size_t>(i)]) EXPECT_EQ(q[i], neutral[i]) << i;
+    if (!arm_variable[static_cast<std::size_t>(i)]) {
+      EXPECT_EQ(q[i], neutral[i]) << i;
+    }
   }
   EXPECT_EQ(core::human_posture(*cell, {}), neutral);
   EXPECT_THROW(core::human_posture(*cell, {{"middle", arm_q}}), core::InputError);

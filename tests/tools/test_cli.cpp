@@ -309,26 +309,27 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
     if (b["status"] != "solved") continue;
     ++solved;
     SCOPED_TRACE(b["board"].get<std::string>());
-    const auto& e = b["ergonomics"];
-    ASSERT_TRUE(e.contains("hands")) << e.dump();
-    ASSERT_EQ(e["hands"].size(), b["human_posture_rad"].size());
-    EXPECT_EQ(e["two_hands"].get<bool>(), e["hands"].size() == 2);
-    two_hand += e["two_hands"].get<bool>() ? 1 : 0;
+    const auto& ergonomics = b["ergonomics"];
+    ASSERT_TRUE(ergonomics.contains("hands")) << ergonomics.dump();
+    ASSERT_EQ(ergonomics["hands"].size(), b["human_posture_rad"].size());
+    EXPECT_EQ(ergonomics["two_hands"].get<bool>(), ergonomics["hands"].size() == 2);
+    two_hand += ergonomics["two_hands"].get<bool>() ? 1 : 0;
     int grand = 0, reba = 0;
-    for (const auto& h : e["hands"]) {
+    for (const auto& h : ergonomics["hands"]) {
       EXPECT_TRUE(b["human_posture_rad"].contains(h["side"].get<std::string>()));
       grand = std::max(grand, h["rula"]["grand"].get<int>());
       reba = std::max(reba, h["reba"]["score"].get<int>());
-      EXPECT_DOUBLE_EQ(h["reba"]["load_kg"].get<double>(), e["load_kg"].get<double>());
-      EXPECT_DOUBLE_EQ(h["rula"]["load_kg"].get<double>(),
-                       e["load_kg"].get<double>() / static_cast<double>(e["hands"].size()));
+      EXPECT_DOUBLE_EQ(h["reba"]["load_kg"].get<double>(), ergonomics["load_kg"].get<double>());
+      EXPECT_DOUBLE_EQ(
+          h["rula"]["load_kg"].get<double>(),
+          ergonomics["load_kg"].get<double>() / static_cast<double>(ergonomics["hands"].size()));
     }
-    EXPECT_EQ(e["rula"]["grand"].get<int>(), grand);
-    EXPECT_EQ(e["reba"]["score"].get<int>(), reba);
+    EXPECT_EQ(ergonomics["rula"]["grand"].get<int>(), grand);
+    EXPECT_EQ(ergonomics["reba"]["score"].get<int>(), reba);
     EXPECT_GE(grand, 1);
     EXPECT_LE(grand, 7);
-    EXPECT_GE(e["rula"]["action_level"].get<int>(), 1);
-    EXPECT_FALSE(e["reba"]["risk"].get<std::string>().empty());
+    EXPECT_GE(ergonomics["rula"]["action_level"].get<int>(), 1);
+    EXPECT_FALSE(ergonomics["reba"]["risk"].get<std::string>().empty());
   }
   EXPECT_GT(solved, 0) << plan.out;
   EXPECT_GT(two_hand, 0);
