@@ -13,6 +13,7 @@
 #include "gltf_reading.hpp"
 #include "hila/db/database.hpp"
 #include "hila/offline/build.hpp"
+#include "hila/online/receiving_scores.hpp"
 #include "util/quick_build.hpp"
 #include "util/test_util.hpp"
 
@@ -192,6 +193,49 @@ TEST_F(DatabaseExports, GoalsAtTheStoredPosesAndPostures) {
   }
   EXPECT_GT(goals_checked, 5);
   EXPECT_GT(exchanges, 0);
+}
+
+// `--colour rula`: each goal's part named by the RULA grand score the plan file gives the same
+// stored posture (online::receiving_scores), for the part's mass.
+TEST_F(DatabaseExports, GoalsColouredByTheRulaOfTheStoredPosture) {
+  const auto cell = reference_cell();
+  const core::ProductSpec product = core::load_product(product_path());
+  int scored = 0;
+  for (const db::PartRecord& part : database_->parts()) {
+    SCOPED_TRACE(part.name);
+    std::vector<db::HandoverCandidateRecord> goals = database_->handover_goals(part.id);
+    std::sort(goals.begin(), goals.end(),
+              [](const auto& a, const auto& b) { return a.rank < b.rank; });
+    const std::string out = dir_ + "/rula_" + part.name + ".glb";
+    const CommandRun r = run(export_args("goals", part.name, out) + " --count 3 --colour rula");
+    ASSERT_EQ(r.status, 0) << r.out;
+    const tinygltf::Model gltf = load_glb(read_file(out));
+    const auto nodes = nodes_by_name(gltf);
+    for (std::size_t k = 0; k < goals.size() && k < 3; ++k) {
+      const db::HandoverCandidateRecord& goal = goals[k];
+      const int node = nodes.at("goal:" + std::to_string(goal.rank) + "/part");
+      const int mesh = gltf.nodes[static_cast<std::size_t>(node)].mesh;
+      const std::string& name =
+          gltf.materials
+              .at(static_cast<std::size_t>(
+                  gltf.meshes.at(static_cast<std::size_t>(mesh)).primitives.at(0).material))
+              .name;
+      online::BoardPlan plan;
+      plan.human_arm = goal.human_arm;
+      plan.human_joints = goal.human_joints;
+      plan.second_human_arm = goal.second_joints.size() > 0 ? goal.second_arm : "";
+      plan.second_human_joints = goal.second_joints;
+      const online::ReceivingScores want =
+          online::receiving_scores(*cell, plan, product.part(part.name).mass);
+      if (!want.scored) {
+        EXPECT_EQ(name, "RULA -");
+        continue;
+      }
+      EXPECT_EQ(name, "RULA " + std::to_string(want.rula().grand));
+      ++scored;
+    }
+  }
+  EXPECT_GT(scored, 5);
 }
 
 TEST_F(DatabaseExports, AnUnknownPartOrNoGoalCountIsBadInput) {

@@ -182,6 +182,40 @@ TEST_F(GoalExport, ThePartsColourRisesWithQ) {
   EXPECT_GT(by_q.front().second[0], by_q.back().second[0]);
 }
 
+// Coloured by RULA: green at 1 to red at 7 whatever the Q, named by the score; a goal not
+// scored grey.
+TEST_F(GoalExport, ByRulaThePartsColourFallsWithTheScore) {
+  viz::GoalsView view = view_;
+  for (std::size_t k = 0; k < view.goals.size(); ++k)
+    view.goals[k].rula_grand = static_cast<int>(k);
+  viz::GoalsSettings settings;
+  settings.colour = viz::GoalColour::kRula;
+  const tinygltf::Model gltf = load_glb(viz::goals_glb(*cell_, view, settings));
+  const auto nodes = nodes_by_name(gltf);
+  std::vector<std::pair<int, std::vector<double>>> by_score;
+  for (const auto& g : view.goals) {
+    const int node = nodes.at("goal:" + std::to_string(g.rank) + "/part");
+    const int mesh = gltf.nodes[static_cast<std::size_t>(node)].mesh;
+    const auto& material = gltf.materials.at(static_cast<std::size_t>(
+        gltf.meshes.at(static_cast<std::size_t>(mesh)).primitives.at(0).material));
+    const std::vector<double>& rgba = material.pbrMetallicRoughness.baseColorFactor;
+    if (g.rula_grand == 0) {
+      EXPECT_EQ(material.name, "RULA -");
+      EXPECT_DOUBLE_EQ(rgba[0], rgba[1]);
+      continue;
+    }
+    EXPECT_EQ(material.name, "RULA " + std::to_string(g.rula_grand));
+    by_score.emplace_back(g.rula_grand, rgba);
+  }
+  ASSERT_EQ(by_score.size(), view.goals.size() - 1);
+  for (std::size_t i = 1; i < by_score.size(); ++i) {
+    EXPECT_GT(by_score[i].second[0], by_score[i - 1].second[0]);
+    EXPECT_LT(by_score[i].second[1], by_score[i - 1].second[1]);
+  }
+  EXPECT_GT(by_score.front().second[1], by_score.front().second[0]);  // 1: green
+  EXPECT_GT(by_score.back().second[0], by_score.back().second[1]);    // 6: red
+}
+
 TEST(GoalExportInput, JointsOfTheWrongSizeOrAnUnknownArmAreBadInput) {
   const auto cell = reference_cell();
   const core::ProductSpec product = core::load_product(product_path());

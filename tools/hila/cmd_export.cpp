@@ -35,6 +35,7 @@ struct ExportPartOptions {
   std::string product_file;  // the database's product (empty: the bundled one)
   std::string arm;           // grasps: whose gripper (empty: the first arm)
   int count = 10;            // goals: how many, best first
+  std::string colour = "q";  // goals: "q" (comfort Q) or "rula" (RULA grand score)
   std::string output;
 };
 
@@ -127,7 +128,9 @@ int run_export_grasps(const ExportPartOptions& opt) {
 int run_export_goals(const ExportPartOptions& opt) {
   const CheckedDatabase d = open_part_database(opt);
   const viz::GoalsView view = goals_view(d, opt.part, opt.count);
-  const std::string glb = viz::goals_glb(*d.cell, view);
+  viz::GoalsSettings settings;
+  settings.colour = opt.colour == "rula" ? viz::GoalColour::kRula : viz::GoalColour::kQuality;
+  const std::string glb = viz::goals_glb(*d.cell, view, settings);
   write_file_atomically(opt.output, glb);
   int exchanges = 0;
   for (const auto& g : view.goals) exchanges += g.exchange ? 1 : 0;
@@ -196,13 +199,19 @@ void add_export_command(CLI::App& app, Action& action) {
       [grasps_opt, &action] { action = [grasps_opt] { return run_export_grasps(*grasps_opt); }; });
 
   auto goals_opt = std::make_shared<ExportPartOptions>();
-  auto* goals = add_part_subcommand(
-      *cmd, "goals",
-      "a part's best handover goals side by side: the part (coloured by Q), the human receiving "
-      "it, the robot at the goal's robot-robot exchange",
-      *goals_opt);
+  auto* goals = add_part_subcommand(*cmd, "goals",
+                                    "a part's best handover goals side by side: the part (coloured "
+                                    "by Q or RULA), the human receiving "
+                                    "it, the robot at the goal's robot-robot exchange",
+                                    *goals_opt);
   goals->add_option("--count", goals_opt->count, "how many goals, best first")
       ->check(int_in(1, 1000))
+      ->capture_default_str();
+  goals
+      ->add_option("--colour", goals_opt->colour,
+                   "colour the part by q (comfort Q, lowest shown red to highest green) or by rula "
+                   "(the receiving posture's RULA grand score: 1 green to 7 red)")
+      ->check(CLI::IsMember({"q", "rula"}))
       ->capture_default_str();
   goals->callback(
       [goals_opt, &action] { action = [goals_opt] { return run_export_goals(*goals_opt); }; });

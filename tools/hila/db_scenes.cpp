@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "hila/core/ergonomic_scores.hpp"
 #include "hila/db/provenance.hpp"
 
 namespace hila::tools {
@@ -50,6 +51,24 @@ viz::GraspsView grasps_view(const CheckedDatabase& d, const std::string& part,
   return view;
 }
 
+int receiving_rula(const core::Cell& cell, const std::map<std::string, Eigen::VectorXd>& arms,
+                   double load_kg) {
+  if (arms.empty()) return 0;
+  const std::vector<std::pair<std::string, Eigen::VectorXd>> hands(arms.begin(), arms.end());
+  try {
+    const Eigen::VectorXd q = core::human_posture(cell, hands);
+    int worst = 0;
+    for (const auto& [arm, joints] : hands) {
+      const core::RulaInputs in =
+          core::rula_inputs_from_posture(cell.human(), q, arm, load_kg, hands.size() > 1);
+      worst = std::max(worst, core::rula(in).grand);
+    }
+    return worst;
+  } catch (const core::InputError&) {
+    return 0;  // a human model the scores do not read: shown unscored
+  }
+}
+
 viz::GoalsView goals_view(const CheckedDatabase& d, const std::string& part, int count) {
   const db::PartRecord& record = d.database.part(part);
   viz::GoalsView view;
@@ -77,6 +96,7 @@ viz::GoalsView goals_view(const CheckedDatabase& d, const std::string& part, int
     if (!goal.second_arm.empty() && goal.second_joints.size() > 0) {
       v.human_arms[goal.second_arm] = goal.second_joints;
     }
+    v.rula_grand = receiving_rula(*d.cell, v.human_arms, d.product.part(part).mass);
     for (const db::SharedGraspRecord& shared : d.database.shared_grasps(goal.id)) {
       const auto h = handovers.find(shared.robot_handover_id);
       if (h == handovers.end()) continue;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,6 +39,13 @@ viz::GraspsView grasps_view(const CheckedDatabase& d, const std::string& part,
 // hand, second_joints of the other for a two-hand part) and the robot-robot exchange of the
 // goal's first shared grasp (its robot_handovers pose and suction arm's joints, the receiving
 // arm's joints_rr and the grasp's jaw width), if it has one.
+// (and the RULA grand score of each stored posture: receiving_rula).
 viz::GoalsView goals_view(const CheckedDatabase& d, const std::string& part, int count);
+
+// RULA grand score (1-7) of the human holding a part of `load_kg` with `arms` (human arm name ->
+// its joints, the rest of the body neutral; each hand its share of the load), the worse hand's;
+// 0 where the cell's human model is not one the scores read (core::human_posture).
+int receiving_rula(const core::Cell& cell, const std::map<std::string, Eigen::VectorXd>& arms,
+                   double load_kg);
 
 }  // namespace hila::tools

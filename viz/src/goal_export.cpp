@@ -66,9 +66,19 @@ std::string goals_glb(const core::Cell& cell, const GoalsView& view,
     const int root = builder.add_node(name, -1, offset);
 
     char label[32];
-    std::snprintf(label, sizeof label, "Q %.3f", goal.quality);
-    const int q_material = builder.add_material(
-        label, scale_colour(q_high > q_low ? (goal.quality - q_low) / (q_high - q_low) : 1.0));
+    int q_material = -1;
+    if (settings.colour == GoalColour::kRula) {
+      if (goal.rula_grand >= 1 && goal.rula_grand <= 7) {
+        std::snprintf(label, sizeof label, "RULA %d", goal.rula_grand);
+        q_material = builder.add_material(label, scale_colour((7.0 - goal.rula_grand) / 6.0));
+      } else {
+        q_material = builder.add_material("RULA -", {0.6, 0.6, 0.6, 1.0});
+      }
+    } else {
+      std::snprintf(label, sizeof label, "Q %.3f", goal.quality);
+      q_material = builder.add_material(
+          label, scale_colour(q_high > q_low ? (goal.quality - q_low) / (q_high - q_low) : 1.0));
+    }
     builder.add_node(name + "/part", root, goal.board,
                      add_part_mesh(builder, name + "/part", *view.mesh, q_material));
 

@@ -28,12 +28,20 @@ struct GoalView {
   int rank = 0;                               // 0-based, by Eq. 8
   core::Pose board = core::Pose::Identity();  // world
   double quality = 0.0;                       // Q, 0 to 1
+  // RULA grand score (1-7) of the receiving posture, the worse hand's; 0: not scored.
+  int rula_grand = 0;
   // Human arm name -> its joints (rad) in the receiving posture; the other arms neutral.
   std::map<std::string, Eigen::VectorXd> human_arms;
   std::optional<ExchangeView> exchange;  // empty: the robot at home, no exchange shown
 };
 
+enum class GoalColour {
+  kQuality,  // by Q, from the lowest shown (red) to the highest (green)
+  kRula,     // by RULA grand score: 1 green to 7 red (a goal not scored: grey)
+};
+
 struct GoalsSettings {
+  GoalColour colour = GoalColour::kQuality;
   // Goal k's scene is moved by k * offset (world) so that the scenes stand side by side.
   Eigen::Vector3d offset{0.0, 2.0, 0.0};
 };
@@ -47,7 +55,8 @@ struct GoalsView {
 
 // The goals as a glTF 2.0 binary (.glb): per goal a node "goal:RANK" at k * offset (k: its
 // index in `goals`) holding, in world coordinates: the part "goal:RANK/part" at the goal's pose
-// (material "Q V", scale_colour of Q from the lowest Q of `goals`, red, to the highest, green),
+// (material "Q V", scale_colour of Q from the lowest Q of `goals`, red, to the highest, green;
+// with GoalColour::kRula material "RULA G", scale_colour((7 - G) / 6), "RULA -" grey unscored),
 // the human "goal:RANK/human/LINK" at the stance in the receiving posture, the table
 // "goal:RANK/obstacle/NAME", the robot "goal:RANK/robot/LINK" at the exchange's joints (the
 // receiving jaws at its opening; home without an exchange), the suction tool in the suction
