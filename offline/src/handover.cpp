@@ -830,6 +830,16 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // Whether either arm's gripper could hold the part at the candidates the human takes
   // comfortably at all, however it got there ("; ..." for a failure): where neither can, no way
   // from where the part lies would help (out of both arms' reach).
+  // The board at candidate c with the human's hands at the grasps of their choice h.
+  auto place_at_candidate = [&](const db::HandoverCandidateRecord& c, const HumanChoice& h) {
+    data.set_body_pose(scene.board, c.board);
+    const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
+    place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
+    if (h.second_grasp >= 0) {
+      const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
+      place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
+    }
+  };
   auto reach_census = [&]() -> std::string {
     std::vector<int> census;
     for (std::size_t i = 0; i < result.candidates.size(); ++i) {
@@ -859,13 +869,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
           core::set_robot_pose(data, scene.tool, scene.tool_links_in_handle,
                                product.suction_tool_pose);
         }
-        data.set_body_pose(scene.board, c.board);
-        const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
-        place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
-        if (h.second_grasp >= 0) {
-          const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-          place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
-        }
+        place_at_candidate(c, h);
         for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
           Receiving r;
           if (reach_with(*a, base_inv, c.board, g, bodies, false, r)) {
@@ -1005,15 +1009,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
         // The board at the candidate with the human's hands at their grasps (again after an arm's
         // checks reset the scene).
-        const auto at_candidate = [&] {
-          data.set_body_pose(scene.board, c.board);
-          const auto& g0 = grasps.human[static_cast<std::size_t>(h.grasp)];
-          place_hand(data, robot_hands[0], c.board * g0.hand, g0.aperture + kHandOpeningMargin);
-          if (h.second_grasp >= 0) {
-            const auto& g1 = grasps.human[static_cast<std::size_t>(h.second_grasp)];
-            place_hand(data, robot_hands[1], c.board * g1.hand, g1.aperture + kHandOpeningMargin);
-          }
-        };
+        const auto at_candidate = [&] { place_at_candidate(c, h); };
         at_candidate();
         int shared = 0;
         for (int g = 0; g < static_cast<int>(grasps.robot.size()) && !relays_only; ++g) {

@@ -21,22 +21,10 @@ using namespace hila;
 
 namespace {
 
-struct CommandRun {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using test::CommandRun;
 
 CommandRun run(const std::string& args) {
-  CommandRun r;
-  const std::string command = std::string(HILA_EXE) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return r;
-  std::array<char, 4096> buffer{};
-  std::size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
+  return test::run_command(std::string(HILA_EXE) + " " + args);
 }
 
 std::string json_part(const std::string& out) {

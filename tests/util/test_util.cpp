@@ -1,7 +1,10 @@
 #include "util/test_util.hpp"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -149,6 +152,18 @@ parts:
     target: {xyz: [-0.052145, -0.133773, 0.05528], rotation: [[0, 0, 1], [1, 0, 0], [0, 1, 0]]}
     initial: {xyz: [0.43, 0.201716, 1.107993], rotation: [[0.052221916, -0.998635505, 0], [0.998635505, 0.052221916, 0], [0, 0, 1]]}
 )");
+}
+
+CommandRun run_command(const std::string& command) {
+  CommandRun r;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return r;
+  std::array<char, 4096> buffer{};
+  std::size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
+  const int raw = pclose(pipe);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
 }
 
 }  // namespace hila::test

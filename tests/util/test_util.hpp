@@ -29,6 +29,13 @@ std::string temp_dir(const std::string& name);
 // Writes `text` to `dir/name` and returns the path.
 std::string write_file(const std::string& dir, const std::string& name, const std::string& text);
 std::string read_file(const std::string& path);
+
+// A shell command's exit status (-1 when it did not exit) and its stdout and stderr together.
+struct CommandRun {
+  int status = -1;
+  std::string out;
+};
+CommandRun run_command(const std::string& command);
 // The reference cell with one text change (`from`, which must occur, replaced by `to`), written
 // into `dir` with the URDFs it names; returns the cell file's path.
 std::string cell_variant(const std::string& dir, const std::string& from, const std::string& to);
