@@ -393,8 +393,9 @@ Eigen::VectorXd human_posture(
   Eigen::VectorXd q = cell.human_neutral();
   for (const auto& [name, joints] : arm_joints) {
     const auto& arms = cell.human_arms();
+    const std::string& wanted = name;  // a structured binding is not captured (clang before 16)
     const auto arm = std::find_if(arms.begin(), arms.end(),
-                                  [&](const HumanArm& h) { return h.spec.name == name; });
+                                  [&](const HumanArm& h) { return h.spec.name == wanted; });
     if (arm == arms.end()) {
       std::string names;
       for (const HumanArm& h : arms) names += (names.empty() ? "" : ", ") + h.spec.name;
