@@ -5,7 +5,6 @@
 #include <cmath>
 #include <map>
 #include <memory>
-#include <numeric>
 #include <optional>
 #include <random>
 
@@ -759,12 +758,11 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     return true;
   };
   // The receiving arm takes the board held at `board` (suction grasp s, the suction arm at
-  // suction_q) with each of `wanted` that has fewer than rr_per_grasp poses yet (its way in
-  // included); a robot-robot pose is kept when any does. Returns how many took it.
-  auto receive_held = [&](const core::Pose& board, int s, const Eigen::VectorXd& suction_q,
-                          const std::vector<int>& wanted) {
+  // suction_q) with each robot grasp that has fewer than rr_per_grasp poses yet (its way in
+  // included); a robot-robot pose is kept when any does.
+  auto receive_held = [&](const core::Pose& board, int s, const Eigen::VectorXd& suction_q) {
     std::vector<Receiving> received;
-    for (const int g : wanted) {
+    for (int g = 0; g < static_cast<int>(grasps.robot.size()); ++g) {
       // A grasp with its rr_per_grasp poses already is not looked at again (only those are
       // stored): the way-in check makes each look costly.
       if (static_cast<int>(rr_of_grasp[static_cast<std::size_t>(g)].size()) >=
@@ -775,7 +773,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       if (receive(board, g, receiving_bodies, true, r)) received.push_back(r);
     }
     restore_receiving();
-    if (received.empty()) return 0;
+    if (received.empty()) return;
     db::RobotHandoverRecord rr;
     rr.board = board;
     rr.suction_grasp_id = s;
@@ -788,12 +786,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       }
     }
     result.robot_handovers.push_back(rr);
-    const int n = static_cast<int>(received.size());
     rr_grasps.push_back(std::move(received));
-    return n;
   };
-  std::vector<int> all_grasps(grasps.robot.size());
-  std::iota(all_grasps.begin(), all_grasps.end(), 0);
   for (const int combo : order) {
     if (examined >= settings.rr_poses || !exchange_failure.empty()) break;
     const int s = combo % n_suction;
@@ -806,7 +800,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     Eigen::VectorXd suction_q;
     if (hold_on_cup(board, s, suction_q)) {
       ++examined;
-      receive_held(board, s, suction_q, all_grasps);
+      receive_held(board, s, suction_q);
     }
     reset_state();
   }
