@@ -304,7 +304,7 @@ std::string settings_hash(const BuildSettings& s) {
   const auto& g = s.regrasp;
   text << "regrasp " << g.goals << ' ' << g.served_goals << ' ' << g.attach_neighbours << ' '
        << g.bridge.max_checks << ' ' << g.transfer_bridges << ' ' << g.bridge_alternatives << ' '
-       << g.alternative_checks << '\n';
+       << g.alternative_checks << ' ' << g.timing_speed_scale << ' ' << g.timing_step << '\n';
   return db::sha256_hex(text.str());
 }
 

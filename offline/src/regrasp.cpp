@@ -14,6 +14,7 @@
 #include "hila/core/slip_projection.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
+#include "hila/core/time_parameterization.hpp"
 #include "hila/offline/arm_workspace.hpp"
 #include "hila/offline/suction_pick.hpp"
 
@@ -382,6 +383,15 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     e.path_nodes = c.connected ? c.path_nodes : 0;
     e.via = c.connected ? c.via : "";
     if (c.connected) e.path = c.path;
+    if (e.path.size() >= 2) {
+      const core::ArmSpec& spec = arm == settings.suction_arm ? suction.workspace.arm().spec
+                                                              : receiving.workspace.arm().spec;
+      e.duration = core::time_parameterize_through(e.path, spec.max_velocity,
+                                                   spec.max_acceleration,
+                                                   settings.timing_speed_scale,
+                                                   settings.timing_step)
+                       .time.back();
+    }
     result.edges.push_back(e);
     result.bridges += c.connected && c.via == "bridge" ? 1 : 0;
     return static_cast<int>(result.edges.size()) - 1;

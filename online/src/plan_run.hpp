@@ -25,12 +25,16 @@
 #include "hila/online/arm_motion.hpp"
 #include "hila/online/board_planner.hpp"
 #include "hila/online/planner_model.hpp"
-#include "hila/online/time_parameterization.hpp"
+#include "hila/core/time_parameterization.hpp"
 #include "hila/online/validation_queue.hpp"
 #include "hila/online/validator.hpp"
 #include "hila/online/world.hpp"
 
 namespace hila::online::detail {
+
+using core::resample_path;
+using core::TimedPath;
+using core::time_parameterize_through;
 
 // IK solutions of `arm` for a TCP pose in the world, nearest `seed` first (`preferred`, when
 // given and among them, first of all).

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "hila/online/time_parameterization.hpp"
+#include "hila/core/time_parameterization.hpp"
 
 namespace hila::online {
+
+using core::resample_path;
 
 SmoothResult smooth_path(
     const std::vector<Eigen::VectorXd>& path,

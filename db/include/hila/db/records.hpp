@@ -290,6 +290,12 @@ struct RegraspEdgeRecord {
   // waypoints joined by straight segments (empty when not connected and for a handover; at
   // least 2 waypoints of equal size otherwise).
   std::vector<Eigen::VectorXd> path;
+  // Estimated robot time along `path`, s (schema version 9): the path timed as the online
+  // planner times a motion (core::time_parameterize_through, not stopping at its waypoints) at
+  // the moving arm's velocity and acceleration limits times RegraspSettings::timing_speed_scale.
+  // 0 without a path, and in a file migrated from version 8 or earlier (not estimated: the
+  // online planner then times `path` itself).
+  double duration = 0.0;
 };
 
 // Self-description of a database (the `meta` table, one key per field).

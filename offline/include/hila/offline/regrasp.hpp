@@ -48,6 +48,12 @@ struct RegraspSettings {
   // Motions holding the board (attachments, roadmap edges, bridges) are checked this finely
   // (rad; the build takes HandoverSettings::exchange_resolution, the online validator's).
   double held_resolution = 0.01;
+  // Each stored path's estimated duration (RegraspEdgeRecord::duration) is its time at the arm's
+  // velocity and acceleration limits times this, in pieces of at most `timing_step` rad: the
+  // online planner's defaults (BoardPlanSettings::speed_scale and timing_step), so that a stored
+  // duration reads as the robot's seconds along the path before it is smoothed.
+  double timing_speed_scale = 0.5;
+  double timing_step = 0.05;
   std::string suction_arm = "right";
   std::string receiving_arm = "left";
 };

@@ -3,7 +3,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-namespace hila::online {
+namespace hila::core {
 
 struct TimedPath {
   std::vector<double> time;        // s, from 0
@@ -19,6 +19,13 @@ TimedPath time_parameterize(const std::vector<Eigen::VectorXd>& path,
                             const Eigen::VectorXd& max_velocity,
                             const Eigen::VectorXd& max_acceleration, double scale = 1.0,
                             int samples_per_segment = 8);
+
+// The duration (s) of time_parameterize's timing of `path` (rest to rest at every waypoint)
+// without sampling it: an upper bound of the time the robot takes along the path, cheap enough
+// to estimate a motion before it is planned (the straight move between two configurations).
+double rest_to_rest_duration(const std::vector<Eigen::VectorXd>& path,
+                             const Eigen::VectorXd& max_velocity,
+                             const Eigen::VectorXd& max_acceleration, double scale = 1.0);
 
 // The path's points with every segment split evenly into pieces no longer than `max_step`
 // (rad), repeated waypoints dropped: what the smoother and time_parameterize_through work on.
@@ -38,4 +45,4 @@ TimedPath time_parameterize_through(const std::vector<Eigen::VectorXd>& path,
                                     const Eigen::VectorXd& max_acceleration, double scale = 1.0,
                                     double max_step = 0.05);
 
-}  // namespace hila::online
+}  // namespace hila::core

@@ -1,9 +1,11 @@
-#include "hila/online/time_parameterization.hpp"
+#include "hila/core/time_parameterization.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
-namespace hila::online {
+namespace hila::core {
 
 namespace {
 
@@ -35,7 +37,36 @@ struct Profile {
   }
 };
 
+// The profile of a straight segment `delta` (rad): its speed and acceleration in the unit
+// parameter, the tightest joint deciding; none for a repeated waypoint.
+std::optional<Profile> segment_profile(const Eigen::VectorXd& delta,
+                                       const Eigen::VectorXd& max_velocity,
+                                       const Eigen::VectorXd& max_acceleration, double scale) {
+  double v = std::numeric_limits<double>::infinity();
+  double a = std::numeric_limits<double>::infinity();
+  for (Eigen::Index j = 0; j < delta.size(); ++j) {
+    const double d = std::abs(delta[j]);
+    if (d < 1e-12) continue;
+    v = std::min(v, scale * max_velocity[j] / d);
+    a = std::min(a, scale * max_acceleration[j] / d);
+  }
+  if (!std::isfinite(v)) return std::nullopt;
+  return Profile(v, a);
+}
+
 }  // namespace
+
+double rest_to_rest_duration(const std::vector<Eigen::VectorXd>& path,
+                             const Eigen::VectorXd& max_velocity,
+                             const Eigen::VectorXd& max_acceleration, double scale) {
+  double total = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const auto segment =
+        segment_profile(path[i] - path[i - 1], max_velocity, max_acceleration, scale);
+    if (segment) total += segment->duration;
+  }
+  return total;
+}
 
 TimedPath time_parameterize(const std::vector<Eigen::VectorXd>& path,
                             const Eigen::VectorXd& max_velocity,
@@ -48,17 +79,9 @@ TimedPath time_parameterize(const std::vector<Eigen::VectorXd>& path,
   double t0 = 0.0;
   for (std::size_t i = 1; i < path.size(); ++i) {
     const Eigen::VectorXd delta = path[i] - path[i - 1];
-    // The segment's speed and acceleration in its unit parameter: the tightest joint decides.
-    double v = std::numeric_limits<double>::infinity();
-    double a = std::numeric_limits<double>::infinity();
-    for (Eigen::Index j = 0; j < delta.size(); ++j) {
-      const double d = std::abs(delta[j]);
-      if (d < 1e-12) continue;
-      v = std::min(v, scale * max_velocity[j] / d);
-      a = std::min(a, scale * max_acceleration[j] / d);
-    }
-    if (!std::isfinite(v)) continue;  // a repeated waypoint
-    const Profile profile(v, a);
+    const auto segment = segment_profile(delta, max_velocity, max_acceleration, scale);
+    if (!segment) continue;  // a repeated waypoint
+    const Profile& profile = *segment;
     for (int k = 1; k <= samples_per_segment; ++k) {
       const double t = profile.duration * static_cast<double>(k) / samples_per_segment;
       out.time.push_back(t0 + t);
@@ -281,4 +304,4 @@ TimedPath time_parameterize_through(const std::vector<Eigen::VectorXd>& path,
   return out;
 }
 
-}  // namespace hila::online
+}  // namespace hila::core

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "hila/online/time_parameterization.hpp"
+#include "hila/core/time_parameterization.hpp"
 
 using namespace hila;
 
@@ -32,16 +32,16 @@ TEST(TimeParameterization, OneLongSegmentTakesTheTrapezoidsClosedFormTime) {
   Eigen::VectorXd a = Eigen::VectorXd::Zero(6), b = a;
   b[1] = 2.0;  // joint 2 moves 2 rad; v 1 rad/s, a 2 rad/s^2: 2/1 + 1/2 = 2.5 s
   b[3] = 0.5;
-  const auto timed = online::time_parameterize({a, b}, limits(1.0), limits(2.0));
+  const auto timed = core::time_parameterize({a, b}, limits(1.0), limits(2.0));
   EXPECT_NEAR(timed.time.back(), 2.5, 1e-12);
   EXPECT_TRUE(timed.q.back().isApprox(b, 0.0));
   // Short: triangular, 2 sqrt(d / a) = 2 sqrt(0.1 / 2).
   b = a;
   b[0] = 0.1;
-  EXPECT_NEAR(online::time_parameterize({a, b}, limits(1.0), limits(2.0)).time.back(),
+  EXPECT_NEAR(core::time_parameterize({a, b}, limits(1.0), limits(2.0)).time.back(),
               2.0 * std::sqrt(0.05), 1e-12);
   // Half the scale: twice as long for a triangular profile's sqrt(1/a)... exactly sqrt(2) times.
-  EXPECT_NEAR(online::time_parameterize({a, b}, limits(1.0), limits(2.0), 0.5).time.back(),
+  EXPECT_NEAR(core::time_parameterize({a, b}, limits(1.0), limits(2.0), 0.5).time.back(),
               2.0 * std::sqrt(0.1), 1e-12);
 }
 
@@ -53,7 +53,7 @@ TEST(TimeParameterization, RandomPathsKeepEveryLimitBetweenSamples) {
   for (int trial = 0; trial < 50; ++trial) {
     const std::vector<Eigen::VectorXd> path = random_path(rng, 5);
     const double scale = 0.5;
-    const auto timed = online::time_parameterize(path, vmax, amax, scale);
+    const auto timed = core::time_parameterize(path, vmax, amax, scale);
     ASSERT_EQ(timed.q.size(), timed.time.size());
     EXPECT_TRUE(timed.q.front().isApprox(path.front(), 0.0));
     EXPECT_TRUE(timed.q.back().isApprox(path.back(), 0.0));
@@ -107,12 +107,36 @@ double worst_rate_ratio(const online::TimedPath& timed, const Eigen::VectorXd& v
 
 }  // namespace
 
+// The closed form by hand (the trapezoid of the slowest joint, segment by segment) against the
+// sampled timing's last time stamp.
+TEST(RestToRestDuration, EqualsTheSampledTimingsDurationAndTheTrapezoidsByHand) {
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(6), b = a, c = a;
+  b[1] = 2.0;  // 2/1 + 1/2 = 2.5 s (trapezoid)
+  c = b;
+  c[0] = 0.1;  // then 0.1 rad: triangular, 2 sqrt(0.1 / 2)
+  EXPECT_NEAR(core::rest_to_rest_duration({a, b, c}, limits(1.0), limits(2.0)),
+              2.5 + 2.0 * std::sqrt(0.05), 1e-12);
+  EXPECT_EQ(core::rest_to_rest_duration({a}, limits(1.0), limits(2.0)), 0.0);
+  EXPECT_EQ(core::rest_to_rest_duration({a, a}, limits(1.0), limits(2.0)), 0.0);
+  std::mt19937_64 rng(5);
+  Eigen::VectorXd vmax(6), amax(6);
+  vmax << 3.14, 3.14, 3.14, 6.28, 6.28, 6.28;
+  amax << 2.97, 2.97, 2.97, 5.93, 5.93, 5.93;
+  for (int trial = 0; trial < 20; ++trial) {
+    const auto path = random_path(rng, 4);
+    for (const double scale : {1.0, 0.5, 0.2}) {
+      EXPECT_NEAR(core::rest_to_rest_duration(path, vmax, amax, scale),
+                  core::time_parameterize(path, vmax, amax, scale).time.back(), 1e-9);
+    }
+  }
+}
+
 TEST(TimeParameterizationThrough, OneStraightSegmentMatchesTheTrapezoid) {
   Eigen::VectorXd a = Eigen::VectorXd::Zero(6), b = a;
   b << 2.0, 1.5, -1.0, 0.5, 0.3, 0.1;
-  const auto rest = online::time_parameterize({a, b}, limits(3.14), limits(2.97), 0.5);
+  const auto rest = core::time_parameterize({a, b}, limits(3.14), limits(2.97), 0.5);
   const auto through =
-      online::time_parameterize_through({a, b}, limits(3.14), limits(2.97), 0.5, 0.05);
+      core::time_parameterize_through({a, b}, limits(3.14), limits(2.97), 0.5, 0.05);
   // Pieces of 0.05 rad at constant speed approximate the continuous ramp (v^2 = 2 a x).
   EXPECT_NEAR(through.time.back(), rest.time.back(), 0.02 * rest.time.back());
   EXPECT_TRUE(through.q.back().isApprox(b, 0.0));
@@ -123,10 +147,10 @@ TEST(TimeParameterizationThrough, CollinearWaypointsAreNotStoppedAt) {
   // Ten waypoints on one line: rest-to-rest stops nine times, through them it does not.
   std::vector<Eigen::VectorXd> path;
   for (int i = 0; i <= 9; ++i) path.push_back(Eigen::VectorXd::Constant(6, 0.3 * i));
-  const auto rest = online::time_parameterize(path, limits(3.14), limits(2.97));
-  const auto through = online::time_parameterize_through(path, limits(3.14), limits(2.97));
+  const auto rest = core::time_parameterize(path, limits(3.14), limits(2.97));
+  const auto through = core::time_parameterize_through(path, limits(3.14), limits(2.97));
   const auto single =
-      online::time_parameterize({path.front(), path.back()}, limits(3.14), limits(2.97));
+      core::time_parameterize({path.front(), path.back()}, limits(3.14), limits(2.97));
   EXPECT_LT(through.time.back(), 0.5 * rest.time.back());
   EXPECT_NEAR(through.time.back(), single.time.back(), 0.02 * single.time.back());
 }
@@ -144,7 +168,7 @@ TEST(TimeParameterizationThrough, ACircularArcRunsAtItsCentripetalLimit) {
     path.push_back(q);
   }
   const double amax = 1.5;
-  const auto timed = online::time_parameterize_through(path, limits(10.0), limits(amax));
+  const auto timed = core::time_parameterize_through(path, limits(10.0), limits(amax));
   double length = 0.0;
   for (std::size_t i = 1; i < path.size(); ++i) length += (path[i] - path[i - 1]).norm();
   const double cruise = length / std::sqrt(amax * radius);
@@ -160,7 +184,7 @@ TEST(TimeParameterizationThrough, RandomPathsKeepEveryLimitFromRestToRest) {
   amax << 2.97, 2.97, 2.97, 5.93, 5.93, 5.93;
   for (int trial = 0; trial < 50; ++trial) {
     const std::vector<Eigen::VectorXd> path = random_path(rng, 6);
-    const auto timed = online::time_parameterize_through(path, vmax, amax, 0.5, 0.05);
+    const auto timed = core::time_parameterize_through(path, vmax, amax, 0.5, 0.05);
     ASSERT_EQ(timed.q.size(), timed.time.size());
     EXPECT_TRUE(timed.q.front().isApprox(path.front(), 0.0));
     EXPECT_TRUE(timed.q.back().isApprox(path.back(), 0.0));
@@ -177,6 +201,6 @@ TEST(TimeParameterizationThrough, RandomPathsKeepEveryLimitFromRestToRest) {
     EXPECT_LE(worst_rate_ratio(timed, 0.5 * vmax, 0.5 * amax), 1.0 + 1e-9) << "trial " << trial;
     // Sharp corners need near stops, but never a slower run than stopping at every waypoint.
     EXPECT_LT(timed.time.back(),
-              1.05 * online::time_parameterize(path, vmax, amax, 0.5).time.back());
+              1.05 * core::time_parameterize(path, vmax, amax, 0.5).time.back());
   }
 }
