@@ -73,7 +73,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_generality --products DIR [--jobs N] [--seed N] [--quick] [--only p00,p01]\n"
     "                        [--deadline S] [--keep-db] [--reuse-db] [--json FILE]\n"
-    "                        [--meta KEY=VALUE]...\n"
+    "                        [--way-order time|fixed] [--meta KEY=VALUE]...\n"
     "       bench_generality --pick-region N --db FILE [--scene FILE] [--region M] [--seed N]\n"
     "                        [--stack-pose DX,DY,YAW_DEG]...\n"
     "                        [--deadline S] [--json FILE] [--meta KEY=VALUE]...\n"
@@ -92,6 +92,8 @@ constexpr const char* kUsage =
     "  --region      m, the stack's offset in x and y is uniform in +-this (default 0.10)\n"
     "  --stack-pose  DX,DY,YAW_DEG: plan this stack pose (m, m, deg; repeatable) instead of\n"
     "                drawn ones, touching or not\n"
+    "  --way-order   each goal's ways by estimated robot time (default) or in the fixed\n"
+    "                order direct, regrasp, suction, exchange (BoardPlanSettings::way_order)\n"
     "  --json        also write every figure to FILE\n"
     "  --meta        KEY=VALUE recorded in the JSON (commit, machine, ...)\n";
 
@@ -112,6 +114,7 @@ struct Options {
   std::string json;
   std::map<std::string, std::string> meta;
   std::string command;
+  online::WayOrder way_order = online::WayOrder::kEstimatedTime;
 };
 
 [[noreturn]] void usage_error(const std::string& what) {
@@ -180,6 +183,11 @@ Options parse(int argc, char** argv) {
         const auto v = split_list(value);
         if (v.size() != 3) usage_error("--stack-pose: expected DX,DY,YAW_DEG, got '" + value + "'");
         opt.stack_poses.emplace_back(std::stod(v[0]), std::stod(v[1]), std::stod(v[2]));
+      } else if (arg == "--way-order") {
+        if (value != "time" && value != "fixed") {
+          usage_error("--way-order: expected time or fixed, got '" + value + "'");
+        }
+        opt.way_order = value == "time" ? online::WayOrder::kEstimatedTime : online::WayOrder::kFixed;
       } else if (arg == "--json") {
         opt.json = value;
       } else if (arg == "--meta") {
@@ -600,7 +608,8 @@ int run_products(const Options& opt) {
     temp_dir = fs::temp_directory_path() / ("bench_generality." + std::to_string(::getpid()));
     fs::create_directories(temp_dir);
   }
-  const online::BoardPlanSettings plan_settings;
+  online::BoardPlanSettings plan_settings;
+  plan_settings.way_order = opt.way_order;
 
   std::vector<ProductResult> results;
   const auto started = std::chrono::steady_clock::now();
@@ -902,7 +911,8 @@ int run_pick_region(const Options& opt) {
     }
   }
   const Eigen::Vector2d centre = 0.5 * (lo + hi);
-  const online::BoardPlanSettings plan_settings;
+  online::BoardPlanSettings plan_settings;
+  plan_settings.way_order = opt.way_order;
   online::BoardPlanner planner(*model, plan_settings);
   std::vector<StackPose> poses;
   int invalid = 0;

@@ -48,7 +48,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_online [--db FILE] [--scene FILE] [--variations N] [--boards a,b]\n"
     "                    [--deadline S] [--planners hila,rrt_connect,lazy_prm] [--seed N]\n"
-    "                    [--overlap-validation yes|no] [--held-resolution RAD] [--json FILE]\n"
+    "                    [--overlap-validation yes|no] [--held-resolution RAD] [--fixed-ways]\n"
+    "                    [--json FILE]\n"
     "  --db          the cabinet database (default: $HILA_BENCH_DATABASE, else\n"
     "                out/cabinet.hila)\n"
     "  --scene       the nominal scene (default: meshes/cabinet/scene.yaml)\n"
@@ -63,6 +64,8 @@ constexpr const char* kUsage =
     "  --held-resolution\n"
     "                rad between the checked samples of a held board's motions, for every\n"
     "                planner (MotionSettings::held_resolution, default 0.04)\n"
+    "  --fixed-ways  also hila with each goal's ways in the fixed order (direct, regrasp,\n"
+    "                suction, exchange: BoardPlanSettings::way_order kFixed), interleaved\n"
     "  --json        also write every problem's figures to FILE\n";
 
 constexpr const char* kBuildHint =
@@ -82,6 +85,7 @@ struct Options {
                                                      online::MotionPlannerKind::kLazyPrm};
   std::uint64_t seed = 1;
   bool overlap_validation = true;
+  bool fixed_ways = false;
   std::string json;
 };
 
@@ -108,6 +112,10 @@ Options parse(int argc, char** argv) {
   }
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg == "--fixed-ways") {
+      opt.fixed_ways = true;
+      continue;
+    }
     if (arg == "-h" || arg == "--help") {
       std::cout << kUsage;
       std::exit(0);
@@ -410,6 +418,15 @@ int main(int argc, char** argv) {
     settings.push_back(s);
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
     names.emplace_back(online::to_string(kind));
+  }
+  if (opt.fixed_ways) {  // after the planners: their indices stay those of opt.planners
+    online::BoardPlanSettings s;
+    s.overlap_validation = opt.overlap_validation;
+    s.motion.held_resolution = opt.held_resolution;
+    s.way_order = online::WayOrder::kFixed;
+    settings.push_back(s);
+    planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
+    names.emplace_back("hila (fixed way order)");
   }
 
   std::vector<Problem> problems;

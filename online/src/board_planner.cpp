@@ -48,6 +48,16 @@ const char* to_string(AttemptResult result) {
   return "unknown";
 }
 
+const char* to_string(WayOrder order) {
+  switch (order) {
+    case WayOrder::kEstimatedTime:
+      return "estimated time";
+    case WayOrder::kFixed:
+      return "fixed";
+  }
+  return "unknown";
+}
+
 const char* to_string(BoardPlanStatus status) {
   switch (status) {
     case BoardPlanStatus::kSolved:
@@ -338,8 +348,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   };
   // One direct chain of a goal; true when it is planned (result filled in).
   auto try_direct = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
-                        const db::DirectGraspRecord& d) {
+                        const db::DirectGraspRecord& d, double estimate) {
     GoalAttempt attempt;
+    attempt.estimated_seconds = estimate;
     attempt.rank = goal.rank;
     attempt.candidate_id = goal.id;
     attempt.mode = DeliveryMode::kDirect;
@@ -351,6 +362,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     record(attempt, round, failure, deadline);
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
+    result.estimated_seconds = estimate;
     planned(goal, d.robot_grasp_id, steps, end);
     result.mode = DeliveryMode::kDirect;
     result.picking_arm = d.arm;
@@ -360,8 +372,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   };
   // One regrasp chain of a goal; true when it is planned (result filled in).
   auto try_regrasp = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
-                         const db::TableRegraspRecord& r) {
+                         const db::TableRegraspRecord& r, double estimate) {
     GoalAttempt attempt;
+    attempt.estimated_seconds = estimate;
     attempt.rank = goal.rank;
     attempt.candidate_id = goal.id;
     attempt.mode = DeliveryMode::kRegrasp;
@@ -373,6 +386,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     record(attempt, round, failure, deadline);
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
+    result.estimated_seconds = estimate;
     planned(goal, r.robot_grasp_id, steps, end);
     result.mode = DeliveryMode::kRegrasp;
     result.picking_arm = r.arm;
@@ -384,8 +398,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   };
   // One suction chain of a goal; true when it is planned (result filled in).
   auto try_suction = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
-                         const db::SuctionDeliveryRecord& d) {
+                         const db::SuctionDeliveryRecord& d, double estimate) {
     GoalAttempt attempt;
+    attempt.estimated_seconds = estimate;
     attempt.rank = goal.rank;
     attempt.candidate_id = goal.id;
     attempt.mode = DeliveryMode::kSuction;
@@ -397,6 +412,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     record(attempt, round, failure, deadline);
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
+    result.estimated_seconds = estimate;
     planned(goal, 0, steps, end);
     result.mode = DeliveryMode::kSuction;
     result.picking_arm = d.arm;
@@ -407,8 +423,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   // One exchange chain of a goal under the round's budgets; true when it is planned (result
   // filled in).
   auto try_shared = [&](const std::string& round, const db::HandoverCandidateRecord& goal,
-                        const db::SharedGraspRecord& s) {
+                        const db::SharedGraspRecord& s, double estimate) {
     GoalAttempt attempt;
+    attempt.estimated_seconds = estimate;
     attempt.rank = goal.rank;
     attempt.candidate_id = goal.id;
     attempt.mode = DeliveryMode::kExchange;
@@ -422,6 +439,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     result.attempts.push_back(attempt);
     if (!failure.empty()) return false;
     const auto& rr = run.handovers().at(s.robot_handover_id);
+    result.estimated_seconds = estimate;
     planned(goal, s.robot_grasp_id, steps, end);
     result.mode = DeliveryMode::kExchange;
     result.picking_arm = run.suction_arm().spec.name;
@@ -440,58 +458,79 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
         best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal.id]);
         continue;
       }
-      // The direct ways first: a third of the exchange's motions.
+      // The goal's ways, each with its estimated robot time, in the order they are tried
+      // (BoardPlanSettings::way_order).
+      struct Way {
+        const db::DirectGraspRecord* direct = nullptr;
+        const db::TableRegraspRecord* regrasp = nullptr;
+        const db::SuctionDeliveryRecord* suction = nullptr;
+        const db::SharedGraspRecord* shared = nullptr;
+        bool unconnected = false;  // an exchange the offline regrasp graph did not connect
+        double seconds = 0.0;
+      };
+      std::vector<Way> ways;
       if (const auto direct = records->direct_grasps.find(goal.id);
           direct != records->direct_grasps.end()) {
         for (const auto& d : direct->second) {
-          if (std::chrono::steady_clock::now() >= deadline) return false;
           if (direct_within_payload.count(d.arm) == 0) continue;
-          if (try_direct(round, goal, d)) return true;
+          ways.push_back({.direct = &d, .seconds = run.estimate(goal, d)});
         }
       }
-      // Then a regrasp on the table: five stages, all by one arm.
       if (const auto regrasps = records->table_regrasps.find(goal.id);
           regrasps != records->table_regrasps.end()) {
         for (const auto& r : regrasps->second) {
-          if (std::chrono::steady_clock::now() >= deadline) return false;
           if (direct_within_payload.count(r.arm) == 0 ||
               direct_within_payload.count(r.repick_arm) == 0) {
             continue;
           }
-          if (try_regrasp(round, goal, r)) return true;
+          ways.push_back({.regrasp = &r, .seconds = run.estimate(goal, r)});
         }
       }
-      // The suction way, where the build found no gripper for this goal: one arm, no exchange.
       if (const auto deliveries = records->suction_deliveries.find(goal.id);
           suction_within_payload && deliveries != records->suction_deliveries.end()) {
         for (const auto& d : deliveries->second) {
-          if (std::chrono::steady_clock::now() >= deadline) return false;
-          if (try_suction(round, goal, d)) return true;
+          ways.push_back({.suction = &d, .seconds = run.estimate(goal, d)});
         }
       }
-      if (!exchange_within_payload) continue;
       // The shared grasps the offline regrasp graph connected for this goal first: their
       // stored paths and IK branches are what the motions re-validate.
-      std::vector<db::SharedGraspRecord> shared = records->shared_grasps.at(goal.id);
-      const auto connected =
-          std::stable_partition(shared.begin(), shared.end(),
-                                [&](const auto& s) { return run.connected_offline(goal, s); });
-      any_connected_offline = any_connected_offline || connected != shared.begin();
+      if (const auto shared = records->shared_grasps.find(goal.id);
+          exchange_within_payload && shared != records->shared_grasps.end()) {
+        const std::size_t first = ways.size();
+        for (const auto& g : shared->second) {
+          const bool connected = run.connected_offline(goal, g);
+          any_connected_offline = any_connected_offline || connected;
+          ways.push_back({.shared = &g, .unconnected = !connected, .seconds = run.estimate(goal, g)});
+        }
+        std::stable_partition(ways.begin() + static_cast<std::ptrdiff_t>(first), ways.end(),
+                              [](const Way& w) { return !w.unconnected; });
+      }
+      if (settings_.way_order == WayOrder::kEstimatedTime) {
+        std::stable_sort(ways.begin(), ways.end(), [](const Way& a, const Way& b) {
+          return std::make_pair(a.unconnected, a.seconds) < std::make_pair(b.unconnected, b.seconds);
+        });
+      }
+      auto try_way = [&](const Way& w) {
+        if (w.direct != nullptr) return try_direct(round, goal, *w.direct, w.seconds);
+        if (w.regrasp != nullptr) return try_regrasp(round, goal, *w.regrasp, w.seconds);
+        if (w.suction != nullptr) return try_suction(round, goal, *w.suction, w.seconds);
+        return try_shared(round, goal, *w.shared, w.seconds);
+      };
       // Where the receiving arm did not reach the exchange with a grasp, that grasp at the same
       // board pose (another suction grasp holding it there) is tried after the goal's other
-      // chains: what blocked it is still there, so it would most likely fail again.
-      std::vector<const db::SharedGraspRecord*> later;
-      for (const auto& s : shared) {
+      // ways: what blocked it is still there, so it would most likely fail again.
+      std::vector<const Way*> later;
+      for (const auto& w : ways) {
         if (std::chrono::steady_clock::now() >= deadline) return false;
-        if (run.receive_failed_at_same_pose(s)) {
-          later.push_back(&s);
+        if (w.shared != nullptr && run.receive_failed_at_same_pose(*w.shared)) {
+          later.push_back(&w);
           continue;
         }
-        if (try_shared(round, goal, s)) return true;
+        if (try_way(w)) return true;
       }
-      for (const auto* s : later) {
+      for (const auto* w : later) {
         if (std::chrono::steady_clock::now() >= deadline) return false;
-        if (try_shared(round, goal, *s)) return true;
+        if (try_way(*w)) return true;
       }
     }
     return false;

@@ -209,6 +209,22 @@ class Run {
   std::int64_t suction_delivery_cup(const db::SuctionDeliveryRecord& delivery,
                                     const db::HandoverCandidateRecord& goal) const;
 
+  // --- Estimates: a way's robot time before it is planned (way_estimate.cpp) ------------------
+
+  // The robot time (s) the way would take from where the robot and the tool are (start()): its
+  // arms' motions one after another, as the plan runs them. A motion the regrasp graph stores
+  // counts its stored duration (RegraspEdgeRecord::duration; in a file without durations, its
+  // stored path timed rest to rest); any other is the straight joint-space move between the
+  // configurations the records store, timed rest to rest (core::rest_to_rest_duration) at the
+  // planner's speed scale. The tool is taken from (or set down on) its place where the way needs
+  // it. Left out: the straight approaches, lifts and retreats of a few centimetres, which every
+  // way has, and the detour a planned motion makes around what the straight move would cross.
+  double estimate(const db::HandoverCandidateRecord& goal, const db::DirectGraspRecord& direct);
+  double estimate(const db::HandoverCandidateRecord& goal, const db::TableRegraspRecord& regrasp);
+  double estimate(const db::HandoverCandidateRecord& goal,
+                  const db::SuctionDeliveryRecord& delivery);
+  double estimate(const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared);
+
  private:
   // --- Construction, the memoised stages and the board's records (plan_run.cpp) --------------
 
@@ -271,6 +287,38 @@ class Run {
   }
 
   static Hints paths_of(const std::vector<const db::RegraspEdgeRecord*>& edges);
+
+  // --- Estimates (way_estimate.cpp) --------------------------------------------------------------
+
+  // The straight move's rest-to-rest time at the planner's speed scale (s).
+  double straight_seconds(const core::Arm& arm, const Eigen::VectorXd& from,
+                          const Eigen::VectorXd& to) const;
+  // The stored motion `edge` in seconds, or `otherwise` when there is none (nullptr).
+  double stored_seconds(const core::Arm& arm, const db::RegraspEdgeRecord* edge,
+                        double otherwise) const;
+  // The stored motions and pick configurations the estimates look up, by what they join: the
+  // first connected edge of each (id order, as the stages' hints), indexed in one pass over the
+  // board's graph when first needed.
+  struct EstimateIndex {
+    // (arm, suction grasp): the pick node's first solution.
+    std::map<std::pair<std::string, std::int64_t>, const Eigen::VectorXd*> suction_pick;
+    // (robot handover, suction grasp): the suction arm's transfer from the pick.
+    std::map<std::pair<std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*> to_exchange;
+    // (robot handover, robot grasp): the receiving arm's transit from home.
+    std::map<std::pair<std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*> way_in;
+    // (robot handover, robot grasp, goal): the receiving arm's transfer to the human.
+    std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*>
+        to_human;
+    // (arm, suction grasp, goal): the suction delivery's transfer from the pick.
+    std::map<std::tuple<std::string, std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*>
+        on_cup;
+  };
+  const EstimateIndex& estimate_index();
+  // The suction arm from home to the tool's place in the scene and back: taking the tool or
+  // setting it down (computed once per run).
+  double tool_seconds();
+  // The arm's joints where the scene has them.
+  Eigen::VectorXd start_joints(const core::Arm& arm) const;
 
   // --- The step pipeline: plan a motion, smooth, time, validate (plan_run.cpp) ----------------
 
@@ -573,6 +621,8 @@ class Run {
   ArmsState start_;
 
   PlanTimes times_;
+  std::optional<double> tool_seconds_;  // tool_seconds()'s, once computed
+  std::optional<EstimateIndex> estimate_index_;
   std::optional<Stage> tool_;
   std::optional<Stage> tool_down_;
   std::optional<Stage> tool_return_;         // return_tool's, once a way is planned

@@ -129,6 +129,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
                         {"robot_grasp", a.robot_grasp_id},
                         {"suction_grasp", a.suction_grasp_id},
                         {"robot_handover", a.robot_handover_id},
+                        {"estimated_s", a.estimated_seconds},
                         {"result", online::to_string(a.result)},
                         {"larger_bridges", a.larger_bridges},
                         {"step", a.step},
@@ -215,6 +216,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
     }
     j["human_handover"] = pose_to_json(plan.human_handover);
     j["duration_s"] = plan.duration;
+    j["estimated_s"] = plan.estimated_seconds;
     j["path_length_rad"] = plan.path_length;
     j["validated"] = plan.validated;
     j["larger_bridges"] = plan.larger_bridges;

@@ -17,10 +17,21 @@
 
 namespace hila::online {
 
+// The order in which a goal's ways are planned (the goals themselves are always taken in Eq. 8
+// order: the human's comfort and least re-orientation come first, the robot's time second).
+// kEstimatedTime: by the way's estimated robot time from where the robot and tool are (Run's
+// estimate: the regrasp graph's stored durations, else straight joint moves), exchanges the
+// offline regrasp graph did not connect end to end last (they mostly fail, and their estimate
+// omits the detour they would need). kFixed: direct, regrasp on the table, suction, exchange,
+// each in the database's record order (connected exchanges first): a baseline to measure by.
+enum class WayOrder { kEstimatedTime, kFixed };
+const char* to_string(WayOrder order);
+
 struct BoardPlanSettings {
   double approach = 0.05;     // m: straight approach and retreat along the cup's / gripper's axis
   double lift = 0.15;         // m: straight up from the table after the suction pick
   int goals = 10;             // goals tried in Eq. 8 order
+  WayOrder way_order = WayOrder::kEstimatedTime;  // within each goal
   int exchange_bridges = 2;   // receiving-arm IK branches at the exchange given a bridge
   double speed_scale = 0.5;   // of the arms' velocity and acceleration limits
   double jaw_margin = 0.005;  // m: the gripper opens this much wider than the board while holding
@@ -94,6 +105,8 @@ struct GoalAttempt {
   std::int64_t robot_grasp_id = 0;     // 0 for the suction way
   std::int64_t suction_grasp_id = 0;   // the suction way's cup (the database's), else 0
   std::int64_t robot_handover_id = 0;  // 0 for a direct pick
+  // The way's estimated robot time (s) by which it was ordered among its goal's ways (WayOrder).
+  double estimated_seconds = 0.0;
   AttemptResult result = AttemptResult::kFailed;
   bool larger_bridges = false;  // tried in the second round (MotionSettings escalated budgets)
   // The step the chain stopped at (a PlanStep name such as "receiving_grasp", or a stage such as
@@ -161,6 +174,9 @@ struct BoardPlan {
   double planning_seconds = 0.0;
   PlanTimes times;           // of planning_seconds
   double duration = 0.0;     // s, the robot's motion
+  // The chosen way's estimated robot time (GoalAttempt::estimated_seconds), before the tool is
+  // put back: beside `duration`, how good the estimate was.
+  double estimated_seconds = 0.0;
   double path_length = 0.0;  // rad, both arms
   bool validated = false;    // every step passed the validator
   // Planned in the second round, with MotionSettings::escalated_bridge_checks per bridge (every
