@@ -84,7 +84,7 @@ namespace {
 // Every velocity on each piece and every acceleration between consecutive pieces, measured as
 // the validator measures them, plus from rest into the first piece and out of the last to rest;
 // the largest ratio to its scaled limit.
-double worst_rate_ratio(const online::TimedPath& timed, const Eigen::VectorXd& vmax,
+double worst_rate_ratio(const core::TimedPath& timed, const Eigen::VectorXd& vmax,
                         const Eigen::VectorXd& amax) {
   double worst = 0.0;
   const std::size_t n = timed.q.size();
