@@ -73,7 +73,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_generality --products DIR [--jobs N] [--seed N] [--quick] [--only p00,p01]\n"
     "                        [--deadline S] [--keep-db] [--reuse-db] [--json FILE]\n"
-    "                        [--way-order time|fixed] [--meta KEY=VALUE]...\n"
+    "                        [--way-order time|fixed|cheapest] [--meta KEY=VALUE]...\n"
     "       bench_generality --pick-region N --db FILE [--scene FILE] [--region M] [--seed N]\n"
     "                        [--stack-pose DX,DY,YAW_DEG]...\n"
     "                        [--deadline S] [--json FILE] [--meta KEY=VALUE]...\n"
@@ -92,8 +92,9 @@ constexpr const char* kUsage =
     "  --region      m, the stack's offset in x and y is uniform in +-this (default 0.10)\n"
     "  --stack-pose  DX,DY,YAW_DEG: plan this stack pose (m, m, deg; repeatable) instead of\n"
     "                drawn ones, touching or not\n"
-    "  --way-order   each goal's ways by estimated robot time (default) or in the fixed\n"
-    "                order direct, regrasp, suction, exchange (BoardPlanSettings::way_order)\n"
+    "  --way-order   each goal's ways by estimated robot time (time, the default), in the\n"
+    "                fixed order direct, regrasp, suction, exchange (fixed), or every goal's\n"
+    "                ways by estimate alone (cheapest) (BoardPlanSettings::way_order)\n"
     "  --json        also write every figure to FILE\n"
     "  --meta        KEY=VALUE recorded in the JSON (commit, machine, ...)\n";
 
@@ -184,10 +185,15 @@ Options parse(int argc, char** argv) {
         if (v.size() != 3) usage_error("--stack-pose: expected DX,DY,YAW_DEG, got '" + value + "'");
         opt.stack_poses.emplace_back(std::stod(v[0]), std::stod(v[1]), std::stod(v[2]));
       } else if (arg == "--way-order") {
-        if (value != "time" && value != "fixed") {
-          usage_error("--way-order: expected time or fixed, got '" + value + "'");
+        if (value == "time") {
+          opt.way_order = online::WayOrder::kEstimatedTime;
+        } else if (value == "fixed") {
+          opt.way_order = online::WayOrder::kFixed;
+        } else if (value == "cheapest") {
+          opt.way_order = online::WayOrder::kCheapestFirst;
+        } else {
+          usage_error("--way-order: expected time, fixed or cheapest, got '" + value + "'");
         }
-        opt.way_order = value == "time" ? online::WayOrder::kEstimatedTime : online::WayOrder::kFixed;
       } else if (arg == "--json") {
         opt.json = value;
       } else if (arg == "--meta") {

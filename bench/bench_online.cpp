@@ -48,8 +48,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_online [--db FILE] [--scene FILE] [--variations N] [--boards a,b]\n"
     "                    [--deadline S] [--planners hila,rrt_connect,lazy_prm] [--seed N]\n"
-    "                    [--overlap-validation yes|no] [--held-resolution RAD] [--fixed-ways]\n"
-    "                    [--json FILE]\n"
+    "                    [--overlap-validation yes|no] [--held-resolution RAD]\n"
+    "                    [--way-orders fixed,cheapest] [--json FILE]\n"
     "  --db          the cabinet database (default: $HILA_BENCH_DATABASE, else\n"
     "                out/cabinet.hila)\n"
     "  --scene       the nominal scene (default: meshes/cabinet/scene.yaml)\n"
@@ -64,8 +64,9 @@ constexpr const char* kUsage =
     "  --held-resolution\n"
     "                rad between the checked samples of a held board's motions, for every\n"
     "                planner (MotionSettings::held_resolution, default 0.04)\n"
-    "  --fixed-ways  also hila with each goal's ways in the fixed order (direct, regrasp,\n"
-    "                suction, exchange: BoardPlanSettings::way_order kFixed), interleaved\n"
+    "  --way-orders  also hila with other orders of the ways (BoardPlanSettings::way_order),\n"
+    "                interleaved: fixed (each goal's direct, regrasp, suction, exchange) and\n"
+    "                cheapest (every goal's ways by estimated robot time alone)\n"
     "  --json        also write every problem's figures to FILE\n";
 
 constexpr const char* kBuildHint =
@@ -85,7 +86,7 @@ struct Options {
                                                      online::MotionPlannerKind::kLazyPrm};
   std::uint64_t seed = 1;
   bool overlap_validation = true;
-  bool fixed_ways = false;
+  std::vector<online::WayOrder> way_orders;  // extra hila variants
   std::string json;
 };
 
@@ -112,10 +113,6 @@ Options parse(int argc, char** argv) {
   }
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--fixed-ways") {
-      opt.fixed_ways = true;
-      continue;
-    }
     if (arg == "-h" || arg == "--help") {
       std::cout << kUsage;
       std::exit(0);
@@ -164,6 +161,16 @@ Options parse(int argc, char** argv) {
           usage_error("--overlap-validation: expected yes or no, got '" + value + "'");
         }
         opt.overlap_validation = value == "yes";
+      } else if (arg == "--way-orders") {
+        for (const auto& name : split_list(value)) {
+          if (name == "fixed") {
+            opt.way_orders.push_back(online::WayOrder::kFixed);
+          } else if (name == "cheapest") {
+            opt.way_orders.push_back(online::WayOrder::kCheapestFirst);
+          } else {
+            usage_error("--way-orders: expected fixed or cheapest, got '" + name + "'");
+          }
+        }
       } else if (arg == "--json") {
         opt.json = value;
       } else {
@@ -419,14 +426,14 @@ int main(int argc, char** argv) {
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
     names.emplace_back(online::to_string(kind));
   }
-  if (opt.fixed_ways) {  // after the planners: their indices stay those of opt.planners
+  for (const auto order : opt.way_orders) {  // after the planners: their indices stay
     online::BoardPlanSettings s;
     s.overlap_validation = opt.overlap_validation;
     s.motion.held_resolution = opt.held_resolution;
-    s.way_order = online::WayOrder::kFixed;
+    s.way_order = order;
     settings.push_back(s);
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
-    names.emplace_back("hila (fixed way order)");
+    names.push_back(std::string("hila (ways: ") + online::to_string(order) + ")");
   }
 
   std::vector<Problem> problems;

@@ -54,6 +54,8 @@ const char* to_string(WayOrder order) {
       return "estimated time";
     case WayOrder::kFixed:
       return "fixed";
+    case WayOrder::kCheapestFirst:
+      return "cheapest first";
   }
   return "unknown";
 }
@@ -448,8 +450,91 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     result.robot_handover = rr.board;
     return true;
   };
-  // Every goal in order under the round's budgets; true when one is planned (result filled in).
+  // A goal's ways, each with its estimated robot time: direct, regrasp, suction, exchange, each
+  // in record order, the exchanges the offline regrasp graph connected first (WayOrder::kFixed).
+  struct Way {
+    const db::HandoverCandidateRecord* goal = nullptr;
+    const db::DirectGraspRecord* direct = nullptr;
+    const db::TableRegraspRecord* regrasp = nullptr;
+    const db::SuctionDeliveryRecord* suction = nullptr;
+    const db::SharedGraspRecord* shared = nullptr;
+    bool unconnected = false;  // an exchange the offline regrasp graph did not connect
+    double seconds = 0.0;
+  };
+  auto ways_of = [&](const db::HandoverCandidateRecord& goal, std::vector<Way>& ways) {
+    if (const auto direct = records->direct_grasps.find(goal.id);
+        direct != records->direct_grasps.end()) {
+      for (const auto& d : direct->second) {
+        if (direct_within_payload.count(d.arm) == 0) continue;
+        ways.push_back({.goal = &goal, .direct = &d, .seconds = run.estimate(goal, d)});
+      }
+    }
+    if (const auto regrasps = records->table_regrasps.find(goal.id);
+        regrasps != records->table_regrasps.end()) {
+      for (const auto& r : regrasps->second) {
+        if (direct_within_payload.count(r.arm) == 0 ||
+            direct_within_payload.count(r.repick_arm) == 0) {
+          continue;
+        }
+        ways.push_back({.goal = &goal, .regrasp = &r, .seconds = run.estimate(goal, r)});
+      }
+    }
+    if (const auto deliveries = records->suction_deliveries.find(goal.id);
+        suction_within_payload && deliveries != records->suction_deliveries.end()) {
+      for (const auto& d : deliveries->second) {
+        ways.push_back({.goal = &goal, .suction = &d, .seconds = run.estimate(goal, d)});
+      }
+    }
+    // The shared grasps the offline regrasp graph connected for this goal first: their stored
+    // paths and IK branches are what the motions re-validate.
+    if (const auto shared = records->shared_grasps.find(goal.id);
+        exchange_within_payload && shared != records->shared_grasps.end()) {
+      const std::size_t first = ways.size();
+      for (const auto& g : shared->second) {
+        const bool connected = run.connected_offline(goal, g);
+        any_connected_offline = any_connected_offline || connected;
+        ways.push_back({.goal = &goal,
+                        .shared = &g,
+                        .unconnected = !connected,
+                        .seconds = run.estimate(goal, g)});
+      }
+      std::stable_partition(ways.begin() + static_cast<std::ptrdiff_t>(first), ways.end(),
+                            [](const Way& w) { return !w.unconnected; });
+    }
+  };
+  // Ways in the given order under the round's budgets; true when one is planned (result filled
+  // in). Where the receiving arm did not reach the exchange with a grasp, that grasp at the same
+  // board pose (another suction grasp holding it there) is tried after the other ways: what
+  // blocked it is still there, so it would most likely fail again.
+  auto try_ways = [&](const std::string& round, const std::vector<Way>& ways) {
+    auto try_way = [&](const Way& w) {
+      const auto& goal = *w.goal;
+      if (w.direct != nullptr) return try_direct(round, goal, *w.direct, w.seconds);
+      if (w.regrasp != nullptr) return try_regrasp(round, goal, *w.regrasp, w.seconds);
+      if (w.suction != nullptr) return try_suction(round, goal, *w.suction, w.seconds);
+      return try_shared(round, goal, *w.shared, w.seconds);
+    };
+    std::vector<const Way*> later;
+    for (const auto& w : ways) {
+      if (std::chrono::steady_clock::now() >= deadline) return false;
+      if (w.shared != nullptr && run.receive_failed_at_same_pose(*w.shared)) {
+        later.push_back(&w);
+        continue;
+      }
+      if (try_way(w)) return true;
+    }
+    for (const auto* w : later) {
+      if (std::chrono::steady_clock::now() >= deadline) return false;
+      if (try_way(*w)) return true;
+    }
+    return false;
+  };
+  auto by_estimate = [](const Way& a, const Way& b) {
+    return std::make_pair(a.unconnected, a.seconds) < std::make_pair(b.unconnected, b.seconds);
+  };
+  // Every goal under the round's budgets; true when one is planned (result filled in).
   auto try_goals = [&](const std::string& round) {
+    std::vector<Way> across;  // kCheapestFirst: every goal's ways
     for (const auto* goal_record : goals) {
       const auto& goal = *goal_record;
       // A goal the maps call comfortable may still be out of reach (a map bin holds the best of
@@ -458,82 +543,21 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
         best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal.id]);
         continue;
       }
-      // The goal's ways, each with its estimated robot time, in the order they are tried
-      // (BoardPlanSettings::way_order).
-      struct Way {
-        const db::DirectGraspRecord* direct = nullptr;
-        const db::TableRegraspRecord* regrasp = nullptr;
-        const db::SuctionDeliveryRecord* suction = nullptr;
-        const db::SharedGraspRecord* shared = nullptr;
-        bool unconnected = false;  // an exchange the offline regrasp graph did not connect
-        double seconds = 0.0;
-      };
+      if (settings_.way_order == WayOrder::kCheapestFirst) {
+        ways_of(goal, across);
+        continue;
+      }
       std::vector<Way> ways;
-      if (const auto direct = records->direct_grasps.find(goal.id);
-          direct != records->direct_grasps.end()) {
-        for (const auto& d : direct->second) {
-          if (direct_within_payload.count(d.arm) == 0) continue;
-          ways.push_back({.direct = &d, .seconds = run.estimate(goal, d)});
-        }
-      }
-      if (const auto regrasps = records->table_regrasps.find(goal.id);
-          regrasps != records->table_regrasps.end()) {
-        for (const auto& r : regrasps->second) {
-          if (direct_within_payload.count(r.arm) == 0 ||
-              direct_within_payload.count(r.repick_arm) == 0) {
-            continue;
-          }
-          ways.push_back({.regrasp = &r, .seconds = run.estimate(goal, r)});
-        }
-      }
-      if (const auto deliveries = records->suction_deliveries.find(goal.id);
-          suction_within_payload && deliveries != records->suction_deliveries.end()) {
-        for (const auto& d : deliveries->second) {
-          ways.push_back({.suction = &d, .seconds = run.estimate(goal, d)});
-        }
-      }
-      // The shared grasps the offline regrasp graph connected for this goal first: their
-      // stored paths and IK branches are what the motions re-validate.
-      if (const auto shared = records->shared_grasps.find(goal.id);
-          exchange_within_payload && shared != records->shared_grasps.end()) {
-        const std::size_t first = ways.size();
-        for (const auto& g : shared->second) {
-          const bool connected = run.connected_offline(goal, g);
-          any_connected_offline = any_connected_offline || connected;
-          ways.push_back({.shared = &g, .unconnected = !connected, .seconds = run.estimate(goal, g)});
-        }
-        std::stable_partition(ways.begin() + static_cast<std::ptrdiff_t>(first), ways.end(),
-                              [](const Way& w) { return !w.unconnected; });
-      }
+      ways_of(goal, ways);
       if (settings_.way_order == WayOrder::kEstimatedTime) {
-        std::stable_sort(ways.begin(), ways.end(), [](const Way& a, const Way& b) {
-          return std::make_pair(a.unconnected, a.seconds) < std::make_pair(b.unconnected, b.seconds);
-        });
+        std::stable_sort(ways.begin(), ways.end(), by_estimate);
       }
-      auto try_way = [&](const Way& w) {
-        if (w.direct != nullptr) return try_direct(round, goal, *w.direct, w.seconds);
-        if (w.regrasp != nullptr) return try_regrasp(round, goal, *w.regrasp, w.seconds);
-        if (w.suction != nullptr) return try_suction(round, goal, *w.suction, w.seconds);
-        return try_shared(round, goal, *w.shared, w.seconds);
-      };
-      // Where the receiving arm did not reach the exchange with a grasp, that grasp at the same
-      // board pose (another suction grasp holding it there) is tried after the goal's other
-      // ways: what blocked it is still there, so it would most likely fail again.
-      std::vector<const Way*> later;
-      for (const auto& w : ways) {
-        if (std::chrono::steady_clock::now() >= deadline) return false;
-        if (w.shared != nullptr && run.receive_failed_at_same_pose(*w.shared)) {
-          later.push_back(&w);
-          continue;
-        }
-        if (try_way(w)) return true;
-      }
-      for (const auto* w : later) {
-        if (std::chrono::steady_clock::now() >= deadline) return false;
-        if (try_way(*w)) return true;
-      }
+      if (try_ways(round, ways)) return true;
+      if (std::chrono::steady_clock::now() >= deadline) return false;
     }
-    return false;
+    // Across the goals, in Eq. 8 order where two ways' estimates are equal.
+    std::stable_sort(across.begin(), across.end(), by_estimate);
+    return try_ways(round, across);
   };
   // A solved board, with the tool put back when asked.
   auto solved = [&] {

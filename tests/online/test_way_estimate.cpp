@@ -11,7 +11,6 @@
 #include "hila/core/time_parameterization.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/online/board_planner.hpp"
-#include "util/quick_build.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -75,7 +74,7 @@ struct Graph {
 
 }  // namespace
 
-// The cabinet database (HILA_TEST_DATABASE, else a quick build) and its model, once per process.
+// The cabinet database (HILA_TEST_DATABASE, else a build) and its model, once per process.
 class WayEstimate : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -85,7 +84,11 @@ class WayEstimate : public ::testing::Test {
     } else {
       dir_ = test::temp_dir("way_estimate_" + std::to_string(::getpid()));
       path = dir_ + "/cabinet.hila";
-      offline::BuildSettings s = test::quick_build_settings(7, 2);
+      // The default build with a smaller roadmap, as test_board_planner's (the quick settings'
+      // goals are too few for lateral_right).
+      offline::BuildSettings s;
+      s.jobs = 2;
+      s.roadmap.nodes = 1200;
       offline::build_database(test::product_path(), test::cell_path(), path, s);
     }
     model_ = online::PlannerModel::load(path, test::cell_path(), test::product_path());

@@ -24,7 +24,10 @@ namespace hila::online {
 // offline regrasp graph did not connect end to end last (they mostly fail, and their estimate
 // omits the detour they would need). kFixed: direct, regrasp on the table, suction, exchange,
 // each in the database's record order (connected exchanges first): a baseline to measure by.
-enum class WayOrder { kEstimatedTime, kFixed };
+// kCheapestFirst: every way of every goal tried by its estimate alone (unconnected exchanges
+// last, Eq. 8 order between equal estimates): the least robot time first, whatever the goal's
+// comfort rank; measured against kEstimatedTime (docs/online.md), not the default.
+enum class WayOrder { kEstimatedTime, kFixed, kCheapestFirst };
 const char* to_string(WayOrder order);
 
 struct BoardPlanSettings {
