@@ -305,6 +305,9 @@ struct PartResult {
   std::string way;              // "exchange", "direct" or "regrasp" (delivered parts)
   std::string delivering_arm;
   double quality = 0.0;            // the human's comfort Q at the goal delivered to (paper Eq. 4)
+  int goal_rank = -1;              // its Eq. 8 rank
+  double estimated_seconds = 0.0;  // the chosen way's estimated robot time
+  int motions_planned = 0;         // BoardPlan::motions_planned (every attempt's)
   bool tool_in_hand_after = true;  // the suction arm holds the tool after the part
   std::string tool_arm = online::kDefaultSuctionArm;  // the arm holding it then
   std::optional<core::Pose> tool_place;               // where the plan moved the tool to
@@ -373,6 +376,8 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
   if (r.delivered) {
     r.way = online::to_string(plan.mode);
     r.quality = plan.quality;
+    r.goal_rank = plan.goal_rank;
+    r.estimated_seconds = plan.estimated_seconds;
     r.delivering_arm = plan.delivering_arm;
     r.tool_in_hand_after = plan.tool_in_hand_after;
     r.tool_arm = plan.suction_arm;
@@ -384,6 +389,7 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
   r.status = online::to_string(plan.status);
   r.reason = plan.reason;
   r.plan_s = plan.planning_seconds;
+  r.motions_planned = plan.motions_planned;
   r.attempts = static_cast<int>(plan.attempts.size());
   for (const auto& a : plan.attempts) ++r.outcomes[a.outcome];
   if (!r.delivered) {
@@ -479,7 +485,8 @@ nlohmann::json part_json(const PartResult& r) {
                       {"robot_grasps", r.robot_grasps},
                       {"build_failure", r.build_failure},
                       {"start_collision", r.start_collision},
-                      {"outcomes", r.outcomes}};
+                      {"outcomes", r.outcomes},
+                      {"motions_planned", r.motions_planned}};
   if (!r.kind.empty()) j["kind"] = r.kind;
   if (r.delivered) {
     j["validated"] = r.validated;
@@ -490,6 +497,8 @@ nlohmann::json part_json(const PartResult& r) {
     j["way"] = r.way;
     j["delivering_arm"] = r.delivering_arm;
     j["quality"] = r.quality;
+    j["goal_rank"] = r.goal_rank;
+    j["estimated_s"] = r.estimated_seconds;
   } else {
     const Limit limit = limit_of(r);
     j["cause"] = r.cause;

@@ -194,6 +194,8 @@ struct Result {
   double duration = 0.0;
   int attempts = 0;
   int goal_rank = -1;
+  double quality = 0.0;            // the scene's human's comfort Q at the goal
+  double estimated_seconds = 0.0;  // the chosen way's estimated robot time
   double theta_c_deg = 0.0;
   std::string why_failed;               // the most frequent attempt outcome (failures)
   std::map<std::string, int> outcomes;  // every attempt's outcome in full, with its count
@@ -270,6 +272,8 @@ Result run(online::BoardPlanner& planner, const online::PlannerModel& model,
   r.path_length = plan.path_length;
   r.duration = plan.duration;
   r.goal_rank = plan.goal_rank;
+  r.quality = plan.quality;
+  r.estimated_seconds = plan.estimated_seconds;
   r.theta_c_deg = plan.theta_c_deg;
   try {
     const bench::PlanCheck check = bench::check_plan(model, scene, plan, settings);
@@ -363,6 +367,8 @@ nlohmann::json result_json(const Result& r) {
     j["path_length_rad"] = r.path_length;
     j["duration_s"] = r.duration;
     j["goal_rank"] = r.goal_rank;
+    j["quality"] = r.quality;
+    j["estimated_s"] = r.estimated_seconds;
     j["theta_c_deg"] = r.theta_c_deg;
     j["valid"] = !r.invalid();
     j["invalidity"] = r.invalidity;
