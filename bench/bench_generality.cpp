@@ -306,6 +306,7 @@ struct PartResult {
   std::string delivering_arm;
   double quality = 0.0;            // the human's comfort Q at the goal delivered to (paper Eq. 4)
   int goal_rank = -1;              // its Eq. 8 rank
+  std::int64_t candidate_id = 0;   // handover_candidates.id of that goal
   double estimated_seconds = 0.0;  // the chosen way's estimated robot time
   int motions_planned = 0;         // BoardPlan::motions_planned (every attempt's)
   bool tool_in_hand_after = true;  // the suction arm holds the tool after the part
@@ -377,6 +378,7 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
     r.way = online::to_string(plan.mode);
     r.quality = plan.quality;
     r.goal_rank = plan.goal_rank;
+    r.candidate_id = plan.candidate_id;
     r.estimated_seconds = plan.estimated_seconds;
     r.delivering_arm = plan.delivering_arm;
     r.tool_in_hand_after = plan.tool_in_hand_after;
@@ -498,6 +500,7 @@ nlohmann::json part_json(const PartResult& r) {
     j["delivering_arm"] = r.delivering_arm;
     j["quality"] = r.quality;
     j["goal_rank"] = r.goal_rank;
+    j["candidate"] = r.candidate_id;
     j["estimated_s"] = r.estimated_seconds;
   } else {
     const Limit limit = limit_of(r);
