@@ -747,7 +747,7 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
   db.regrasp_edges_ = load_table<RegraspEdgeRecord>(
       *connection, "regrasp_edges",
       "kind, arm, from_node, to_node, filter_id, connected, cost, path_nodes, via, path_dof, "
-      "path_waypoints, path",
+      "path_waypoints, path, duration",
       fix, verify, [&](detail::Statement& s, RegraspEdgeRecord& r) {
         RowCheck check(path, "regrasp_edges", fix);
         check.set_row("id " + std::to_string(r.id));
@@ -776,6 +776,15 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
                        std::to_string(dof) + " joint values as little-endian doubles",
                    [&] { return detail::decode_vectors(bytes, waypoints, dof, r.path); });
         check.finite("path", r.path, [](std::size_t i) { return nth("waypoint", i); });
+        // Schema version 9. The file's CHECKs refuse a negative value and one without a path,
+        // but not +infinity (nor a file whose schema lost them).
+        r.duration = s.next_double();
+        if (!std::isfinite(r.duration) || r.duration < 0.0) {
+          check.fail("duration", "a time in seconds, finite and >= 0", exact(r.duration));
+        }
+        if (waypoints == 0 && r.duration != 0.0) {
+          check.fail("duration", "0 when path_waypoints is 0 (no path)", exact(r.duration));
+        }
       });
   detail::check_references(*connection, path, fix);
   detail::check_table_digests(path, meta_map, verify.digests, fix);

@@ -19,7 +19,7 @@ std::string hila_version() {
 
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 8;
+  return 9;
 }
 
 namespace detail {
@@ -151,8 +151,8 @@ std::string create_tables_v3() {
 
 // The roadmap and regrasp-graph tables as schema version 4 defines them, one constant per table
 // (with its indexes). Both the current schema and the 3 -> 4 migration step create them from this
-// text; like the constants above, a later change goes into schema_sql() and leaves these to the
-// step.
+// text, but for regrasp_edges, which version 9 changed (kCreateRegraspEdgesV9): like the constants
+// above, a later change goes into a constant of its own and leaves these to the step.
 //
 // Arrays are BLOBs, little-endian: roadmaps.node_joints node_count * dof doubles (node-major),
 // node_gravity node_count * 3 doubles (x, y, z), node_inclination_deg, edge_length and
@@ -245,10 +245,75 @@ CREATE TABLE regrasp_edges (
 CREATE INDEX regrasp_edges_part_id ON regrasp_edges(part_id);
 )sql";
 
-// Every table schema version 4 adds, in schema order.
+// The regrasp_edges table as schema version 9 defines it (with its index): version 4's with
+// duration, the estimated robot time along the stored path in seconds (records::RegraspEdgeRecord::
+// duration): >= 0, and 0 without a path. 0 with a path means "not estimated" (a row migrated from
+// version 8 or earlier: the online planner times the path itself). Created by schema_sql() and by
+// the 8 -> 9 step (rebuild_regrasp_edges_v9) from this text; kCreateRegraspEdgesV4 stays for the
+// 3 -> 4 step.
+constexpr const char* kCreateRegraspEdgesV9 = R"sql(
+CREATE TABLE regrasp_edges (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  kind TEXT NOT NULL CHECK (kind IN ('transit', 'transfer', 'handover')),
+  arm TEXT NOT NULL,
+  from_node INTEGER NOT NULL REFERENCES regrasp_nodes(id),
+  to_node INTEGER NOT NULL REFERENCES regrasp_nodes(id),
+  filter_id INTEGER REFERENCES roadmap_filters(id),
+  connected INTEGER NOT NULL CHECK (connected IN (0, 1)),
+  cost REAL NOT NULL,
+  path_nodes INTEGER NOT NULL,
+  via TEXT NOT NULL CHECK (via IN ('', 'roadmap', 'bridge')),
+  path_dof INTEGER NOT NULL,
+  path_waypoints INTEGER NOT NULL,
+  path BLOB NOT NULL,
+  duration REAL NOT NULL CHECK (duration >= 0),
+  CHECK ((kind = 'transfer') = (filter_id IS NOT NULL)),
+  CHECK (connected = 1 OR (cost = 0 AND path_nodes = 0)),
+  CHECK ((connected = 1 AND kind IN ('transit', 'transfer')) = (via <> '')),
+  CHECK ((via = '') = (path_waypoints = 0)),
+  CHECK (path_waypoints <> 0 OR duration = 0)
+);
+CREATE INDEX regrasp_edges_part_id ON regrasp_edges(part_id);
+)sql";
+
+// The 8 -> 9 step: the version 9 regrasp_edges in place of the version 8 one (which is version
+// 4's), every row kept with duration 0 (not estimated). The column is first added as ALTER TABLE
+// adds one, at the end, every row's its DEFAULT 0 (and the step fails, leaving the file as it was,
+// on a table that has the column already: a version 9 file whose version was set back). Then the
+// table is rebuilt, as the 7 -> 8 step rebuilt table_regrasps: an added column keeps its DEFAULT
+// and cannot take the table's CHECK tying it to the path, so the old table is renamed out of the
+// way (its index dropped, so the name is free), the version 9 one created, the rows copied with
+// their ids and the old one dropped, which leaves the file declaring the table exactly as a fresh
+// one does. Nothing in a version 8 file refers to regrasp_edges, so the rename rewrites no other
+// table; the foreign keys the table holds (parts, regrasp_nodes, roadmap_filters) name tables that
+// stay.
+constexpr const char* kRegraspEdgesColumnsV9 =
+    "id, part_id, kind, arm, from_node, to_node, filter_id, connected, cost, path_nodes, via, "
+    "path_dof, path_waypoints, path, duration";
+
+std::string rebuild_regrasp_edges_v9() {
+  return std::string(
+             "ALTER TABLE regrasp_edges ADD COLUMN duration REAL NOT NULL DEFAULT 0.0;\n"
+             "DROP INDEX regrasp_edges_part_id;\n"
+             "ALTER TABLE regrasp_edges RENAME TO regrasp_edges_v8;\n") +
+         kCreateRegraspEdgesV9 + "INSERT INTO regrasp_edges (" + kRegraspEdgesColumnsV9 +
+         ")\n  SELECT " + kRegraspEdgesColumnsV9 + " FROM regrasp_edges_v8 ORDER BY id;\n" +
+         "DROP TABLE regrasp_edges_v8;\n";
+}
+
+// Every table schema version 4 adds, in schema order, as version 4 declared them (the 3 -> 4
+// step; schema_sql() has the version 9 regrasp_edges, create_tables_v9()).
 std::string create_tables_v4() {
   return std::string(kCreateRoadmapsV4) + kCreateRoadmapFiltersV4 + kCreateRegraspNodesV4 +
          kCreateRegraspEdgesV4;
+}
+
+// The roadmap and regrasp-graph tables as schema version 9 has them: version 4's with
+// kCreateRegraspEdgesV9. What schema_sql() creates.
+std::string create_tables_v9() {
+  return std::string(kCreateRoadmapsV4) + kCreateRoadmapFiltersV4 + kCreateRegraspNodesV4 +
+         kCreateRegraspEdgesV9;
 }
 
 // The direct_grasps table as schema version 5 defines it (with its index): robot grasps with which
@@ -367,9 +432,10 @@ CREATE INDEX suction_deliveries_candidate_id ON suction_deliveries(candidate_id)
 
 // Written out in full (not generated) so this file is the readable reference of the schema (the
 // comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
-// kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones, the
-// direct_grasps table kCreateDirectGraspsV5, the table_regrasps table kCreateTableRegraspsV8, the
-// suction_deliveries table kCreateSuctionDeliveriesV8).
+// kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones but for
+// regrasp_edges, kCreateRegraspEdgesV9, the direct_grasps table kCreateDirectGraspsV5, the
+// table_regrasps table kCreateTableRegraspsV8, the suction_deliveries table
+// kCreateSuctionDeliveriesV8).
 // Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
@@ -450,7 +516,7 @@ CREATE TABLE human_grasps (
 );
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql" + std::string(kCreateComfortMapsV2) +
-                                 create_tables_v3() + create_tables_v4() + kCreateDirectGraspsV5 +
+                                 create_tables_v3() + create_tables_v9() + kCreateDirectGraspsV5 +
                                  kCreateTableRegraspsV8 + kCreateSuctionDeliveriesV8;
   return sql;
 }
@@ -482,6 +548,10 @@ const std::vector<MigrationStep>& migration_steps() {
       // table_regrasps.repick_arm (the table rebuilt with the column, each row's its arm: version 7
       // had no relays). The migration rewrites every table's digest after its last step.
       {7, kCreateSuctionDeliveriesV8 + rebuild_table_regrasps_v8()},
+      // 8 -> 9: regrasp_edges.duration (the table rebuilt with the column, every row's 0: not
+      // estimated, the online planner times the stored path itself). The migration rewrites every
+      // table's digest after its last step.
+      {8, rebuild_regrasp_edges_v9()},
   };
   return steps;
 }

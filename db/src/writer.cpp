@@ -81,6 +81,13 @@ class FiniteCheck {
   std::string record_;
 };
 
+// A double as SQLite stores it (17 significant digits), for "is ..." in a refusal.
+std::string exact(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
 std::string record_label(std::size_t index, std::size_t count, const std::string& owner) {
   return "record " + std::to_string(index) + " of " + std::to_string(count) + ", " + owner;
 }
@@ -361,7 +368,7 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
         *m.connection,
         insert_sql("regrasp_edges",
                    "part_id, kind, arm, from_node, to_node, filter_id, connected, cost, "
-                   "path_nodes, via, path_dof, path_waypoints, path"),
+                   "path_nodes, via, path_dof, path_waypoints, path, duration"),
         m.context("regrasp_edges"));
     m.select_robot_grasp.emplace(*m.connection, "SELECT 1 FROM robot_grasps WHERE id = ?",
                                  m.context("robot_grasps"));
@@ -1172,6 +1179,17 @@ std::vector<std::int64_t> DatabaseWriter::add_regrasp_edges(
                           : "as many as path[0] (" + std::to_string(e.path[0].size()) + ")"));
         }
       }
+      // The estimated time along the path (schema version 9): finite, >= 0, and 0 without a
+      // path (0 with one: not estimated).
+      check.value("duration", e.duration);
+      if (e.duration < 0.0) {
+        bad("duration", "RegraspEdgeRecord::duration is " + exact(e.duration) +
+                            ", expected a time in seconds >= 0");
+      }
+      if (e.path.empty() && e.duration != 0.0) {
+        bad("duration", "RegraspEdgeRecord::duration is " + exact(e.duration) +
+                            " for an edge without a path, expected 0");
+      }
       for (std::size_t j = 0; j < e.path.size(); ++j) {
         check.set_record(record + ", waypoint " + std::to_string(j));
         check.joints("path", e.path[j]);
@@ -1198,6 +1216,7 @@ std::vector<std::int64_t> DatabaseWriter::add_regrasp_edges(
       s.bind_next(static_cast<std::int64_t>(e.path.empty() ? 0 : e.path[0].size()));
       s.bind_next(static_cast<std::int64_t>(e.path.size()));
       s.bind_blob(detail::encode_vectors(e.path));
+      s.bind_next(e.duration);
       s.run();
       ids.push_back(m.last_id());
     }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "hila/db/database.hpp"
+#include "hila/db/migration.hpp"
 #include "util/test_util.hpp"
 
 namespace hila::db::test_data {
@@ -443,6 +444,14 @@ inline void add_roadmap_records(Sample& s, std::mt19937_64& rng) {
   a.regrasp_edges[1].path[1][0] = -0.0;
   a.regrasp_edges[1].path[1][4] = std::numeric_limits<double>::denorm_min();
   b.regrasp_edges[1].path[2][1] = 1e300;
+  // Estimated times along the paths (schema version 9), each different: one not exactly
+  // representable, a path with none estimated (0, as a migrated row), a huge one and a subnormal.
+  // The edges without a path keep 0.
+  a.regrasp_edges[0].duration = 6.125;
+  a.regrasp_edges[1].duration = 0.1;
+  a.regrasp_edges[2].duration = 0.0;
+  a.regrasp_edges[5].duration = 1e300;
+  b.regrasp_edges[1].duration = std::numeric_limits<double>::denorm_min();
   std::int64_t edge_id = 0;
   for (auto& p : s.parts) {
     for (auto& e : p.regrasp_edges) e.id = ++edge_id;
@@ -744,6 +753,28 @@ inline std::vector<std::int64_t> write_sample(const std::string& path, const Sam
   }
   writer.commit();
   return ids;
+}
+
+// SQL that turns a current file's regrasp_edges back into the table of schema versions 4 to 8
+// (without duration), every other value kept: for a version 8 (or older) file made from the
+// sample. The table's CREATE text (and its index's) is the 3 -> 4 step's, which is never edited,
+// so the file declares the table as the hila of those versions wrote it.
+inline std::string regrasp_edges_before_v9_sql() {
+  const std::string& step_v4 = detail::migration_steps().at(2).sql;
+  return "DROP INDEX regrasp_edges_part_id;\n"
+         "ALTER TABLE regrasp_edges RENAME TO regrasp_edges_v9;\n" +
+         step_v4.substr(step_v4.find("CREATE TABLE regrasp_edges (")) +
+         "INSERT INTO regrasp_edges SELECT id, part_id, kind, arm, from_node, to_node, filter_id, "
+         "connected, cost, path_nodes, via, path_dof, path_waypoints, path FROM regrasp_edges_v9 "
+         "ORDER BY id;\n"
+         "DROP TABLE regrasp_edges_v9;\n";
+}
+
+// The sample as a file migrated from version 8 or earlier holds it: no edge's duration estimated.
+inline void clear_durations(Sample& sample) {
+  for (auto& p : sample.parts) {
+    for (auto& e : p.regrasp_edges) e.duration = 0.0;
+  }
 }
 
 // Largest absolute difference between two poses' 4x4 matrices.

@@ -190,6 +190,20 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
     auto& path = s.parts[0].regrasp_edges[0].path;
     std::swap(path[1], path[2]);
   });
+  // Schema version 9: the estimated duration along the path.
+  add("regrasp edge duration ulp", [](Sample& s) {
+    double& d = s.parts[0].regrasp_edges[0].duration;
+    d = std::nextafter(d, 10.0);
+  });
+  add("regrasp edge duration not estimated",
+      [](Sample& s) { s.parts[0].regrasp_edges[1].duration = 0.0; });
+  add("regrasp edge duration estimated",
+      [](Sample& s) { s.parts[0].regrasp_edges[2].duration = 0.75; });
+  add("regrasp edge durations swapped", [](Sample& s) {
+    std::swap(s.parts[0].regrasp_edges[0].duration, s.parts[0].regrasp_edges[1].duration);
+  });
+  add("regrasp edge duration subnormal to 0",
+      [](Sample& s) { s.parts[1].regrasp_edges[1].duration = 0.0; });
   // Schema version 5: direct grasps.
   add("direct grasp pick inclination ulp", [](Sample& s) {
     double& a = s.parts[0].direct_grasps[3].inclination_pick_deg;

@@ -133,7 +133,7 @@ class HandoverRoundTrip : public ::testing::Test {
 TEST_F(HandoverRoundTrip, MetaHumanBodies) {
   const Database db = Database::open(path_);
   EXPECT_EQ(db.meta().human_bodies, "1.75 male; 1.55 female");
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
 }
 
 TEST_F(HandoverRoundTrip, Stages) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <optional>
 
 #include "hila/db/database.hpp"
@@ -55,20 +56,41 @@ std::vector<MigrationStep> steps_from_v0() {
   return steps;
 }
 
-// The CREATE statements sqlite_master holds for table_regrasps and its index (and for any table
-// left over by a step), in name order: how the file itself declares the table.
-std::vector<std::string> table_regrasps_sql(const std::string& path) {
+// The CREATE statements sqlite_master holds for `table` and its index (and for any table left
+// over by a step, named after it), in name order: how the file itself declares the table.
+std::vector<std::string> declared_sql(const std::string& path, const std::string& table) {
   const ErrorContext context{"(sqlite_master)", "a readable schema", ""};
   Connection connection(path, SQLITE_OPEN_READONLY, path);
   std::vector<std::string> statements;
   {
-    Statement select(
-        connection, "SELECT sql FROM sqlite_master WHERE name GLOB 'table_regrasps*' ORDER BY name",
-        context);
+    Statement select(connection,
+                     "SELECT sql FROM sqlite_master WHERE name GLOB ? ORDER BY name", context);
+    select.bind_next(table + "*");
     while (select.step()) statements.push_back(select.column_text(0));
   }
   connection.close();
   return statements;
+}
+
+std::vector<std::string> table_regrasps_sql(const std::string& path) {
+  return declared_sql(path, "table_regrasps");
+}
+
+std::vector<std::string> regrasp_edges_sql(const std::string& path) {
+  return declared_sql(path, "regrasp_edges");
+}
+
+// The meta table's digest.* rows, key -> value.
+std::map<std::string, std::string> stored_digests(const std::string& path) {
+  const ErrorContext context{"(meta)", "a readable meta table", ""};
+  Connection connection(path, SQLITE_OPEN_READONLY, path);
+  std::map<std::string, std::string> digests;
+  {
+    Statement select(connection, "SELECT key, value FROM meta WHERE key GLOB 'digest.*'", context);
+    while (select.step()) digests[select.column_text(0)] = select.column_text(1);
+  }
+  connection.close();
+  return digests;
 }
 
 std::vector<std::string> files_in(const std::string& dir) {
@@ -437,14 +459,17 @@ std::string write_v3(const std::string& dir) {
   return path;
 }
 
-// One roadmap without nodes or edges and a human_handover regrasp node at the goal of kV3Rows
-// (the one solution (0.5, 1.0), as in the kV3Rows blobs), as rows of the version 4 tables; the
-// version set to 4.
+// One roadmap without nodes or edges, a human_handover regrasp node at the goal of kV3Rows (the
+// one solution (0.5, 1.0), as in the kV3Rows blobs) and a connected transit edge from that node to
+// itself via the roadmap, its path the solution twice, as rows of the version 4 tables (the edge
+// has no duration before version 9); the version set to 4.
 const char* const kV4Rows = R"sql(
 UPDATE meta SET value = '4' WHERE key = 'schema_version';
 INSERT INTO roadmaps VALUES (1, 'left', 6, 0.0625, 0, 0, x'', x'', x'', x'', x'', x'');
 INSERT INTO regrasp_nodes VALUES (1, 1, 'human_handover', 'left', 'gripper', 1, NULL, 1,
   0.25, 0.5, 1.0, 1.0, 0.0, 0.0, 0.0, 2, 1, x'000000000000e03f000000000000f03f');
+INSERT INTO regrasp_edges VALUES (1, 1, 'transit', 'left', 1, 1, NULL, 1, 0.375, 3, 'roadmap',
+  2, 2, x'000000000000e03f000000000000f03f000000000000e03f000000000000f03f');
 )sql";
 
 // A version 4 file made by hand: kV1Rows, kV3Rows and kV4Rows.
@@ -498,12 +523,14 @@ std::string write_v6(const std::string& dir) {
 // the version 5 record of write_v5 when `with_direct_grasp_records` (which needs the version 3
 // ones), and with the version 6 record of write_v6 when `with_table_regrasp_records` (likewise),
 // taken again by `table_regrasp_repick_arm` (the arm that set it down, as a migrated version 6 row
-// says, unless told otherwise).
+// says, unless told otherwise). The regrasp edge of write_v4 takes `regrasp_edge_duration` (0, not
+// estimated, as in a file migrated from version 8 or earlier, unless told otherwise).
 void write_reference_content(const std::string& path, bool with_comfort_map,
                              bool with_handover_records = false, bool with_roadmap_records = false,
                              bool with_direct_grasp_records = false,
                              bool with_table_regrasp_records = false,
-                             const std::string& table_regrasp_repick_arm = "left") {
+                             const std::string& table_regrasp_repick_arm = "left",
+                             double regrasp_edge_duration = 0.0) {
   Meta meta;
   meta.hila_version = "0.1.0";
   meta.product_name = "cabinet";
@@ -635,6 +662,19 @@ void write_reference_content(const std::string& path, bool with_comfort_map,
     node.board.translation() = Eigen::Vector3d(0.25, 0.5, 1.0);
     node.solutions = {Eigen::Vector2d(0.5, 1.0)};
     writer.add_regrasp_nodes({node});
+    RegraspEdgeRecord edge;
+    edge.part_id = id;
+    edge.kind = "transit";
+    edge.arm = "left";
+    edge.from_node = 1;
+    edge.to_node = 1;
+    edge.connected = true;
+    edge.cost = 0.375;
+    edge.path_nodes = 3;
+    edge.via = "roadmap";
+    edge.path = {Eigen::Vector2d(0.5, 1.0), Eigen::Vector2d(0.5, 1.0)};
+    edge.duration = regrasp_edge_duration;
+    writer.add_regrasp_edges({edge});
   }
   if (with_direct_grasp_records) {
     DirectGraspRecord direct;
@@ -722,11 +762,13 @@ Database open_migrated(const std::string& path) {
 }
 
 // After rows were added by SQL, the per-table digests of the file as it now is, written the only
-// way outside the writer, by a migration: set back to version 7, a step to 8 that changes no table
-// (the real one would create suction_deliveries again), after which the migration writes them.
-void reseal(const std::string& path) {
-  execute_script(path, "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
-  migrate_with_steps(path, {{7, "DELETE FROM meta WHERE key GLOB 'digest.*';"}}, 8);
+// way outside the writer, by a migration: set back to version `version` - 1, a step to `version`
+// that changes no table (the real one would add regrasp_edges.duration again), after which the
+// migration writes them, for the tables of `version`.
+void reseal(const std::string& path, int version = current_schema_version()) {
+  execute_script(path, "UPDATE meta SET value = '" + std::to_string(version - 1) +
+                           "' WHERE key = 'schema_version'");
+  migrate_with_steps(path, {{version - 1, "DELETE FROM meta WHERE key GLOB 'digest.*';"}}, version);
 }
 
 // A migrated file has the version 6 table, empty.
@@ -750,7 +792,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v1 = content_digest(path);  // an old file still has a digest
 
-  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8
+  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9
 
   // Readable now, but still what hila 0.1.0 built: refused unless any hila version is accepted.
   expect_input_error([&] { Database::open(path); },
@@ -758,7 +800,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                           hila_version() + "), got one built by hila 0.1.0 (an older hila",
                       "rebuild with: hila build product.yaml -o " + path});
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
   EXPECT_EQ(db.meta().product_name, "cabinet");
   EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
@@ -793,16 +835,16 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
        "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_THROW(Database::open(path), DatabaseError);
   const std::string digest_v2 = content_digest(path);
 
-  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8
+  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   expect_v1_records(db);
   ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
@@ -834,15 +876,15 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
        "written by schema version 3 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v3 = content_digest(path);
 
-  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6 -> 7 -> 8
+  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -888,8 +930,8 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(open_migrated(path).roadmaps().size(), 1u);
   // The regrasp edges as a fresh file has them: how each was connected and its path.
   execute_script(path,
-                 "CREATE TEMP TABLE probe AS SELECT via, path_dof, path_waypoints, path "
-                 "FROM regrasp_edges;");
+                 "CREATE TEMP TABLE probe AS SELECT via, path_dof, path_waypoints, path, "
+                 "duration FROM regrasp_edges;");
   expect_input_error(
       [&] {
         execute_script(path,
@@ -924,15 +966,15 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
        "written by schema version 4 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v4 = content_digest(path);
 
-  migrate_in_place(path);  // 4 -> 5 -> 6 -> 7 -> 8
+  migrate_in_place(path);  // 4 -> 5 -> 6 -> 7 -> 8 -> 9
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -948,6 +990,20 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   EXPECT_EQ(db.regrasp_nodes(1)[0].candidate_id, 1);
   ASSERT_EQ(db.regrasp_nodes(1)[0].solutions.size(), 1u);
   EXPECT_EQ(db.regrasp_nodes(1)[0].solutions[0], Eigen::Vector2d(0.5, 1.0));
+  // The regrasp edge is kept, every field, and has the column of version 9: 0, not estimated.
+  const auto edges = db.regrasp_edges(1);
+  ASSERT_EQ(edges.size(), 1u);
+  EXPECT_EQ(edges[0].id, 1);
+  EXPECT_EQ(edges[0].kind, "transit");
+  EXPECT_EQ(edges[0].from_node, 1);
+  EXPECT_EQ(edges[0].filter_id, 0);
+  EXPECT_TRUE(edges[0].connected);
+  EXPECT_EQ(edges[0].cost, 0.375);
+  EXPECT_EQ(edges[0].path_nodes, 3);
+  EXPECT_EQ(edges[0].via, "roadmap");
+  ASSERT_EQ(edges[0].path.size(), 2u);
+  EXPECT_EQ(edges[0].path[1], Eigen::Vector2d(0.5, 1.0));
+  EXPECT_EQ(edges[0].duration, 0.0) << "the 8 -> 9 step: not estimated";
   // The version 5, 6 and 8 tables exist, empty.
   expect_no_direct_grasps(db);
   expect_no_table_regrasps(db);
@@ -959,6 +1015,13 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   write_reference_content(fresh, true, true, true);
   EXPECT_EQ(content_digest(path), content_digest(fresh));
   EXPECT_NE(content_digest(path), digest_v4);
+  // With the edge's duration estimated the content differs: the comparison sees the column.
+  const std::string estimated = dir + "/estimated.db";
+  write_reference_content(estimated, true, true, true, false, false, "left", 1.5);
+  EXPECT_NE(content_digest(path), content_digest(estimated));
+  // regrasp_edges (and its index) declared as a fresh file declares them, nothing left over.
+  EXPECT_EQ(regrasp_edges_sql(path), regrasp_edges_sql(fresh));
+  EXPECT_EQ(regrasp_edges_sql(path).size(), 2u);
 
   // The migrated file takes direct grasps like a fresh one (the table and its foreign keys are
   // there): a row by SQL, read back, then one of a candidate that does not exist.
@@ -1007,15 +1070,15 @@ TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
        "written by schema version 5 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v5 = content_digest(path);
 
-  migrate_in_place(path);  // 5 -> 6 -> 7 -> 8
+  migrate_in_place(path);  // 5 -> 6 -> 7 -> 8 -> 9
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -1132,15 +1195,15 @@ TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 8), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
        "written by schema version 6 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v6 = content_digest(path);
 
-  migrate_in_place(path);  // 6 -> 7 -> 8
+  migrate_in_place(path);  // 6 -> 7 -> 8 -> 9
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -1223,9 +1286,9 @@ TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
 
 TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
   // A version 7 file as this hila's writer would have made it: no suction_deliveries table, no
-  // table_regrasps.repick_arm, and a stored digest for every table. The step adds the table and
-  // the column (each row's its arm), the migration the digests of all of them, the new one
-  // included.
+  // table_regrasps.repick_arm, no regrasp_edges.duration, and a stored digest for every table. The
+  // 7 -> 8 step adds the table and the column (each row's its arm), the 8 -> 9 step the duration
+  // (0), the migration the digests of all of them, the new one included.
   const std::string dir = temp_dir("db_migration_v7");
   Sample sample = make_sample();
   sample.parts[0].suction_deliveries.clear();  // a version 7 file cannot hold any
@@ -1234,9 +1297,12 @@ TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
   execute_script(path,
                  "DROP TABLE suction_deliveries;"
                  "DELETE FROM meta WHERE key = 'digest.suction_deliveries';"
-                 "ALTER TABLE table_regrasps DROP COLUMN repick_arm;"
-                 "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
-  // What this hila writes for the same records: every regrasp taken again by its own arm.
+                 "ALTER TABLE table_regrasps DROP COLUMN repick_arm;" +
+                     regrasp_edges_before_v9_sql() +
+                     "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
+  // What this hila writes for the same records: every regrasp taken again by its own arm, no
+  // edge's duration estimated.
+  clear_durations(sample);
   std::size_t relays = 0;
   for (auto& r : sample.parts[0].table_regrasps) {
     relays += r.repick_arm != r.arm ? 1 : 0;
@@ -1250,11 +1316,12 @@ TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v7 = content_digest(path);
 
-  migrate_in_place(path);  // 7 -> 8
+  migrate_in_place(path);  // 7 -> 8 -> 9
 
   // Built by this hila: opens with the default options, every stored digest checked.
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
+  for (const auto& e : db.regrasp_edges(1)) EXPECT_EQ(e.duration, 0.0) << e.id;
   for (const auto& c : db.handover_candidates(1)) {
     EXPECT_TRUE(db.suction_deliveries(c.id).empty()) << c.id;
   }
@@ -1294,6 +1361,111 @@ TEST(Migration, Version7FileThatAlreadyHasTheNewTableFailsCleanly) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
+TEST(Migration, Version8FileIsUpgradedWithItsDurationsNotEstimated) {
+  // A version 8 file as this hila's writer would have made it: regrasp_edges without duration
+  // (version 4's table) and a stored digest for every table, of that content. The 8 -> 9 step
+  // gives every edge the column, 0 (not estimated), the migration the digests.
+  const std::string dir = temp_dir("db_migration_v8");
+  Sample sample = make_sample();
+  const std::string path = dir + "/v8.db";
+  write_sample(path, sample);  // its estimated durations go with the column
+  execute_script(path, regrasp_edges_before_v9_sql());
+  reseal(path, 8);  // the digests a version 8 writer stored for this content
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
+       "written by schema version 8 (an older hila); rebuild with: hila build "
+       "meshes/cabinet/product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  ASSERT_EQ(regrasp_edges_sql(path).size(), 2u);
+  EXPECT_EQ(regrasp_edges_sql(path)[0].find("duration"), std::string::npos)
+      << regrasp_edges_sql(path)[0];
+  const std::string digest_v8 = content_digest(path);
+  const auto digests_v8 = stored_digests(path);
+  // What this hila writes for the same records: no edge's duration estimated.
+  std::size_t estimated = 0;
+  for (const auto& p : sample.parts) {
+    for (const auto& e : p.regrasp_edges) estimated += e.duration > 0.0 ? 1 : 0;
+  }
+  ASSERT_GT(estimated, 0u) << "the sample has durations, so the migration must not keep them";
+  clear_durations(sample);
+  const std::string written = dir + "/written.db";
+  write_sample(written, sample);
+
+  migrate_in_place(path);  // 8 -> 9
+
+  // Built by this hila: opens with the default options, every stored digest checked.
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 9);
+  std::size_t edges = 0;
+  for (std::size_t k = 0; k < sample.parts.size(); ++k) {
+    const auto got = db.regrasp_edges(static_cast<std::int64_t>(k + 1));
+    const auto& want = sample.parts[k].regrasp_edges;
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      SCOPED_TRACE(want[i].id);
+      ++edges;
+      EXPECT_EQ(got[i].duration, 0.0) << "the step: not estimated";
+      EXPECT_EQ(got[i].id, want[i].id) << "the rest of the row is kept";
+      EXPECT_EQ(got[i].kind, want[i].kind);
+      EXPECT_EQ(got[i].filter_id, want[i].filter_id);
+      EXPECT_EQ(got[i].cost, want[i].cost);
+      EXPECT_EQ(got[i].via, want[i].via);
+      EXPECT_EQ(got[i].path, want[i].path);
+    }
+  }
+  EXPECT_EQ(edges, 8u);
+  EXPECT_EQ(content_digest(path), content_digest(written));
+  EXPECT_NE(content_digest(path), digest_v8);
+  // The stored digests are the writer's; against the version 8 file's, only regrasp_edges' (its
+  // column) and meta's (schema_version) changed.
+  const auto digests = stored_digests(path);
+  EXPECT_EQ(digests, stored_digests(written));
+  ASSERT_EQ(digests.size(), digests_v8.size());
+  for (const auto& [key, digest] : digests) {
+    if (key == "digest.regrasp_edges" || key == "digest.meta") {
+      EXPECT_NE(digest, digests_v8.at(key)) << key;
+    } else {
+      EXPECT_EQ(digest, digests_v8.at(key)) << key;
+    }
+  }
+  // The table (and its index) declared as a fresh file declares them, nothing left over.
+  EXPECT_EQ(regrasp_edges_sql(path), regrasp_edges_sql(written));
+  EXPECT_EQ(regrasp_edges_sql(path).size(), 2u);
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"v8.db", "written.db"}));
+
+  // The migrated table takes an estimated duration like a fresh one, and its CHECKs refuse one
+  // without a path (edge 4 is not connected).
+  execute_script(path, "UPDATE regrasp_edges SET duration = 2.5 WHERE id = 1");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": regrasp_edges: expected the content digest stored when it was "
+                             "written"});
+  reseal(path);
+  EXPECT_EQ(Database::open(path).regrasp_edges(1)[0].duration, 2.5);
+  expect_input_error(
+      [&] { execute_script(path, "UPDATE regrasp_edges SET duration = 2.5 WHERE id = 4"); },
+      {"CHECK constraint failed"});
+
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after) << "migrating a current file is a no-op";
+}
+
+TEST(Migration, Version8FileThatAlreadyHasTheNewColumnFailsCleanly) {
+  // Version 9 content with the version number set back: the 8 -> 9 step's ADD COLUMN fails and
+  // the file is left as it was (its estimated durations are not replaced by 0).
+  const std::string dir = temp_dir("db_migration_v8_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '8' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 8 -> 9", "duplicate column name: duration"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
+}
+
 TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
   // A hand-made version 2 file that already has the key: the step does not overwrite it.
   const std::string dir = temp_dir("db_migration_v2_bodies");
@@ -1326,7 +1498,7 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
 
   // Made from the sample, which this hila wrote: it opens with the default options.
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -1348,11 +1520,12 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 8 -> 9 needs the table step 0 -> 1 creates and the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
-  // 4 -> 5, 5 -> 6 and 7 -> 8 create; listed first to prove ordering.
+  // Step 9 -> 10 needs the table step 0 -> 1 creates, the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
+  // 4 -> 5, 5 -> 6 and 7 -> 8 create and the column 8 -> 9 adds; listed first to prove ordering.
   std::vector<MigrationStep> steps = {
-      {8,
-       "INSERT INTO notes (text) VALUES ('from step 8');"
+      {9,
+       "INSERT INTO notes (text) VALUES ('from step 9');"
+       "INSERT INTO notes (text) SELECT duration FROM regrasp_edges;"
        "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
        "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
        "INSERT INTO notes (text) SELECT arm FROM roadmaps;"
@@ -1360,6 +1533,7 @@ TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
        "INSERT INTO notes (text) SELECT arm FROM table_regrasps;"
        "INSERT INTO notes (text) SELECT arm FROM suction_deliveries;"}};
   steps.push_back(migration_steps().at(1));
+  steps.push_back(migration_steps().at(7));
   steps.push_back(migration_steps().at(6));
   steps.push_back(migration_steps().at(5));
   steps.push_back(migration_steps().at(4));
@@ -1369,13 +1543,13 @@ TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 9));
-  migrate_with_steps(path, steps, 9);
-  // The file is now version 9: this hila (8) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 9"});
-  // Migrating to 9 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 10));
+  migrate_with_steps(path, steps, 10);
+  // The file is now version 10: this hila (9) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 10"});
+  // Migrating to 10 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 9);
+  migrate_with_steps(path, steps, 10);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -1419,6 +1593,12 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
                    migration_steps().at(3), migration_steps().at(4), migration_steps().at(5)},
                   1, 8))
       << "1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 does not reach 8";
+  EXPECT_FALSE(can_migrate(
+      {migration_steps().at(0), migration_steps().at(1), migration_steps().at(2),
+       migration_steps().at(3), migration_steps().at(4), migration_steps().at(5),
+       migration_steps().at(6)},
+      1, 9))
+      << "1 -> 2 -> ... -> 8 does not reach 9";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },
@@ -1463,9 +1643,9 @@ TEST(Migration, NewerDatabaseIsRefused) {
   const std::string dir = temp_dir("db_migration_newer");
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
-  execute_script(path, "UPDATE meta SET value = '9' WHERE key = 'schema_version'");
+  execute_script(path, "UPDATE meta SET value = '10' WHERE key = 'schema_version'");
   expect_input_error([&] { migrate_in_place(path); },
-                     {path, "written by schema version 9 (a newer hila)", "upgrade hila"});
+                     {path, "written by schema version 10 (a newer hila)", "upgrade hila"});
 }
 
 TEST(Migration, ForeignFilesAreRefused) {

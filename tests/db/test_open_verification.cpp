@@ -323,6 +323,32 @@ TEST(OpenVerification, RelayUndoneByHand) {
                       rebuild(path)});
 }
 
+TEST(OpenVerification, DurationEditedByHand) {
+  // An edge's estimated duration changed to another valid time (or to 0, not estimated): a row
+  // every other check accepts; only regrasp_edges' digest sees it.
+  const std::string path = write_small(temp_dir("db_verify_duration"));
+  const std::string pristine = read_file(path);
+  ASSERT_EQ(query_int(path, "SELECT count(*) FROM regrasp_edges WHERE duration > 0"), 4);
+  for (const std::string sql : {"UPDATE regrasp_edges SET duration = 6.0 WHERE id = 1",
+                                "UPDATE regrasp_edges SET duration = 0 WHERE id = 2",
+                                "UPDATE regrasp_edges SET duration = 1.5 WHERE id = 3"}) {
+    SCOPED_TRACE(sql);
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
+    edit(path, sql);
+    expect_input_error([&] { Database::open(path); },
+                       {path + ": regrasp_edges: expected the content digest stored when it was "
+                               "written (meta.digest.regrasp_edges = ",
+                        rebuild(path)});
+  }
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
+  flip_real(path, "regrasp_edges", "duration", 1);
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": regrasp_edges: expected the content digest stored when it was "
+                             "written (meta.digest.regrasp_edges = "});
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
+  EXPECT_NO_THROW(Database::open(path));
+}
+
 TEST(OpenVerification, RoadmapEdgeDeleted) {
   // The last of the left arm's 13 roadmap edges cut from its arrays (8 bytes each), the count
   // lowered to match, and that edge's bit (bit 4 of byte 1) cleared in every filter of the
@@ -474,7 +500,7 @@ TEST(OpenVerification, WrongStorageClassesAndColumns) {
           {path + ": meta.value (key 'product_name'): expected a TEXT (the column is TEXT NOT "
                   "NULL), got a BLOB of 1 byte"});
   refused("ALTER TABLE robot_grasps ADD COLUMN note TEXT",
-          {path + ": robot_grasps: expected the 26 columns of schema version 8, got 27 columns "
+          {path + ": robot_grasps: expected the 26 columns of schema version 9, got 27 columns "
                   "(column 27 is 'note', expected none)"});
 }
 
@@ -602,17 +628,20 @@ TEST(OpenVerification, Version6FileIsMigratedWithItsDigests) {
   write_sample(path, sample);  // its relays lose their repick arm with the column
   edit(path,
        "DROP TABLE suction_deliveries;"
-       "ALTER TABLE table_regrasps DROP COLUMN repick_arm;"
-       "DELETE FROM meta WHERE key GLOB 'digest.*';"
-       "UPDATE meta SET value = '6' WHERE key = 'schema_version'");
-  // This hila's writer for the same records: a version 6 regrasp is taken again by its own arm.
+       "ALTER TABLE table_regrasps DROP COLUMN repick_arm;" +
+           regrasp_edges_before_v9_sql() +
+           "DELETE FROM meta WHERE key GLOB 'digest.*';"
+           "UPDATE meta SET value = '6' WHERE key = 'schema_version'");
+  // This hila's writer for the same records: a version 6 regrasp is taken again by its own arm,
+  // and no edge's duration is estimated.
   for (auto& r : sample.parts[0].table_regrasps) r.repick_arm = r.arm;
+  clear_durations(sample);
   const std::string written = dir + "/written.db";
   write_sample(written, sample);
   expect_input_error([&] { Database::open(path); },
                      {path +
                       ": meta.schema_version: expected a database this hila reads (schema "
-                      "version 8), got one written by schema version 6 (an older hila); " +
+                      "version 9), got one written by schema version 6 (an older hila); " +
                       rebuild(path) + " (or migrate it in place with hila::db::migrate_in_place)"});
   migrate_in_place(path);
   EXPECT_NO_THROW(Database::open(path)) << "built by this hila: opens with the default options";

@@ -104,6 +104,7 @@ void expect_same(const RegraspEdgeRecord& got, const RegraspEdgeRecord& want) {
   EXPECT_EQ(got.cost, want.cost);
   EXPECT_EQ(got.path_nodes, want.path_nodes);
   EXPECT_EQ(got.via, want.via);
+  expect_same_value(got.duration, want.duration);
   ASSERT_EQ(got.path.size(), want.path.size());
   for (std::size_t i = 0; i < want.path.size(); ++i) {
     SCOPED_TRACE("waypoint " + std::to_string(i));
@@ -191,7 +192,7 @@ class RoadmapRoundTrip : public ::testing::Test {
 };
 
 TEST_F(RoadmapRoundTrip, SchemaVersion) {
-  EXPECT_EQ(Database::open(path_).meta().schema_version, 8);
+  EXPECT_EQ(Database::open(path_).meta().schema_version, 9);
 }
 
 TEST_F(RoadmapRoundTrip, RoadmapsBitForBitInIdOrder) {
@@ -318,6 +319,53 @@ TEST_F(RoadmapRoundTrip, RegraspEdgePathsAndHowTheyWereConnected) {
   EXPECT_TRUE(other[0].path.empty());
   ASSERT_EQ(other[1].path.size(), 5u);
   EXPECT_EQ(other[1].path[2][1], 1e300);
+}
+
+TEST_F(RoadmapRoundTrip, RegraspEdgeDurationsBitForBit) {
+  // Schema version 9: each edge's estimated time along its path, as written.
+  const Database db = Database::open(path_);
+  const auto edges = db.regrasp_edges(ids_[0]);
+  ASSERT_EQ(edges.size(), 6u);
+  EXPECT_EQ(edges[0].duration, 6.125);
+  EXPECT_EQ(edges[1].duration, 0.1) << "not exactly representable, read back bit for bit";
+  EXPECT_EQ(edges[2].duration, 0.0) << "a path whose time was not estimated";
+  EXPECT_FALSE(edges[2].path.empty());
+  EXPECT_EQ(edges[3].duration, 0.0) << "not connected: no path";
+  EXPECT_EQ(edges[4].duration, 0.0) << "a handover: no path";
+  EXPECT_EQ(edges[5].duration, 1e300);
+  const auto other = db.regrasp_edges(ids_[1]);
+  ASSERT_EQ(other.size(), 2u);
+  EXPECT_EQ(other[0].duration, 0.0);
+  EXPECT_EQ(other[1].duration, std::numeric_limits<double>::denorm_min());
+  // Each value in its own column, a REAL.
+  const auto probe = [&](const std::string& count_sql, int expected) {
+    detail::execute_script(
+        path_, "CREATE TEMP TABLE probe (n INTEGER CHECK (n = " + std::to_string(expected) +
+                   ")); INSERT INTO probe " + count_sql);
+  };
+  probe("SELECT count(*) FROM regrasp_edges WHERE typeof(duration) = 'real'", 8);
+  probe("SELECT count(*) FROM regrasp_edges WHERE duration = 6.125 AND id = 1", 1);
+  probe("SELECT count(*) FROM regrasp_edges WHERE duration > 0", 4);
+}
+
+TEST_F(RoadmapRoundTrip, RegraspEdgeDurationChecksInTheFile) {
+  // The file's CHECKs refuse a negative duration and one on an edge without a path, for rows
+  // edited by hand; a path may have 0 (not estimated) or any time.
+  for (const std::string sql : {
+           "UPDATE regrasp_edges SET duration = -1.0 WHERE id = 1",
+           "UPDATE regrasp_edges SET duration = -1e-300 WHERE id = 2",
+           "UPDATE regrasp_edges SET duration = 2.5 WHERE id = 4",  // not connected
+           "UPDATE regrasp_edges SET duration = 1e-300 WHERE id = 5",  // a handover
+           "UPDATE regrasp_edges SET duration = NULL WHERE id = 1",
+       }) {
+    SCOPED_TRACE(sql);
+    expect_input_error([&] { detail::execute_script(path_, sql); },
+                       {std::string(sql.find("NULL") == std::string::npos
+                                        ? "CHECK constraint failed"
+                                        : "NOT NULL constraint failed")});
+  }
+  EXPECT_NO_THROW(detail::execute_script(path_, "UPDATE regrasp_edges SET duration = 0 WHERE id = 1"));
+  EXPECT_NO_THROW(detail::execute_script(path_, "UPDATE regrasp_edges SET duration = 7 WHERE id = 3"));
 }
 
 TEST_F(RoadmapRoundTrip, RegraspEdgePathColumnsInTheFile) {
@@ -789,6 +837,40 @@ TEST(RoadmapWriter, RegraspEdgeMistakesAreRefused) {
       [](RegraspEdgeRecord& e) { e.path.back()[0] = -std::numeric_limits<double>::infinity(); },
       {"regrasp_edges.path[0] (record 0 of 6, part id 1, waypoint 5) must be finite, got -inf"});
 
+  // The estimated duration (schema version 9).
+  refused("negative duration", 0, [](RegraspEdgeRecord& e) { e.duration = -0.5; },
+          {"DatabaseWriter::add_regrasp_edges: regrasp_edges.duration (record 0 of 6, part id 1): "
+           "RegraspEdgeRecord::duration is -0.5, expected a time in seconds >= 0"});
+  refused("the least negative duration", 1,
+          [](RegraspEdgeRecord& e) { e.duration = -std::numeric_limits<double>::denorm_min(); },
+          {"regrasp_edges.duration (record 1 of 6, part id 1): RegraspEdgeRecord::duration is "
+           "-4.9406564584124654e-324, expected a time in seconds >= 0"});
+  refused("NaN duration", 2, [](RegraspEdgeRecord& e) { e.duration = std::nan(""); },
+          {"DatabaseWriter::add_regrasp_edges: regrasp_edges.duration (record 2 of 6, part id 1) "
+           "must be finite, got nan"});
+  refused("infinite duration", 5,
+          [](RegraspEdgeRecord& e) { e.duration = std::numeric_limits<double>::infinity(); },
+          {"regrasp_edges.duration (record 5 of 6, part id 1) must be finite, got inf"});
+  refused("duration without a path (not connected)", 3,
+          [](RegraspEdgeRecord& e) { e.duration = 2.5; },
+          {"DatabaseWriter::add_regrasp_edges: regrasp_edges.duration (record 3 of 6, part id 1): "
+           "RegraspEdgeRecord::duration is 2.5 for an edge without a path, expected 0"});
+  refused("duration on a handover", 4, [](RegraspEdgeRecord& e) { e.duration = 1e-300; },
+          {"regrasp_edges.duration (record 4 of 6, part id 1): RegraspEdgeRecord::duration is "
+           "1e-300 for an edge without a path, expected 0"});
+  // Refused before anything is written: an earlier edge that would fail its foreign key on
+  // insertion is not reached.
+  expect_refused(dir, "duration after an unknown node",
+                 [](DatabaseWriter& w, const Sample& s) {
+                   w.add_roadmap_filters(s.parts[0].roadmap_filters);
+                   w.add_regrasp_nodes(s.parts[0].regrasp_nodes);
+                   auto edges = s.parts[0].regrasp_edges;
+                   edges[0].to_node = 99;
+                   edges[4].duration = 1.0;
+                   w.add_regrasp_edges(edges);
+                 },
+                 {"regrasp_edges.duration (record 4 of 6, part id 1)"});
+
   expect_database_error(
       dir, "unknown node", write_with(5, [](RegraspEdgeRecord& e) { e.to_node = 8; }),
       {"regrasp_edges (part id 1, transfer edge 6 -> 8)", "FOREIGN KEY constraint failed"});
@@ -909,6 +991,70 @@ TEST(RoadmapReader, DamagedRowsAreDatabaseErrors) {
           {"regrasp_edges.path_dof (id 2)", "an integer from 1 to 2147483647", "got 0"});
   damaged("joints without waypoints", "UPDATE regrasp_edges SET path_dof = 6 WHERE id = 4",
           {"regrasp_edges.path_dof (id 4)", "expected 0 when path_waypoints is 0", "got 6"});
+  // The duration (schema version 9). +infinity passes the file's CHECK (duration >= 0).
+  damaged("infinite duration", "UPDATE regrasp_edges SET duration = 9e999 WHERE id = 2",
+          {path + ": regrasp_edges.duration (id 2): expected a time in seconds, finite and >= 0, "
+                  "got inf; rebuild with: hila build meshes/cabinet/product.yaml -o " +
+               path});
+  damaged("duration that is not a number",
+          "UPDATE regrasp_edges SET duration = 'slow' WHERE id = 1",
+          {path + ": regrasp_edges.duration (id 1): expected a REAL (the column is REAL NOT "
+                  "NULL), got the TEXT 'slow'"});
+}
+
+TEST(RoadmapReader, BadDurationsPastTheFilesChecksAreDatabaseErrors) {
+  // A negative duration, or one on an edge without a path: the file's CHECKs refuse the edit
+  // (RegraspEdgeDurationChecksInTheFile), but not one made with them ignored, and Database::open's
+  // PRAGMA quick_check does not see it either (SQLite verifies no CHECK constraint on a read-only
+  // connection): the loader refuses the row.
+  const std::string path = temp_dir("db_roadmap_duration_unchecked") + "/p.db";
+  write_sample(path, make_sample());
+  const std::string pristine = read_file(path);
+  const auto damaged = [&](const std::string& name, const std::string& sql,
+                           std::initializer_list<std::string> fragments) {
+    SCOPED_TRACE(name);
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
+    detail::execute_script(path, "PRAGMA ignore_check_constraints = ON;" + sql);
+    expect_input_error([&] { Database::open(path); }, fragments);
+  };
+  damaged("negative duration", "UPDATE regrasp_edges SET duration = -2.5 WHERE id = 3",
+          {path + ": regrasp_edges.duration (id 3): expected a time in seconds, finite and >= 0, "
+                  "got -2.5; rebuild with: hila build meshes/cabinet/product.yaml -o " +
+               path});
+  damaged("the least negative duration",
+          "UPDATE regrasp_edges SET duration = -4.9406564584124654e-324 WHERE id = 1",
+          {path + ": regrasp_edges.duration (id 1): expected a time in seconds, finite and >= 0, "
+                  "got -4.9406564584124654e-324"});
+  damaged("duration without a path", "UPDATE regrasp_edges SET duration = 0.25 WHERE id = 4",
+          {path + ": regrasp_edges.duration (id 4): expected 0 when path_waypoints is 0 (no "
+                  "path), got 0.25; rebuild with: hila build"});
+  damaged("duration on a handover", "UPDATE regrasp_edges SET duration = 3 WHERE id = 5",
+          {"regrasp_edges.duration (id 5): expected 0 when path_waypoints is 0", "got 3"});
+  // A file whose schema lost the CHECKs (edited first, then the value, each in a connection of its
+  // own: a connection keeps the schema it read) is refused the same way.
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
+  detail::execute_script(
+      path,
+      "PRAGMA writable_schema = ON;"
+      "UPDATE sqlite_master SET sql = replace(replace(sql, ' CHECK (duration >= 0)', ''), "
+      "',\n  CHECK (path_waypoints <> 0 OR duration = 0)', '') WHERE name = 'regrasp_edges';"
+      "PRAGMA writable_schema = OFF;");
+  ASSERT_NO_THROW(Database::open(path)) << "the schema edit alone is not seen";
+  detail::execute_script(path, "UPDATE regrasp_edges SET duration = -1 WHERE id = 6");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": regrasp_edges.duration (id 6): expected a time in seconds, "
+                             "finite and >= 0, got -1"});
+}
+
+TEST(RoadmapReader, ACurrentFileWithoutDurationIsRefused) {
+  // A current file whose regrasp_edges lacks the column (a version 8 table with a current version
+  // number, or damaged by hand) cannot open; a version 8 file is migrated instead (test_migration).
+  const std::string path = temp_dir("db_roadmap_no_duration") + "/p.db";
+  write_sample(path, make_sample());
+  detail::execute_script(path, regrasp_edges_before_v9_sql());
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": regrasp_edges: expected a readable hila table",
+                      "no such column: duration", "rebuild with: hila build"});
 }
 
 TEST(RoadmapReader, EmptyTablesOpen) {

@@ -34,9 +34,9 @@ std::vector<std::string> create_statements(const std::string& sql) {
 
 }  // namespace
 
-TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
-  EXPECT_EQ(current_schema_version(), 8);
-  ASSERT_EQ(migration_steps().size(), 7u);
+TEST(Schema, VersionIsNineWithStepsFromOneToEight) {
+  EXPECT_EQ(current_schema_version(), 9);
+  ASSERT_EQ(migration_steps().size(), 8u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
   EXPECT_EQ(migration_steps()[1].from_version, 2);
   EXPECT_EQ(migration_steps()[2].from_version, 3);
@@ -44,6 +44,7 @@ TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
   EXPECT_EQ(migration_steps()[4].from_version, 5);
   EXPECT_EQ(migration_steps()[5].from_version, 6);
   EXPECT_EQ(migration_steps()[6].from_version, 7);
+  EXPECT_EQ(migration_steps()[7].from_version, 8);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 3, current_schema_version()));
@@ -51,6 +52,7 @@ TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
   EXPECT_TRUE(can_migrate(migration_steps(), 5, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 6, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 7, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 8, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
   // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
@@ -68,7 +70,8 @@ TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
   EXPECT_NE(migration_steps()[1].sql.find(
                 "INSERT OR IGNORE INTO meta (key, value) VALUES ('human_bodies', '');"),
             std::string::npos);
-  // 3 -> 4: the roadmap and regrasp-graph tables, as a fresh database has them, and nothing else.
+  // 3 -> 4: the roadmap and regrasp-graph tables, as a fresh database has them (but for version
+  // 9's regrasp_edges.duration), and nothing else.
   const auto created_v4 = create_statements(migration_steps()[2].sql);
   ASSERT_EQ(created_v4.size(), 6u) << "4 tables, 2 indexes";
   for (const std::string table :
@@ -76,8 +79,29 @@ TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
     EXPECT_NE(migration_steps()[2].sql.find("CREATE TABLE " + table + " ("), std::string::npos)
         << table;
   }
+  std::string regrasp_edges_v4;
   for (const auto& statement : created_v4) {
+    if (statement.rfind("CREATE TABLE regrasp_edges (", 0) == 0) {
+      regrasp_edges_v4 = statement;
+      EXPECT_EQ(statement.find("duration"), std::string::npos) << statement;
+      EXPECT_EQ(schema_sql().find(statement), std::string::npos) << "version 9 changed the table";
+      continue;
+    }
     EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  {
+    // Version 9's table is version 4's with the column after path and its CHECK last.
+    std::string with_duration = regrasp_edges_v4;
+    const std::string path = "  path BLOB NOT NULL,\n";
+    const std::string last = "  CHECK ((via = '') = (path_waypoints = 0))\n";
+    ASSERT_NE(with_duration.find(path), std::string::npos);
+    with_duration.insert(with_duration.find(path) + path.size(),
+                         "  duration REAL NOT NULL CHECK (duration >= 0),\n");
+    ASSERT_NE(with_duration.find(last), std::string::npos);
+    with_duration.replace(with_duration.find(last), last.size(),
+                          "  CHECK ((via = '') = (path_waypoints = 0)),\n"
+                          "  CHECK (path_waypoints <> 0 OR duration = 0)\n");
+    EXPECT_NE(schema_sql().find(with_duration), std::string::npos) << with_duration;
   }
   EXPECT_EQ(migration_steps()[2].sql.find("INSERT"), std::string::npos);
   // 4 -> 5: the direct_grasps table and its index, as a fresh database has them, and nothing else.
@@ -149,6 +173,45 @@ TEST(Schema, VersionIsEightWithStepsFromOneToSeven) {
   EXPECT_EQ(step_v8.find("INSERT", copied + 1), std::string::npos) << "one INSERT";
   EXPECT_EQ(step_v8.find("INSERT"), copied);
   EXPECT_EQ(migration_steps()[6].sql.find("digest"), std::string::npos)
+      << "the migration, not the step, writes the digests";
+  // 8 -> 9: regrasp_edges rebuilt with duration (and its index again), as a fresh database has
+  // them, and nothing else: the column added (failing on a table that has it), the old table out
+  // of the way, the new one created, the rows copied, the old table dropped.
+  const std::string& step_v9 = migration_steps()[7].sql;
+  const auto created_v9 = create_statements(step_v9);
+  ASSERT_EQ(created_v9.size(), 2u) << "1 table, 1 index";
+  EXPECT_EQ(created_v9[0].rfind("CREATE TABLE regrasp_edges (", 0), 0u) << created_v9[0];
+  EXPECT_NE(created_v9[0].find("  duration REAL NOT NULL CHECK (duration >= 0),\n"),
+            std::string::npos);
+  EXPECT_EQ(created_v9[1], "CREATE INDEX regrasp_edges_part_id ON regrasp_edges(part_id);");
+  for (const auto& statement : created_v9) {
+    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  const std::size_t added =
+      step_v9.find("ALTER TABLE regrasp_edges ADD COLUMN duration REAL NOT NULL DEFAULT 0.0;");
+  const std::size_t moved_v9 = step_v9.find("ALTER TABLE regrasp_edges RENAME TO regrasp_edges_v8;");
+  const std::size_t copied_v9 = step_v9.find("INSERT INTO regrasp_edges (");
+  const std::size_t dropped_v9 = step_v9.find("DROP TABLE regrasp_edges_v8;");
+  ASSERT_NE(added, std::string::npos) << step_v9;
+  ASSERT_NE(moved_v9, std::string::npos) << step_v9;
+  ASSERT_NE(copied_v9, std::string::npos) << step_v9;
+  ASSERT_NE(dropped_v9, std::string::npos) << step_v9;
+  EXPECT_EQ(added, 0u) << "first, so that a table with the column fails before anything moves";
+  EXPECT_LT(added, step_v9.find("DROP INDEX regrasp_edges_part_id;"));
+  EXPECT_LT(step_v9.find("DROP INDEX regrasp_edges_part_id;"), moved_v9);
+  EXPECT_LT(moved_v9, step_v9.find("CREATE TABLE regrasp_edges ("));
+  EXPECT_LT(step_v9.find("CREATE TABLE regrasp_edges ("), copied_v9);
+  EXPECT_LT(copied_v9, dropped_v9);
+  EXPECT_NE(step_v9.find("INSERT INTO regrasp_edges (id, part_id, kind, arm, from_node, to_node, "
+                         "filter_id, connected, cost, path_nodes, via, path_dof, path_waypoints, "
+                         "path, duration)\n  SELECT id, part_id, kind, arm, from_node, to_node, "
+                         "filter_id, connected, cost, path_nodes, via, path_dof, path_waypoints, "
+                         "path, duration FROM regrasp_edges_v8 ORDER BY id;"),
+            std::string::npos)
+      << step_v9;
+  EXPECT_EQ(step_v9.find("INSERT", copied_v9 + 1), std::string::npos) << "one INSERT";
+  EXPECT_EQ(step_v9.find("INSERT"), copied_v9);
+  EXPECT_EQ(step_v9.find("digest"), std::string::npos)
       << "the migration, not the step, writes the digests";
 }
 
@@ -321,9 +384,20 @@ TEST(Schema, RoadmapAndRegraspColumnsAreDeclared) {
            "path BLOB NOT NULL",
            "CHECK ((connected = 1 AND kind IN ('transit', 'transfer')) = (via <> ''))",
            "CHECK ((via = '') = (path_waypoints = 0))",
+           "duration REAL NOT NULL CHECK (duration >= 0)",
+           "CHECK (path_waypoints <> 0 OR duration = 0)",
        }) {
     EXPECT_NE(sql.find(column), std::string::npos) << column;
   }
+  // The column specs the checks at open use: duration last, a REAL, after path, as the writer
+  // and reader name them.
+  const auto& columns = schema_columns("regrasp_edges");
+  ASSERT_EQ(columns.size(), 15u);
+  EXPECT_EQ(columns[13].name, "path");
+  EXPECT_EQ(columns[13].storage_class, SQLITE_BLOB);
+  EXPECT_EQ(columns[14].name, "duration");
+  EXPECT_EQ(columns[14].storage_class, SQLITE_FLOAT);
+  EXPECT_FALSE(columns[14].nullable);
 }
 
 TEST(Schema, DirectGraspColumnsAreDeclared) {

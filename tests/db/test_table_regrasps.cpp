@@ -89,7 +89,7 @@ TEST(TableRegrasps, EveryFieldRoundTripsPerCandidateInIdOrder) {
   const Sample sample = make_sample();
   write_sample(path, sample);
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 8);
+  EXPECT_EQ(db.meta().schema_version, 9);
 
   const auto& written = sample.parts[0].table_regrasps;
   ASSERT_EQ(written.size(), 5u);
@@ -380,8 +380,8 @@ TEST(TableRegrasps, ACurrentFileWithoutTheTableIsRefused) {
 }
 
 TEST(TableRegrasps, ACurrentFileWithoutRepickArmIsRefused) {
-  // A version 8 file whose table lacks the column (a version 7 table with the version number of
-  // 8, or damaged by hand) cannot open; a version 7 file is migrated instead (test_migration).
+  // A current file whose table lacks the column (a version 7 table with a current version
+  // number, or damaged by hand) cannot open; a version 7 file is migrated instead (test_migration).
   const std::string path = temp_dir("db_table_regrasps_no_repick_arm") + "/p.db";
   write_sample(path, make_sample());
   detail::execute_script(path, "ALTER TABLE table_regrasps DROP COLUMN repick_arm");

@@ -10,11 +10,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <string>
 
+#include "hila/db/database.hpp"
+#include "hila/db/migration.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
@@ -29,6 +34,57 @@ CommandRun run(const std::string& args) {
 
 std::string json_part(const std::string& out) {
   return out.substr(out.find('{'));
+}
+
+// `inspect graph`'s stored regrasp-graph edges against the database as hila::db reads it: every
+// connected `regrasp` / `transit` of the JSON's edges has the cost_rad and duration_s (both rounded
+// to 1e-4) of a connected regrasp_edges row of the part, and every "C rad T s VIA" of the text
+// (`text`: `inspect graph` of the same part) the cost, duration and via of one, as the text rounds
+// them. Returns {JSON blocks, text mentions} checked, and counts the JSON durations above 0 into
+// `estimated`.
+std::pair<int, int> expect_stored_durations(const nlohmann::json& graph, const std::string& text,
+                                            const db::Database& database, std::int64_t part_id,
+                                            int& estimated) {
+  const auto rounded = [](double v) { return std::round(v / 1e-4) * 1e-4; };
+  const auto edges = database.regrasp_edges(part_id);
+  std::set<std::string> shown;  // the text's "C rad T s VIA" of every connected edge with a time
+  for (const auto& e : edges) {
+    if (!e.connected || (e.duration == 0.0 && e.cost != 0.0)) continue;  // as the text shows them
+    char buffer[96];
+    std::snprintf(buffer, sizeof(buffer), "%.2f rad %.1f s %s", e.cost, e.duration, e.via.c_str());
+    shown.insert(buffer);
+  }
+  int blocks = 0;
+  for (const auto& edge : graph["edges"]) {
+    for (const char* key : {"regrasp", "transit"}) {
+      const auto& stored = edge[key];
+      if (stored.is_null()) continue;
+      if (!stored["connected"].get<bool>()) {
+        EXPECT_TRUE(stored["duration_s"].is_null()) << edge.dump();
+        continue;
+      }
+      ++blocks;
+      const double cost = stored["cost_rad"].get<double>();
+      const double duration = stored["duration_s"].get<double>();
+      estimated += duration > 0.0 ? 1 : 0;
+      bool found = false;
+      for (const auto& e : edges) {
+        found = found || (e.connected && std::abs(rounded(e.cost) - cost) < 1e-9 &&
+                          std::abs(rounded(e.duration) - duration) < 1e-9);
+      }
+      EXPECT_TRUE(found) << "no regrasp_edges row of part " << part_id << " has " << key << " "
+                         << stored.dump();
+    }
+  }
+  int mentions = 0;
+  const std::regex timed(R"((\d+\.\d\d rad \d+\.\d s (roadmap|bridge)))");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), timed);
+       it != std::sregex_iterator(); ++it) {
+    ++mentions;
+    EXPECT_TRUE(shown.count((*it)[1].str())) << "'" << (*it)[1].str() << "' is no edge of part "
+                                             << part_id << "'s regrasp_edges";
+  }
+  return {blocks, mentions};
 }
 
 }  // namespace
@@ -229,6 +285,16 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
       connected += goal["connected"].get<bool>() ? 1 : 0;
     }
     EXPECT_EQ(graph_summary["goals_connected_offline"], connected) << board;
+    // Each stored edge's cost and estimated time are the database's.
+    const db::Database database = db::Database::open(out);
+    const CommandRun graph_text = run("inspect " + out + " graph --part " + board + " --goals 99");
+    ASSERT_EQ(graph_text.status, 0) << graph_text.out;
+    int estimated = 0;
+    const auto [blocks, mentions] = expect_stored_durations(
+        gr, graph_text.out, database, database.part(board).id, estimated);
+    EXPECT_GT(blocks, 0) << board;
+    EXPECT_GT(mentions, 0) << board << "\n" << graph_text.out;
+    EXPECT_GT(estimated, 0) << board;
   }
   const CommandRun graph_text = run("inspect " + out + " graph --part base --goals 2");
   ASSERT_EQ(graph_text.status, 0) << graph_text.out;
@@ -405,6 +471,78 @@ TEST(Cli, InspectGraphShowsTheRegraspsOnTheTable) {
     EXPECT_NE(text.out.find(way["name"].get<std::string>()), std::string::npos) << text.out;
   }
   EXPECT_GT(regrasp_ways, 0);
+}
+
+// The stored regrasp-graph edges `inspect graph` shows are the database's: each one's joint-space
+// cost and the robot's estimated time along its path (regrasp_edges.duration, schema 9), beside
+// each other in the text ("8.74 rad 6.9 s roadmap") and as cost_rad and duration_s in --json, as
+// hila::db reads them. (The bracket above has no regrasp graph: no cup holds it.) A quick cabinet
+// build, every board's graph.
+TEST(Cli, InspectGraphShowsEachStoredEdgesCostAndEstimatedTime) {
+  const std::string dir = test::temp_dir("cli_graph_durations");
+  const std::string db_path = dir + "/cabinet.hila";
+  const CommandRun built =
+      run("build " + test::product_path() + " --cell " + test::cell_path() +
+          " --seed 3 --comfort-samples 20000 --handover-candidates 60 --roadmap-nodes 300 "
+          "--jobs 2 -o " +
+          db_path);
+  ASSERT_LE(built.status, 1) << built.out;  // a board without a goal is part of the content
+  const db::Database database = db::Database::open(db_path);
+  int boards = 0, blocks = 0, mentions = 0, estimated = 0;
+  for (const auto& part : database.parts()) {
+    SCOPED_TRACE(part.name);
+    const CommandRun graph = run("inspect " + db_path + " graph --part " + part.name + " --json");
+    ASSERT_EQ(graph.status, 0) << graph.out;
+    const CommandRun text = run("inspect " + db_path + " graph --part " + part.name + " --goals 99");
+    ASSERT_EQ(text.status, 0) << text.out;
+    const auto [b, m] = expect_stored_durations(nlohmann::json::parse(json_part(graph.out)), text.out,
+                                                database, part.id, estimated);
+    boards += b > 0 ? 1 : 0;
+    blocks += b;
+    mentions += m;
+  }
+  EXPECT_GE(boards, 5) << "most boards have a stored regrasp graph";
+  EXPECT_GT(mentions, 0);
+  EXPECT_GT(estimated, 0) << "a fresh build estimates the paths' times";
+  EXPECT_LT(estimated, blocks) << "handover edges have no path, so no time";
+
+  // A file migrated from schema 8 (made from this one: regrasp_edges as versions 4 to 8 declared
+  // it, the 3 -> 4 step's text, then migrated), whose durations were never estimated: the text
+  // shows the cost without a time, the JSON 0.
+  const std::string& step_v4 = db::detail::migration_steps().at(2).sql;
+  const std::string to_v8 =
+      "DROP INDEX regrasp_edges_part_id; ALTER TABLE regrasp_edges RENAME TO regrasp_edges_v9;" +
+      step_v4.substr(step_v4.find("CREATE TABLE regrasp_edges (")) +
+      "INSERT INTO regrasp_edges SELECT id, part_id, kind, arm, from_node, to_node, filter_id, "
+      "connected, cost, path_nodes, via, path_dof, path_waypoints, path FROM regrasp_edges_v9;"
+      "DROP TABLE regrasp_edges_v9;"
+      "UPDATE meta SET value = '8' WHERE key = 'schema_version';";
+  sqlite3* handle = nullptr;
+  ASSERT_EQ(sqlite3_open(db_path.c_str(), &handle), SQLITE_OK);
+  char* error = nullptr;
+  EXPECT_EQ(sqlite3_exec(handle, to_v8.c_str(), nullptr, nullptr, &error), SQLITE_OK)
+      << (error ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(handle);
+  EXPECT_EQ(run("inspect " + db_path + " graph --part base").status, 2) << "schema 8: refused";
+  db::migrate_in_place(db_path);
+  const CommandRun old_json = run("inspect " + db_path + " graph --part base --json");
+  ASSERT_EQ(old_json.status, 0) << old_json.out;
+  int not_estimated = 0;
+  const auto old_graph = nlohmann::json::parse(json_part(old_json.out));
+  for (const auto& edge : old_graph["edges"]) {
+    for (const char* key : {"regrasp", "transit"}) {
+      if (edge[key].is_null() || !edge[key]["connected"].get<bool>()) continue;
+      EXPECT_EQ(edge[key]["duration_s"].get<double>(), 0.0) << edge.dump();
+      ++not_estimated;
+    }
+  }
+  EXPECT_GT(not_estimated, 0);
+  const CommandRun old_text = run("inspect " + db_path + " graph --part base --goals 99");
+  ASSERT_EQ(old_text.status, 0) << old_text.out;
+  EXPECT_FALSE(std::regex_search(old_text.out, std::regex(R"(rad \d+\.\d s )"))) << old_text.out;
+  EXPECT_TRUE(std::regex_search(old_text.out, std::regex(R"(\d+\.\d\d rad (roadmap|bridge))")))
+      << old_text.out;
 }
 
 // `inspect digest` answers only for a database the loader opens: one another hila built (its

@@ -46,14 +46,16 @@ nlohmann::json pose_values(const core::Pose& pose) {
 struct Stored {
   int edges = 0;
   bool connected = false;
-  double cost = 0.0;  // rad, joint-space length of that edge's path
-  std::string via;    // how that edge was connected: "roadmap" or "bridge"
+  double cost = 0.0;      // rad, joint-space length of that edge's path
+  double duration = 0.0;  // s, the robot's estimated time along it (0: not estimated)
+  std::string via;        // how that edge was connected: "roadmap" or "bridge"
 
   void add(const db::RegraspEdgeRecord& e) {
     ++edges;
     if (e.connected && !connected) {
       connected = true;
       cost = e.cost;
+      duration = e.duration;
       via = e.via;
     }
   }
@@ -74,15 +76,21 @@ nlohmann::json stored_json(const Stored* s) {
   return {{"edges", s->edges},
           {"connected", s->connected},
           {"cost_rad", s->connected ? nlohmann::json(round_to(s->cost, 1e-4)) : nullptr},
+          {"duration_s", s->connected ? nlohmann::json(round_to(s->duration, 1e-4)) : nullptr},
           {"via", s->via}};
 }
 
-// "not stored", "not connected" or e.g. "5.21 rad roadmap".
+// "not stored", "not connected" or e.g. "5.21 rad 2.4 s roadmap" (the time left out where it was
+// not estimated: a path of some length with duration 0, in a file migrated from schema 8).
 std::string status(const Stored* s) {
   if (s == nullptr) return "not stored";
   if (!s->connected) return "not connected";
   std::ostringstream out;
-  out << std::fixed << std::setprecision(2) << s->cost << " rad " << s->via;
+  out << std::fixed << std::setprecision(2) << s->cost << " rad ";
+  if (s->duration > 0.0 || s->cost == 0.0) {
+    out << std::setprecision(1) << s->duration << " s ";
+  }
+  out << s->via;
   return out.str();
 }
 
@@ -630,7 +638,7 @@ void print_text(const Graph& g, int shown_goals) {
       std::cout << "    exchange " << key.first << " -> " << key.second << ": "
                 << count(grasps.size(), "gripper grasp") << " at "
                 << count(by_rr.size(), "robot-robot pose") << "\n"
-                << "        rr   cup  grasps  " << std::left << std::setw(22)
+                << "        rr   cup  grasps  " << std::left << std::setw(28)
                 << key.first + " pick+transfer" << std::setw(20) << key.second + " way in"
                 << key.second + " transfer to goal" << std::right << "\n";
       for (const auto& [id, shared] : by_rr) {
@@ -668,7 +676,7 @@ void print_text(const Graph& g, int shown_goals) {
           delivered += " (" + count(static_cast<std::size_t>(tried), "grasp") + ")";
         }
         std::cout << "      " << std::setw(4) << id << std::setw(6) << rr.suction_grasp_id
-                  << std::setw(8) << shared.size() << "  " << std::left << std::setw(22) << to_rr
+                  << std::setw(8) << shared.size() << "  " << std::left << std::setw(28) << to_rr
                   << std::setw(20) << way_in << delivered << std::right << "\n";
       }
     }

@@ -130,7 +130,8 @@ class DatabaseWriter {
   // and to_node written regrasp nodes; cost finite and >= 0, path_nodes >= 0, both 0 when not
   // connected, cost 0 for a handover. A connected "transit" or "transfer" edge has via "roadmap"
   // or "bridge" and a path of at least 2 waypoints, all of one size > 0 (finite); an edge that is
-  // not connected and a "handover" edge have via "" and no path. Returns the ids.
+  // not connected and a "handover" edge have via "" and no path. duration finite and >= 0, 0
+  // without a path (schema version 9). Returns the ids.
   std::vector<std::int64_t> add_regrasp_edges(const std::vector<RegraspEdgeRecord>& edges);
   // Stores each table's content digest in meta (digest.<table>, what Database::open compares),
   // then commits as described above.
