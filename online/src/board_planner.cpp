@@ -167,6 +167,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   const auto started = std::chrono::steady_clock::now();
   BoardPlan result;
   result.board = board;
+  result.worker = scene.worker;
   Run* running = nullptr;  // once it is under way
   auto finish = [&](BoardPlanStatus status, std::string reason) {
     if (running != nullptr) {
@@ -230,9 +231,13 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   if (!exchange_within_payload && !suction_within_payload && direct_within_payload.empty()) {
     return finish(BoardPlanStatus::kOverPayload, over_payload);
   }
-  // At the stance the goals were built for, their stored Q is the scene human's (the same
-  // lookup); elsewhere the comfort maps are looked up again.
-  const bool built_stance = scene.human_stance.isApprox(model_.cell().spec().human_stance, 1e-12);
+  // The worker the scene names (nullptr: the cell's own human, or a body that is the cell's
+  // human). At the stance the goals were built for, the cell human's stored Q is theirs (the
+  // same lookup); elsewhere, or for another body, the comfort maps are looked up again.
+  const core::HumanBody* body =
+      scene.worker != nullptr && !scene.worker->same_as_cell() ? scene.worker.get() : nullptr;
+  const bool built_stance =
+      body == nullptr && scene.human_stance.isApprox(model_.cell().spec().human_stance, 1e-12);
   const WorkerComfort* comfort = nullptr;
   if (!built_stance) {
     std::string error;
@@ -260,7 +265,8 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       r.joints = goal.human_joints;
       r.second_joints = goal.second_joints;
     } else {  // the human arms' IK: no comfort maps needed
-      r = WorkerComfort::goal_reach(model_.cell(), goal, records->human_grasps, scene.human_stance);
+      r = WorkerComfort::goal_reach(model_.cell(), goal, records->human_grasps, scene.human_stance,
+                                    body);
       if (built_stance) r.quality = goal.quality;  // the stored Q is this human's
     }
     if (!r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
@@ -276,7 +282,8 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   for (const auto& goal : records->goals) {
     const double q = built_stance
                          ? goal.quality
-                         : comfort->goal_quality(goal, records->human_grasps, scene.human_stance);
+                         : comfort->goal_quality(goal, records->human_grasps, scene.human_stance,
+                                                 body);
     worker_quality[goal.id] = q;
     if (q >= std::min(settings_.worker_comfort_floor, goal.quality)) {
       goals.push_back(&goal);
@@ -593,6 +600,7 @@ BoardPlan BoardPlanner::plan_after_tool_moved(const Scene& scene, const core::Pa
   BoardPlan result;
   if (!failure.empty()) {
     result.board = part.name;
+    result.worker = scene.worker;
     result.suction_arm = model_.suction_arm(part.name);
     result.status = BoardPlanStatus::kNoGoal;
     result.reason =

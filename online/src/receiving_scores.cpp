@@ -12,16 +12,19 @@ ReceivingScores receiving_scores(const core::Cell& cell, const BoardPlan& plan, 
     if (plan.second_human_joints.size() == 0) return r;
     arms.emplace_back(plan.second_human_arm, plan.second_human_joints);
   }
-  // Both hands hold the board at once: one configuration.
-  const Eigen::VectorXd q = core::human_posture(cell, arms);
+  // Both hands hold the board at once: one configuration, of the worker's body where the plan
+  // was made for one.
+  const Eigen::VectorXd q =
+      plan.worker != nullptr ? plan.worker->posture(arms) : core::human_posture(cell, arms);
+  const core::RobotModel& human = plan.worker != nullptr ? plan.worker->model() : cell.human();
   r.two_hands = arms.size() > 1;
   r.load_kg = load_kg;
   for (const auto& [arm, joints] : arms) {
     HandScores h;
     h.arm = arm;
-    h.rula_inputs = core::rula_inputs_from_posture(cell.human(), q, arm, load_kg, r.two_hands);
+    h.rula_inputs = core::rula_inputs_from_posture(human, q, arm, load_kg, r.two_hands);
     h.rula = core::rula(h.rula_inputs);
-    h.reba_inputs = core::reba_inputs_from_posture(cell.human(), q, arm, load_kg);
+    h.reba_inputs = core::reba_inputs_from_posture(human, q, arm, load_kg);
     h.reba = core::reba(h.reba_inputs);
     r.hands.push_back(std::move(h));
   }

@@ -119,6 +119,15 @@ nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& 
           {"hands", hands}};
 }
 
+// The worker a plan is for: the scene's `worker` (stature and sex) or the cell's own human.
+nlohmann::json worker_json(const std::shared_ptr<const core::HumanBody>& worker,
+                           const core::Cell& cell) {
+  if (worker == nullptr) return {{"from", "cell"}, {"urdf", cell.spec().human_urdf}};
+  return {{"from", "scene"},
+          {"stature", worker->spec().stature},
+          {"sex", worker->spec().sex == core::Sex::Male ? "male" : "female"}};
+}
+
 nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, double load_kg) {
   nlohmann::json attempts = nlohmann::json::array();
   for (const auto& a : plan.attempts) {
@@ -151,6 +160,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
   nlohmann::json j = {{"board", plan.board},
                       {"status", online::to_string(plan.status)},
                       {"reason", plan.reason},
+                      {"worker", worker_json(plan.worker, cell)},
                       {"planning_ms", 1e3 * plan.planning_seconds},
                       {"planning_split_ms",
                        {{"motions", 1e3 * plan.times.motions},
@@ -257,6 +267,7 @@ int run_plan(const PlanOptions& opt) {
                         {"database", opt.database},
                         {"scene", opt.scene},
                         {"product", model->product().name},
+                        {"worker", worker_json(scene.worker, model->cell())},
                         {"boards", nlohmann::json::array()}};
   int failed = 0;
   if (!opt.json) {

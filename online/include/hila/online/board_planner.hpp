@@ -144,6 +144,9 @@ struct BoardPlan {
   std::int64_t pick_grasp_id = 0;
   core::Pose set_down = core::Pose::Identity();
   double theta_c_deg = 90.0;
+  // The worker planned for: the scene's `worker` (Scene::worker), nullptr for the cell's own
+  // human. Its body's arms give human_joints and its model the receiving scores.
+  std::shared_ptr<const core::HumanBody> worker;
   double quality = 0.0;  // the comfort Q of the scene's human at the goal (paper Eq. 4)
   // Stored goals the scene's human reaches only uncomfortably (tried after the comfortable ones)
   // or not at all (never tried), among those checked (BoardPlanSettings::worker_comfort_floor).
