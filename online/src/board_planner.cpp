@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -18,6 +19,7 @@
 #include "hila/core/pose.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/core/ur_ik.hpp"
+#include "hila/online/receiving_scores.hpp"
 #include "plan_run.hpp"
 
 namespace hila::online {
@@ -291,18 +293,64 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       below_comfort.push_back(&goal);
     }
   }
+  // Goals a person would choose first: of the comfortable ones, then of those the worker reaches
+  // only uncomfortably, those whose receiving posture is natural (the part's centre between hip
+  // and shoulder height first: no inverse kinematics for the others).
+  std::set<std::int64_t> natural;
+  if (settings_.natural_posture_first) {
+    std::vector<const db::HandoverCandidateRecord*> first;
+    const Eigen::Vector3d centre = records->part.mass_properties.com;
+    const core::HumanBody* checked_body = body;  // the cell's human: nullptr
+    std::vector<core::Pose> links;
+    const core::RobotModel& human = checked_body ? checked_body->model() : model_.cell().human();
+    human.link_poses(checked_body ? checked_body->neutral() : model_.cell().human_neutral(), links);
+    const auto& arms = checked_body ? checked_body->arms() : model_.cell().human_arms();
+    double hip_z = std::numeric_limits<double>::infinity(), shoulder_z = -hip_z;
+    for (const auto& arm : arms) {
+      const core::Pose base =
+          scene.human_stance * links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
+      hip_z = std::min(hip_z, base.translation().z());
+      shoulder_z = std::max(shoulder_z, (base * arm.chain.first_joint_position()).z());
+    }
+    for (const auto* list : {&goals, &below_comfort}) {
+      for (const auto* goal : *list) {
+        const double z = (goal->board * centre).z();
+        if (z < hip_z || z > shoulder_z) continue;
+        const auto& r = reach(*goal);
+        if (!r.reachable) continue;
+        std::vector<std::pair<std::string, Eigen::VectorXd>> held{{goal->human_arm, r.joints}};
+        if (!goal->second_arm.empty()) held.emplace_back(goal->second_arm, r.second_joints);
+        const PostureCheck check = check_receiving_posture(
+            model_.cell(), checked_body, scene.human_stance, held, goal->board * centre, part->mass);
+        if (!check.natural(settings_.natural_max_rula)) continue;
+        natural.insert(goal->id);
+        first.push_back(goal);
+        if (list == &below_comfort) worker_quality[goal->id] = r.quality;
+      }
+    }
+    result.goals_natural = static_cast<int>(first.size());
+    for (const auto* goal : goals) {
+      if (natural.count(goal->id) == 0) first.push_back(goal);
+    }
+    goals = std::move(first);
+  }
   for (const auto* goal : below_comfort) {
     if (goals.size() >= goal_limit) break;
+    if (natural.count(goal->id) > 0) continue;  // already first
     const auto& r = reach(*goal);
     if (r.reachable) {
       goals.push_back(goal);
       worker_quality[goal->id] = r.quality;
-      ++result.goals_uncomfortable;
     } else {
       best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal->id]);
     }
   }
   goals.resize(std::min(goals.size(), goal_limit));
+  {
+    const std::set<const db::HandoverCandidateRecord*> uncomfortable(below_comfort.begin(),
+                                                                      below_comfort.end());
+    for (const auto* goal : goals) result.goals_uncomfortable += uncomfortable.count(goal) > 0;
+  }
   // Where the scene's human can take none of the goals: says where they stand and how they face.
   auto human_out_of_reach = [&]() {
     const core::Pose& stance = scene.human_stance;
@@ -331,6 +379,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     result.theta_c_deg =
         robot_grasp_id == 0 ? 90.0 : run.robot_grasps().at(robot_grasp_id).theta_c_deg;
     result.quality = worker_quality.at(goal.id);
+    result.natural_posture = natural.count(goal.id) > 0;
     const auto& posture = reach_of.at(goal.id);
     result.human_arm = goal.human_arm;
     result.human_joints = posture.joints;

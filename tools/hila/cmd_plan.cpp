@@ -95,7 +95,8 @@ nlohmann::json hand_scores_json(const online::HandScores& h) {
 // The receiving posture's RULA and REBA (docs/online.md): the board's scores (the worse hand's)
 // and each hand's. Scored here, after planning; a human model the scores cannot read says why.
 nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& plan,
-                               double load_kg) {
+                               double load_kg, const core::Pose& stance,
+                               const Eigen::Vector3d& centre_of_mass) {
   online::ReceivingScores s;
   try {
     s = online::receiving_scores(cell, plan, load_kg);
@@ -105,7 +106,21 @@ nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& 
   if (!s.scored) return {{"error", "no receiving posture"}};
   nlohmann::json hands = nlohmann::json::array();
   for (const auto& h : s.hands) hands.push_back(hand_scores_json(h));
+  // Where the posture puts the worker (BoardPlanSettings::natural_posture_first).
+  std::vector<std::pair<std::string, Eigen::VectorXd>> arms{{plan.human_arm, plan.human_joints}};
+  if (!plan.second_human_arm.empty()) {
+    arms.emplace_back(plan.second_human_arm, plan.second_human_joints);
+  }
+  const online::PostureCheck c = online::check_receiving_posture(
+      cell, plan.worker.get(), stance, arms, plan.human_handover * centre_of_mass, load_kg);
   return {{"load_kg", s.load_kg},
+          {"posture",
+           {{"trunk_flexion_deg", c.trunk_flexion_deg},
+            {"elbow_below_shoulder", c.elbow_below_shoulder},
+            {"part_centre_z", c.part_centre_z},
+            {"hip_z", c.hip_z},
+            {"shoulder_z", c.shoulder_z},
+            {"natural", c.natural(online::BoardPlanSettings{}.natural_max_rula)}}},
           {"two_hands", s.two_hands},
           {"rula",
            {{"grand", s.rula().grand},
@@ -128,7 +143,8 @@ nlohmann::json worker_json(const std::shared_ptr<const core::HumanBody>& worker,
           {"sex", worker->spec().sex == core::Sex::Male ? "male" : "female"}};
 }
 
-nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, double load_kg) {
+nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, double load_kg,
+                         const core::Pose& stance, const Eigen::Vector3d& centre_of_mass) {
   nlohmann::json attempts = nlohmann::json::array();
   for (const auto& a : plan.attempts) {
     attempts.push_back({{"rank", a.rank},
@@ -171,7 +187,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
                       {"attempts", attempts},
                       {"rejected_motions", plan.rejected_motions},
                       {"goals_out_of_reach", plan.goals_out_of_reach},
-                      {"goals_uncomfortable", plan.goals_uncomfortable}};
+                      {"goals_uncomfortable", plan.goals_uncomfortable},
+                      {"goals_natural", plan.goals_natural}};
   if (plan.solved()) {
     // The way: who picks and how, the exchanges (from the cup to the other arm's gripper), who
     // delivers.
@@ -219,7 +236,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
     if (!plan.second_human_arm.empty())
       posture[plan.second_human_arm] = joints(plan.second_human_joints);
     j["human_posture_rad"] = posture;
-    j["ergonomics"] = ergonomics_json(cell, plan, load_kg);
+    j["natural_posture"] = plan.natural_posture;
+    j["ergonomics"] = ergonomics_json(cell, plan, load_kg, stance, centre_of_mass);
     if (plan.mode == online::DeliveryMode::kExchange) {
       j["robot_handover"] = pose_to_json(plan.robot_handover);
     }
@@ -281,7 +299,10 @@ int run_plan(const PlanOptions& opt) {
     // Where the suction arm cannot take the tool where it is, the plan begins with the other arm
     // setting it down where it can (BoardPlan::tool_place).
     const online::BoardPlan plan = planner.plan(scene, board, deadline);
-    out["boards"].push_back(plan_json(plan, model->cell(), model->product().part(board).mass));
+    const online::BoardRecords* records = model->board_records(board);
+    out["boards"].push_back(
+        plan_json(plan, model->cell(), model->product().part(board).mass, scene.human_stance,
+                  records != nullptr ? records->part.mass_properties.com : Eigen::Vector3d::Zero()));
     if (!opt.json) {
       std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;
       if (plan.solved()) {

@@ -55,6 +55,18 @@ struct BoardPlanSettings {
   // human's arm reaches by inverse kinematics, uncomfortably; the rest are never tried. The
   // build's comfort threshold (paper §VI-B).
   double worker_comfort_floor = 0.06;
+  // Goals a person would choose. Among the goals the worker can take, those whose receiving
+  // posture (check_receiving_posture in receiving_scores.hpp: the worker's posture from the
+  // human arms' inverse kinematics, as the plan returns it) has no forward bend, every receiving
+  // elbow below its shoulder, the part's centre of mass between the worker's hip and shoulder
+  // height and a RULA grand score of at most natural_max_rula come first (the comfortable ones,
+  // then the uncomfortable, each in Eq. 8 order); then the others as without it. Eq. 8 ranks by
+  // the arm's manipulability, which a hand above the shoulder can have; ergonomists would not
+  // choose it. false: the comfort tiers and Eq. 8 order only.
+  bool natural_posture_first = true;
+  // RULA grand score a natural receiving posture keeps to: 3 and below is action level 1-2
+  // ("acceptable", or "investigate further" at 3), what the issue asks of every handover.
+  int natural_max_rula = 3;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
@@ -152,6 +164,10 @@ struct BoardPlan {
   // or not at all (never tried), among those checked (BoardPlanSettings::worker_comfort_floor).
   int goals_out_of_reach = 0;
   int goals_uncomfortable = 0;
+  // Goals whose receiving posture is natural (BoardPlanSettings::natural_posture_first), among
+  // those checked, and whether the chosen goal's is.
+  int goals_natural = 0;
+  bool natural_posture = false;
   // The human's receiving posture at the goal: each hand's arm and its joints (rad), from the
   // human arm's inverse kinematics for the scene's stance (the build's own where it stands as
   // built). Empty second arm for a one-hand goal.
