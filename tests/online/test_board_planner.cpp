@@ -2,15 +2,20 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
 
+#include "hila/core/ergonomic_scores.hpp"
+#include "hila/core/human_model.hpp"
+#include "hila/core/kinematic_chain.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/online/board_planner.hpp"
+#include "hila/online/worker_comfort.hpp"
 #include "util/quick_build.hpp"
 #include "util/test_util.hpp"
 
@@ -547,4 +552,88 @@ TEST(BoardPlannerPayload, APartOverThePayloadIsRefusedWithTheSums) {
   EXPECT_EQ(lateral.motions_planned, 0);
   const online::BoardPlan base = planner.plan(scene, "base", in_seconds(30));
   EXPECT_NE(base.status, online::BoardPlanStatus::kOverPayload) << base.reason;
+}
+
+// Goals a person would choose (BoardPlanSettings::natural_posture_first, on by default): the
+// first goal tried is the first in Eq. 8 order whose receiving posture has the trunk upright, the
+// elbows below the shoulders, the part's centre of mass between hip and shoulder height and RULA
+// grand <= 3 — computed here from the anthropometric ratios (hip 0.530 H, shoulder 0.818 H) and
+// the elbow by a chain of its own (torso to the elbow link), not by the planner's check. At the
+// built stance every stored goal is comfortable, and the posture is the build's where it stored
+// one, else the human arm's inverse kinematics (WorkerComfort::goal_reach). Brute force over
+// every stored goal of every board.
+TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
+  const core::Cell& cell = model().cell();
+  const online::BoardPlanSettings settings;
+  ASSERT_TRUE(settings.natural_posture_first);
+  const core::HumanDimensions dims = core::human_dimensions(core::HumanBodySpec{});
+  int reordered = 0, natural_boards = 0;
+  for (const auto& part : model().product().parts) {
+    SCOPED_TRACE(part.name);
+    const online::BoardRecords* records = model().board_records(part.name);
+    ASSERT_NE(records, nullptr);
+    const online::BoardPlan& plan = plan_of(part.name);
+    const core::Pose stance = scene_of(part.name).human_stance;
+    ASSERT_TRUE(stance.isApprox(cell.spec().human_stance, 1e-12));
+    const double hip_z = (stance * Eigen::Vector3d(0, 0, dims.hip_height)).z();
+    const double shoulder_z = (stance * Eigen::Vector3d(0, 0, dims.shoulder_height)).z();
+    std::vector<std::int64_t> natural;
+    for (const auto& goal : records->goals) {
+      const double centre_z = (goal.board * records->part.mass_properties.com).z();
+      if (centre_z < hip_z || centre_z > shoulder_z) continue;
+      online::WorkerComfort::GoalReach r;
+      if (goal.human_joints.size() > 0 && (goal.second_arm.empty() || goal.second_joints.size())) {
+        r.reachable = true;
+        r.joints = goal.human_joints;
+        r.second_joints = goal.second_joints;
+      } else {
+        r = online::WorkerComfort::goal_reach(cell, goal, records->human_grasps, stance);
+      }
+      if (!r.reachable) continue;
+      std::vector<std::pair<std::string, Eigen::VectorXd>> arms{{goal.human_arm, r.joints}};
+      if (!goal.second_arm.empty()) arms.emplace_back(goal.second_arm, r.second_joints);
+      bool elbows_low = true;
+      int rula = 0;
+      const Eigen::VectorXd q = core::human_posture(cell, arms);
+      for (const auto& [side, joints] : arms) {
+        const core::KinematicChain to_elbow(cell.human(), "torso", side + "_elbow_link");
+        ASSERT_EQ(to_elbow.dof(), 4);
+        const double elbow_in_torso = to_elbow.fk(joints.head(4)).translation().z();
+        elbows_low = elbows_low && elbow_in_torso < dims.shoulder_height - dims.hip_height;
+        rula = std::max(rula, core::rula(core::rula_inputs_from_posture(cell.human(), q, side,
+                                                                        part.mass, arms.size() > 1))
+                                  .grand);
+      }
+      const double trunk = q[cell.human().joints()[static_cast<std::size_t>(
+                                                        cell.human().joint_index("torso_flexion"))]
+                                 .variable];
+      if (std::abs(trunk) < 1e-12 && elbows_low && rula <= 3) natural.push_back(goal.id);
+    }
+    EXPECT_EQ(plan.goals_natural, static_cast<int>(natural.size()));
+    ASSERT_FALSE(plan.attempts.empty());
+    if (natural.empty()) {
+      EXPECT_FALSE(plan.natural_posture);
+      continue;
+    }
+    ++natural_boards;
+    EXPECT_EQ(plan.attempts.front().candidate_id, natural.front());
+    // The goals tried go through the natural ones in Eq. 8 order before any other.
+    std::vector<std::int64_t> tried;  // distinct, in the order first tried (a second round
+                                      // with larger bridges starts over)
+    for (const auto& a : plan.attempts) {
+      if (std::find(tried.begin(), tried.end(), a.candidate_id) == tried.end()) {
+        tried.push_back(a.candidate_id);
+      }
+    }
+    for (std::size_t i = 0; i < tried.size() && i < natural.size(); ++i) {
+      EXPECT_EQ(tried[i], natural[i]) << "goal tried " << i;
+    }
+    if (plan.solved()) {
+      EXPECT_EQ(plan.natural_posture, std::find(natural.begin(), natural.end(),
+                                                plan.candidate_id) != natural.end());
+    }
+    reordered += natural.front() != records->goals.front().id ? 1 : 0;
+  }
+  EXPECT_GT(natural_boards, 0);
+  EXPECT_GT(reordered, 0);  // the tiers change a first goal on the cabinet
 }
