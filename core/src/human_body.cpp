@@ -61,10 +61,10 @@ HumanBody::HumanBody(const Cell& cell, const HumanBodySpec& spec, const std::str
     const Pose base_pose = links[static_cast<std::size_t>(*base)];
     const Pose cell_base =
         cell_links[static_cast<std::size_t>(cell.human().link_index(cell_arm.spec.base_link))];
-    same_as_cell_ = same_as_cell_ && std::abs(scale - 1.0) <= 1e-12 &&
-                    (chain.first_joint_position() - cell_arm.chain.first_joint_position()).norm() <=
-                        1e-12 &&
-                    base_pose.isApprox(cell_base, 1e-12);
+    same_as_cell_ =
+        same_as_cell_ && std::abs(scale - 1.0) <= 1e-12 &&
+        (chain.first_joint_position() - cell_arm.chain.first_joint_position()).norm() <= 1e-12 &&
+        base_pose.isApprox(cell_base, 1e-12);
     arms_.push_back(HumanArm{cell_arm.spec, chain});
     base_in_stance_.push_back(base_pose);
     shoulder_.push_back(chain.first_joint_position());
@@ -73,7 +73,9 @@ HumanBody::HumanBody(const Cell& cell, const HumanBodySpec& spec, const std::str
   }
 }
 
-std::string HumanBody::label() const { return human_body_label(spec_); }
+std::string HumanBody::label() const {
+  return human_body_label(spec_);
+}
 
 int HumanBody::arm_index(const std::string& name) const {
   for (std::size_t i = 0; i < arms_.size(); ++i) {

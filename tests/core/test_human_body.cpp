@@ -63,13 +63,18 @@ TEST(HumanBody, APostureHoldsTheArmJointsAndTheRestNeutral) {
   const Eigen::VectorXd q = body.posture({{arm.spec.name, joints}});
   std::vector<core::Pose> links;
   body.model().link_poses(q, links);
-  const core::Pose base = links[static_cast<std::size_t>(body.model().link_index(arm.spec.base_link))];
-  const core::Pose tip = links[static_cast<std::size_t>(body.model().link_index(arm.spec.tip_link))];
+  const core::Pose base =
+      links[static_cast<std::size_t>(body.model().link_index(arm.spec.base_link))];
+  const core::Pose tip =
+      links[static_cast<std::size_t>(body.model().link_index(arm.spec.tip_link))];
   EXPECT_TRUE((base.inverse() * tip).isApprox(arm.chain.fk(joints), 1e-9));
   EXPECT_TRUE(base.isApprox(body.base_in_stance(0), 1e-12));
   const auto& other = body.arms().back().chain.model_variables();
   for (const int v : other) EXPECT_DOUBLE_EQ(q[v], body.neutral()[v]);
   test::expect_input_error([&] { body.posture({{"middle", joints}}); }, {"'middle'", "left"});
-  test::expect_input_error([&] { body.posture({{arm.spec.name, Eigen::VectorXd::Zero(3)}}); },
-                           {"joints", "7 finite values"});
+  test::expect_input_error(
+      [&] {
+        body.posture({{arm.spec.name, Eigen::VectorXd::Zero(3)}});
+      },
+      {"joints", "7 finite values"});
 }
