@@ -282,10 +282,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   std::map<std::int64_t, double> worker_quality;  // by goal id
   double best_out_of_reach = 0.0;
   for (const auto& goal : records->goals) {
-    const double q = built_stance
-                         ? goal.quality
-                         : comfort->goal_quality(goal, records->human_grasps, scene.human_stance,
-                                                 body);
+    const double q =
+        built_stance ? goal.quality
+                     : comfort->goal_quality(goal, records->human_grasps, scene.human_stance, body);
     worker_quality[goal.id] = q;
     if (q >= std::min(settings_.worker_comfort_floor, goal.quality)) {
       goals.push_back(&goal);
@@ -307,8 +306,8 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     const auto& arms = checked_body ? checked_body->arms() : model_.cell().human_arms();
     double hip_z = std::numeric_limits<double>::infinity(), shoulder_z = -hip_z;
     for (const auto& arm : arms) {
-      const core::Pose base =
-          scene.human_stance * links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
+      const core::Pose base = scene.human_stance *
+                              links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
       hip_z = std::min(hip_z, base.translation().z());
       shoulder_z = std::max(shoulder_z, (base * arm.chain.first_joint_position()).z());
     }
@@ -320,8 +319,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
         if (!r.reachable) continue;
         std::vector<std::pair<std::string, Eigen::VectorXd>> held{{goal->human_arm, r.joints}};
         if (!goal->second_arm.empty()) held.emplace_back(goal->second_arm, r.second_joints);
-        const PostureCheck check = check_receiving_posture(
-            model_.cell(), checked_body, scene.human_stance, held, goal->board * centre, part->mass);
+        const PostureCheck check =
+            check_receiving_posture(model_.cell(), checked_body, scene.human_stance, held,
+                                    goal->board * centre, part->mass);
         if (!check.natural(settings_.natural_max_rula)) continue;
         natural.insert(goal->id);
         first.push_back(goal);
@@ -348,7 +348,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   goals.resize(std::min(goals.size(), goal_limit));
   {
     const std::set<const db::HandoverCandidateRecord*> uncomfortable(below_comfort.begin(),
-                                                                      below_comfort.end());
+                                                                     below_comfort.end());
     for (const auto* goal : goals) result.goals_uncomfortable += uncomfortable.count(goal) > 0;
   }
   // Where the scene's human can take none of the goals: says where they stand and how they face.

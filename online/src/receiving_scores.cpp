@@ -74,9 +74,8 @@ PostureCheck check_receiving_posture(
   c.shoulder_z = std::numeric_limits<double>::infinity();
   c.elbow_below_shoulder = true;
   for (const auto& entry : arms) {
-    const auto arm = std::find_if(human_arms.begin(), human_arms.end(), [&](const auto& h) {
-      return h.spec.name == entry.first;
-    });
+    const auto arm = std::find_if(human_arms.begin(), human_arms.end(),
+                                  [&](const auto& h) { return h.spec.name == entry.first; });
     if (arm == human_arms.end()) continue;  // posture_of has refused it already
     const core::Pose base =
         stance * links[static_cast<std::size_t>(human.link_index(arm->spec.base_link))];
@@ -97,7 +96,8 @@ PostureCheck check_receiving_posture(
       if (n.find("elbow") != std::string::npos) elbow_name = n;
     }
     const auto& joint = human.joints()[static_cast<std::size_t>(human.joint_index(elbow_name))];
-    const double elbow = (stance * links[static_cast<std::size_t>(joint.child_link)]).translation().z();
+    const double elbow =
+        (stance * links[static_cast<std::size_t>(joint.child_link)]).translation().z();
     c.elbow_below_shoulder = c.elbow_below_shoulder && elbow < shoulder;
   }
   const ReceivingScores scores = receiving_scores(cell, body, arms, load_kg);

@@ -200,7 +200,8 @@ Scene load_scene(const std::string& path, const core::Cell& cell,
     }
     const core::YamlNode sex = worker->at("sex");
     const std::string sex_name = sex.as_string();
-    if (sex_name != "male" && sex_name != "female") sex.fail("male or female", "'" + sex_name + "'");
+    if (sex_name != "male" && sex_name != "female")
+      sex.fail("male or female", "'" + sex_name + "'");
     body.sex = sex_name == "male" ? core::Sex::Male : core::Sex::Female;
     // The body's arms must be scaled copies of the cell's human arms (core::HumanBody).
     s.worker = std::make_shared<const core::HumanBody>(cell, body, path, "worker");

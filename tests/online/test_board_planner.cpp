@@ -604,9 +604,10 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
                                                                         part.mass, arms.size() > 1))
                                   .grand);
       }
-      const double trunk = q[cell.human().joints()[static_cast<std::size_t>(
-                                                        cell.human().joint_index("torso_flexion"))]
-                                 .variable];
+      const double trunk =
+          q[cell.human()
+                .joints()[static_cast<std::size_t>(cell.human().joint_index("torso_flexion"))]
+                .variable];
       if (std::abs(trunk) < 1e-12 && elbows_low && rula <= 3) natural.push_back(goal.id);
     }
     EXPECT_EQ(plan.goals_natural, static_cast<int>(natural.size()));
@@ -629,8 +630,8 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
       EXPECT_EQ(tried[i], natural[i]) << "goal tried " << i;
     }
     if (plan.solved()) {
-      EXPECT_EQ(plan.natural_posture, std::find(natural.begin(), natural.end(),
-                                                plan.candidate_id) != natural.end());
+      EXPECT_EQ(plan.natural_posture,
+                std::find(natural.begin(), natural.end(), plan.candidate_id) != natural.end());
     }
     reordered += natural.front() != records->goals.front().id ? 1 : 0;
   }

@@ -263,8 +263,8 @@ TEST(ReceivingScores, APostureCheckOfAWorkersBodyFollowsItsForwardKinematics) {
       (low ? below : above) += 1;
       const auto scores = online::receiving_scores(*cell, &body, arms, 0.8);
       EXPECT_EQ(c.rula_grand, scores.rula().grand);
-      const bool expected = low && c.rula_grand <= 3 && centre.z() >= c.hip_z &&
-                            centre.z() <= c.shoulder_z;
+      const bool expected =
+          low && c.rula_grand <= 3 && centre.z() >= c.hip_z && centre.z() <= c.shoulder_z;
       EXPECT_EQ(c.natural(3), expected);
       natural += expected ? 1 : 0;
     }

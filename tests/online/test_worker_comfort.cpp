@@ -269,8 +269,8 @@ TEST_F(WorkerComfortTest, AShortWomanGetsAnotherGoalThanATallManWhereTheFirstIsO
     scene = scene.with_finished(model_->product(), part.name);
     if (b->goals.empty()) continue;
     const auto& first = b->goals.front();
-    const double her_q = model_->worker_comfort()->goal_quality(first, b->human_grasps, stance,
-                                                                woman.get());
+    const double her_q =
+        model_->worker_comfort()->goal_quality(first, b->human_grasps, stance, woman.get());
     const bool her_reach =
         online::WorkerComfort::goal_reach(cell, first, b->human_grasps, stance, woman.get())
             .reachable;
@@ -298,13 +298,14 @@ TEST_F(WorkerComfortTest, AShortWomanGetsAnotherGoalThanATallManWhereTheFirstIsO
             << body.label();
       }
       // The cell human's arm at the same joints does not hold it: the posture is this body's.
-      const core::HumanArm& cell_arm = *std::find_if(
-          cell.human_arms().begin(), cell.human_arms().end(),
-          [&](const core::HumanArm& h) { return h.spec.name == goal.human_arm; });
+      const core::HumanArm& cell_arm =
+          *std::find_if(cell.human_arms().begin(), cell.human_arms().end(),
+                        [&](const core::HumanArm& h) { return h.spec.name == goal.human_arm; });
       std::vector<core::Pose> links;
       cell.human().link_poses(cell.human_neutral(), links);
       const core::Pose cell_at =
-          stance * links[static_cast<std::size_t>(cell.human().link_index(cell_arm.spec.base_link))] *
+          stance *
+          links[static_cast<std::size_t>(cell.human().link_index(cell_arm.spec.base_link))] *
           cell_arm.chain.fk(plan.human_joints);
       EXPECT_GT((cell_at.translation() - hand.translation()).norm(), 0.01) << body.label();
     }

@@ -300,9 +300,9 @@ int run_plan(const PlanOptions& opt) {
     // setting it down where it can (BoardPlan::tool_place).
     const online::BoardPlan plan = planner.plan(scene, board, deadline);
     const online::BoardRecords* records = model->board_records(board);
-    out["boards"].push_back(
-        plan_json(plan, model->cell(), model->product().part(board).mass, scene.human_stance,
-                  records != nullptr ? records->part.mass_properties.com : Eigen::Vector3d::Zero()));
+    out["boards"].push_back(plan_json(
+        plan, model->cell(), model->product().part(board).mass, scene.human_stance,
+        records != nullptr ? records->part.mass_properties.com : Eigen::Vector3d::Zero()));
     if (!opt.json) {
       std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;
       if (plan.solved()) {

@@ -14,8 +14,8 @@
 #include "hila/core/ergonomic_scores.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/mesh_symmetry.hpp"
-#include "hila/core/product.hpp"
 #include "hila/core/pose.hpp"
+#include "hila/core/product.hpp"
 #include "hila/db/database.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/offline/ergonomics.hpp"
@@ -59,11 +59,9 @@ struct PostureScores {
 // scored: the arm's joints on the cell's human at that torso flexion, the rest neutral, holding
 // the part's mass (two hands where the part has no one-hand grasp, or hila's goal is a two-hand
 // one: the one arm's posture stands for both, as in the build). By method.
-std::map<std::string, PostureScores> score_postures(const core::Cell& cell,
-                                                    const offline::HumanComfort& comfort,
-                                                    const db::Database& database,
-                                                    const db::PartRecord& part,
-                                                    const std::vector<Eigen::Matrix3d>& symmetries) {
+std::map<std::string, PostureScores> score_postures(
+    const core::Cell& cell, const offline::HumanComfort& comfort, const db::Database& database,
+    const db::PartRecord& part, const std::vector<Eigen::Matrix3d>& symmetries) {
   std::map<std::string, PostureScores> out;
   const auto grasps = database.human_grasps(part.id);
   offline::ErgonomicsInputs in;
@@ -190,13 +188,13 @@ nlohmann::json ergonomics_json(const db::Database& database, const core::Cell& c
     nlohmann::json row = {{"part", part.name}, {"order", part.assembly_order}};
     std::map<std::string, PostureScores> scores;
     const auto sym = symmetries.find(part.name);
-    row["symmetries"] = sym != symmetries.end() ? nlohmann::json(sym->second.size())
-                                                 : nlohmann::json(nullptr);
+    row["symmetries"] =
+        sym != symmetries.end() ? nlohmann::json(sym->second.size()) : nlohmann::json(nullptr);
     if (comfort) {
       try {
-        scores = score_postures(cell, *comfort, database, part,
-                                sym != symmetries.end() ? sym->second
-                                                        : std::vector<Eigen::Matrix3d>{});
+        scores =
+            score_postures(cell, *comfort, database, part,
+                           sym != symmetries.end() ? sym->second : std::vector<Eigen::Matrix3d>{});
       } catch (const core::InputError& e) {
         no_scores = e.what();
       }

@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/comfort_map.hpp"
 #include "hila/core/human_body.hpp"
 #include "hila/core/human_model.hpp"
 #include "hila/core/pose.hpp"
-#include "hila/core/comfort_map.hpp"
 
 namespace hila::offline {
 
