@@ -32,6 +32,7 @@ struct PlanOptions {
   bool output_given = false;  // -o was on the command line (perhaps as '')
   bool json = false;
   double deadline_s = 30.0;
+  bool eq8_order = false;  // BoardPlanSettings::natural_posture_first off
 };
 
 nlohmann::json pose_to_json(const core::Pose& pose) {
@@ -280,7 +281,9 @@ int run_plan(const PlanOptions& opt) {
     }
     boards.push_back(opt.board);
   }
-  online::BoardPlanner planner(*model);
+  online::BoardPlanSettings settings;
+  settings.natural_posture_first = !opt.eq8_order;
+  online::BoardPlanner planner(*model, settings);
   nlohmann::json out = {{"hila_plan", 1},
                         {"database", opt.database},
                         {"scene", opt.scene},
@@ -351,6 +354,9 @@ void add_plan_command(CLI::App& app, Action& action) {
   CLI::Option* output =
       cmd->add_option("-o,--output", opt->output, "write the plan (JSON, docs/online.md)");
   cmd->add_flag("--json", opt->json, "print the plan as JSON instead of the table");
+  cmd->add_flag("--eq8-order", opt->eq8_order,
+                "try the goals in Eq. 8 order within the comfort tiers only, not the goals with a "
+                "natural receiving posture first");
   cmd->add_option("--deadline", opt->deadline_s, "seconds per board (default 30)")
       ->check(number_in(kMinDeadlineSeconds, kMaxDeadlineSeconds, false, "seconds"));
   cmd->callback([opt, output, &action] {
