@@ -256,9 +256,17 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   // each goal once; a goal they do not reach is never tried.
   std::map<std::int64_t, WorkerComfort::GoalReach> reach_of;
   std::set<std::int64_t> out_of_reach;
-  auto reach = [&](const db::HandoverCandidateRecord& goal) -> const WorkerComfort::GoalReach& {
+  // `count`: a goal found out of reach counts in goals_out_of_reach (the goals to be tried; the
+  // natural posture's check looks at every goal without counting them).
+  auto reach = [&](const db::HandoverCandidateRecord& goal,
+                   bool count = true) -> const WorkerComfort::GoalReach& {
     const auto it = reach_of.find(goal.id);
-    if (it != reach_of.end()) return it->second;
+    if (it != reach_of.end()) {
+      if (count && !it->second.reachable && out_of_reach.insert(goal.id).second) {
+        ++result.goals_out_of_reach;
+      }
+      return it->second;
+    }
     WorkerComfort::GoalReach r;
     if (built_stance && goal.human_joints.size() > 0 &&
         (goal.second_arm.empty() || goal.second_joints.size() > 0)) {
@@ -271,7 +279,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
                                     body);
       if (built_stance) r.quality = goal.quality;  // the stored Q is this human's
     }
-    if (!r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
+    if (count && !r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
     return reach_of.emplace(goal.id, std::move(r)).first->second;
   };
   // The goals in Eq. 8 order that the scene's human can take: first those they take
@@ -315,7 +323,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       for (const auto* goal : *list) {
         const double z = (goal->board * centre).z();
         if (z < hip_z || z > shoulder_z) continue;
-        const auto& r = reach(*goal);
+        const auto& r = reach(*goal, false);
         if (!r.reachable) continue;
         std::vector<std::pair<std::string, Eigen::VectorXd>> held{{goal->human_arm, r.joints}};
         if (!goal->second_arm.empty()) held.emplace_back(goal->second_arm, r.second_joints);

@@ -23,6 +23,16 @@ using namespace hila;
 
 namespace {
 
+// The settings the fixture's cases plan with: the defaults with the goals in Eq. 8 order within
+// the comfort tiers (natural_posture_first off), the order these cases' premises are about (a
+// board going home along its way in, the nearest goal needing a bridge). The natural goals first
+// are tested on their own below.
+online::BoardPlanSettings eq8_order() {
+  online::BoardPlanSettings s;
+  s.natural_posture_first = false;
+  return s;
+}
+
 std::chrono::steady_clock::time_point in_seconds(double s) {
   return std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(s * 1e6));
 }
@@ -211,7 +221,7 @@ class BoardPlanner : public ::testing::Test {
     const std::string path = database();
     model_ = online::PlannerModel::load(path, test::cell_path(), test::product_path());
     nominal_ = std::make_unique<Nominal>();
-    online::BoardPlanner planner(*model_);
+    online::BoardPlanner planner(*model_, eq8_order());
     online::Scene scene = online::load_scene(test::data_path("cabinet/scene.yaml"), model_->cell(),
                                              model_->product());
     for (const auto& part : model_->product().parts) {
@@ -255,7 +265,7 @@ class BoardPlanner : public ::testing::Test {
         return home_via(kv.second).find("stored") == 0;
       });
       if (it != plans().end()) {
-        online::BoardPlanSettings no_way_back;
+        online::BoardPlanSettings no_way_back = eq8_order();
         no_way_back.way_back_spacing = 0.0;
         auto without = online::BoardPlanner(*model_, no_way_back)
                            .plan(scene_of(it->first), it->first, in_seconds(120.0));
@@ -273,7 +283,7 @@ class BoardPlanner : public ::testing::Test {
       const std::string board = "lateral_right";
       online::Scene scene = scene_of(board);
       scene.obstacles.push_back(box_at("crate", plan_of(board).human_handover.translation(), 0.06));
-      auto plan = online::BoardPlanner(*model_).plan(scene, board, in_seconds(120.0));
+      auto plan = online::BoardPlanner(*model_, eq8_order()).plan(scene, board, in_seconds(120.0));
       print_plan(plan);
       blocked_ = Blocked{std::move(scene), std::move(plan)};
     }
@@ -345,10 +355,10 @@ TEST_F(BoardPlanner, MultiWaypointMotionsAreSmoothed) {
 // thread smoothed a step depends on timing; with every smoothing queued
 // (smooth_here_when_behind false) none is done on the planner's thread, whatever the timing.
 TEST_F(BoardPlanner, WhereAStepIsSmoothedAndValidatedDoesNotChangeThePlan) {
-  online::BoardPlanSettings in_order_settings;
+  online::BoardPlanSettings in_order_settings = eq8_order();
   in_order_settings.overlap_validation = false;
   online::BoardPlanner in_order_planner(model(), in_order_settings);
-  online::BoardPlanSettings all_queued_settings;
+  online::BoardPlanSettings all_queued_settings = eq8_order();
   all_queued_settings.smooth_here_when_behind = false;
   online::BoardPlanner all_queued_planner(model(), all_queued_settings);
   double queued_smoothing = 0.0;
@@ -391,7 +401,7 @@ TEST_F(BoardPlanner, EveryChainFailingEscalatesToLargerBridges) {
     if (needs_bridge.empty() && bridged(plan)) needs_bridge = name;
   }
   ASSERT_FALSE(needs_bridge.empty()) << "some board of the cabinet needs a bridge";
-  online::BoardPlanSettings no_bridges;
+  online::BoardPlanSettings no_bridges = eq8_order();
   no_bridges.motion.bridge_checks = 0;
   no_bridges.goals = 1;
   no_bridges.way_back_spacing = 0.0;
@@ -421,7 +431,7 @@ TEST_F(BoardPlanner, ACrateOnTheStoredPathIsPlannedAround) {
       (core::arm_base_in_world(model().cell(), arm) * arm.chain.fk(middle)).translation();
   online::Scene crated = scene_of(board);
   crated.obstacles.push_back(box_at("crate", gripper, 0.08));
-  const auto repaired = online::BoardPlanner(model()).plan(crated, board, in_seconds(120.0));
+  const auto repaired = online::BoardPlanner(model(), eq8_order()).plan(crated, board, in_seconds(120.0));
   print_plan(repaired);
   ASSERT_TRUE(repaired.solved()) << repaired.reason;
   expect_plan_well_formed(model(), crated, repaired);
@@ -459,7 +469,7 @@ TEST_F(BoardPlanner, ReachOfTheHumanPoseIsCheckedBeforeTheExchange) {
   const Blocked& blocked = crate_at_first_goal();
   const online::BoardPlan& fallback = blocked.plan;
   ASSERT_TRUE(fallback.solved()) << fallback.reason;
-  online::BoardPlanSettings exchange_first;
+  online::BoardPlanSettings exchange_first = eq8_order();
   exchange_first.reach_human_pose_first = false;
   const auto late = online::BoardPlanner(model(), exchange_first)
                         .plan(blocked.scene, "lateral_right", in_seconds(120.0));
@@ -488,7 +498,7 @@ TEST_F(BoardPlanner, ReachOfTheHumanPoseIsCheckedBeforeTheExchange) {
 // same attempts, every emitted step passing the stricter validator. (On this database lateral
 // right's first goal is rejected so, 15 times in order, and its second plans.)
 TEST_F(BoardPlanner, ARejectionFoundLateGivesThePlanOfValidatingInOrder) {
-  online::BoardPlanSettings strict;
+  online::BoardPlanSettings strict = eq8_order();
   strict.validator.slip_tolerance_deg = -2.0;
   online::BoardPlanSettings strict_in_order = strict;
   strict_in_order.overlap_validation = false;
@@ -523,7 +533,7 @@ TEST_F(BoardPlanner, AGraspWhoseReceiveFailedAtABoardPoseComesBackLast) {
   online::Scene boxed = scene_of(name);
   boxed.obstacles.push_back(box_at(
       "crate", plan_of(name).robot_handover.translation() + Eigen::Vector3d(0, 0.22, 0), 0.1));
-  const auto plan = online::BoardPlanner(model()).plan(boxed, name, in_seconds(120.0));
+  const auto plan = online::BoardPlanner(model(), eq8_order()).plan(boxed, name, in_seconds(120.0));
   print_plan(plan);
   ASSERT_TRUE(plan.solved()) << plan.reason;
   expect_plan_well_formed(model(), boxed, plan);
@@ -568,11 +578,12 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
   ASSERT_TRUE(settings.natural_posture_first);
   const core::HumanDimensions dims = core::human_dimensions(core::HumanBodySpec{});
   int reordered = 0, natural_boards = 0;
+  online::BoardPlanner planner(model(), settings);
   for (const auto& part : model().product().parts) {
     SCOPED_TRACE(part.name);
     const online::BoardRecords* records = model().board_records(part.name);
     ASSERT_NE(records, nullptr);
-    const online::BoardPlan& plan = plan_of(part.name);
+    const online::BoardPlan plan = planner.plan(scene_of(part.name), part.name, in_seconds(120.0));
     const core::Pose stance = scene_of(part.name).human_stance;
     ASSERT_TRUE(stance.isApprox(cell.spec().human_stance, 1e-12));
     const double hip_z = (stance * Eigen::Vector3d(0, 0, dims.hip_height)).z();
