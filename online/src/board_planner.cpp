@@ -67,7 +67,28 @@ const char* to_string(BoardPlanStatus status) {
 }
 
 BoardPlanner::BoardPlanner(const PlannerModel& model, const BoardPlanSettings& settings)
-    : model_(model), settings_(settings) {}
+    : model_(model), settings_(settings) {
+  // The natural posture's check reads the joints of a `hila human` model (its RULA mapping); a
+  // cell whose human is another model keeps Eq. 8 order, found out here rather than by an
+  // exception while planning.
+  const core::Cell& cell = model_.cell();
+  if (cell.human_arms().empty()) {
+    natural_check_works_ = false;
+  } else {
+    try {
+      const auto& arm = cell.human_arms().front();
+      const Eigen::VectorXd neutral = cell.human_neutral();
+      Eigen::VectorXd joints(arm.chain.dof());
+      for (int i = 0; i < arm.chain.dof(); ++i) {
+        joints[i] = neutral[arm.chain.model_variables()[static_cast<std::size_t>(i)]];
+      }
+      check_receiving_posture(cell, nullptr, cell.spec().human_stance, {{arm.spec.name, joints}},
+                              Eigen::Vector3d::Zero(), 1.0);
+    } catch (const std::exception&) {
+      natural_check_works_ = false;
+    }
+  }
+}
 
 BoardPlanner::~BoardPlanner() = default;
 
@@ -304,7 +325,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   // only uncomfortably, those whose receiving posture is natural (the part's centre between hip
   // and shoulder height first: no inverse kinematics for the others).
   std::set<std::int64_t> natural;
-  if (settings_.natural_posture_first) {
+  if (settings_.natural_posture_first && (body != nullptr || natural_check_works_)) {
     std::vector<const db::HandoverCandidateRecord*> first;
     const Eigen::Vector3d centre = records->part.mass_properties.com;
     const core::HumanBody* checked_body = body;  // the cell's human: nullptr

@@ -62,7 +62,8 @@ struct BoardPlanSettings {
   // height and a RULA grand score of at most natural_max_rula come first (the comfortable ones,
   // then the uncomfortable, each in Eq. 8 order); then the others as without it. Eq. 8 ranks by
   // the arm's manipulability, which a hand above the shoulder can have; ergonomists would not
-  // choose it. false: the comfort tiers and Eq. 8 order only.
+  // choose it. false: the comfort tiers and Eq. 8 order only (also where the cell's human model
+  // is not one of `hila human`, whose joints the check reads).
   bool natural_posture_first = true;
   // RULA grand score a natural receiving posture keeps to: 3 and below is action level 1-2
   // ("acceptable", or "investigate further" at 3), what the issue asks of every handover.
@@ -254,6 +255,9 @@ class BoardPlanner {
 
   const PlannerModel& model_;
   BoardPlanSettings settings_;
+  // The cell's human is a model the natural posture's check reads (a `hila human` body); else
+  // the goals keep Eq. 8 order within the comfort tiers.
+  bool natural_check_works_ = true;
   // The LazyPRM baseline's roadmaps, kept between queries (settings.motion.planner kLazyPrm).
   std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>> lazy_prm_;
 };
