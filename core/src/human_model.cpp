@@ -53,7 +53,7 @@ struct JointSpec {
 }  // namespace
 
 HumanDimensions human_dimensions(const HumanBodySpec& spec) {
-  if (!std::isfinite(spec.stature) || spec.stature < 1.30 || spec.stature > 2.20) {
+  if (!std::isfinite(spec.stature) || spec.stature < kMinStature || spec.stature > kMaxStature) {
     throw InputError("human body", "stature", "an adult stature in metres within [1.30, 2.20]",
                      format_number(spec.stature) +
                          (spec.stature > 100 ? " (millimetres given as metres?)" : ""));

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "hila/core/error.hpp"
+#include "hila/core/mesh_symmetry.hpp"
 #include "hila/db/database.hpp"
 #include "hila/offline/human_comfort.hpp"
 #include "hila/offline/part_analysis.hpp"
@@ -40,6 +41,8 @@ db::ComfortMapRecord comfort_map_record(const core::ComfortMap& map, const std::
   return record;
 }
 
+}  // namespace
+
 std::string mesh_hash(const core::TriangleMesh& mesh) {
   std::string bytes;
   bytes.reserve(mesh.vertices.size() * 24 + mesh.triangles.size() * 12);
@@ -51,6 +54,8 @@ std::string mesh_hash(const core::TriangleMesh& mesh) {
   }
   return db::sha256_hex(bytes);
 }
+
+namespace {
 
 std::string utc_now() {
   const std::time_t now = std::time(nullptr);
@@ -465,6 +470,7 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
         in.goal_grasp = static_cast<int>(c.human_grasp_id);
       }
     }
+    in.symmetries = core::mesh_symmetries(product.parts[i].mesh);
     ErgonomicsSettings ergonomics = settings.ergonomics;
     ergonomics.seed = part_seed(settings.seed, product.parts[i].name, 5);
     r.ergonomics = evaluate_ergonomics(*cell, comfort, in, ergonomics);

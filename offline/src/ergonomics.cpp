@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "hila/core/comfort.hpp"
+#include "hila/core/mesh_symmetry.hpp"
 #include "hila/core/robot_model.hpp"
 #include "hila/offline/handover.hpp"
 
@@ -152,7 +153,8 @@ std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
     r.torso_flexion_deg = p.torso_flexion_deg;
     r.shoulder_elevated = p.shoulder_elevated;
     r.reach = p.reach;
-    r.reorientation_deg = rotation_angle_deg(board.linear(), in.target.linear());
+    r.reorientation_deg =
+        core::least_rotation_angle_deg(board.linear(), in.target.linear(), in.symmetries);
     r.quality = p.quality;
     r.arm = p.arm >= 0 ? comfort.arm_name(p.arm) : "";
     return r;

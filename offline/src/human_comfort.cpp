@@ -11,10 +11,6 @@ namespace hila::offline {
 
 namespace {
 
-std::string body_label(const core::HumanBodySpec& b) {
-  return core::format_number(b.stature) + (b.sex == core::Sex::Male ? " male" : " female");
-}
-
 // Torso pose in the world at the neutral posture.
 core::Pose base_in_world(const core::Cell& cell, const core::RobotModel& human,
                          const std::string& base_link) {
@@ -36,40 +32,12 @@ HumanComfort::HumanComfort(const core::Cell& cell, std::vector<core::ComfortMap>
     arm_names_.push_back(arm.spec.name);
     arm_base_.push_back(base_in_world(cell, cell.human(), arm.spec.base_link));
     world_to_base_.push_back(arm_base_.back().inverse());
-    shoulder_.push_back(arm.chain.first_joint_position());
   }
   for (const auto& spec : bodies) {
-    const std::string label = body_label(spec);
-    const core::RobotModel model =
-        core::RobotModel::load_urdf_string(core::generate_human_urdf(spec), "human body " + label);
-    Body body;
-    body.spec = spec;
-    for (const auto& arm : arms) {
-      const core::KinematicChain chain(model, arm.spec.base_link, arm.spec.tip_link);
-      body.world_to_base.push_back(base_in_world(cell, model, arm.spec.base_link).inverse());
-      body.shoulder.push_back(chain.first_joint_position());
-      body.scale = core::characteristic_length(arm.chain) / core::characteristic_length(chain);
-      // The lookup is exact only for a scaled copy of the cell's arm: check it.
-      bool copy = chain.dof() == arm.chain.dof() &&
-                  chain.lower_limits().isApprox(arm.chain.lower_limits(), 1e-12) &&
-                  chain.upper_limits().isApprox(arm.chain.upper_limits(), 1e-12);
-      for (int k = 1; copy && k <= 3; ++k) {
-        const Eigen::VectorXd q =
-            arm.chain.lower_limits() +
-            (0.25 * k) * (arm.chain.upper_limits() - arm.chain.lower_limits());
-        const core::Pose a = arm.chain.fk(q);
-        const core::Pose b = chain.fk(q);
-        const Eigen::Vector3d da = a.translation() - arm.chain.first_joint_position();
-        const Eigen::Vector3d db = body.scale * (b.translation() - chain.first_joint_position());
-        copy = a.linear().isApprox(b.linear(), 1e-9) && (da - db).norm() < 1e-9;
-      }
-      if (!copy) {
-        throw core::InputError(
-            "human bodies", "body " + label,
-            "arms that are scaled copies of the cell's human arm '" + arm.spec.name +
-                "' (bodies of `hila human`, the cell's human generated the same way)",
-            "a different arm structure or joint limits");
-      }
+    Body body{std::make_shared<const core::HumanBody>(cell, spec), {}};
+    for (std::size_t a = 0; a < arms.size(); ++a) {
+      body.world_to_base.push_back(
+          (cell.spec().human_stance * body.body->base_in_stance(static_cast<int>(a))).inverse());
     }
     bodies_.push_back(std::move(body));
   }
@@ -83,9 +51,7 @@ double HumanComfort::quality(int arm, const core::Pose& hand) const {
 double HumanComfort::body_quality(int body, int arm, const core::Pose& hand) const {
   const auto a = static_cast<std::size_t>(arm);
   const Body& b = bodies_[static_cast<std::size_t>(body)];
-  core::Pose local = b.world_to_base[a] * hand;
-  local.translation() = shoulder_[a] + b.scale * (local.translation() - b.shoulder[a]);
-  return maps_[a].lookup(local);
+  return maps_[a].lookup(b.body->to_cell_arm(arm, b.world_to_base[a] * hand));
 }
 
 double HumanComfort::worst_quality(int arm, const core::Pose& hand) const {
@@ -130,7 +96,7 @@ std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,
 
 std::string format_human_bodies(const std::vector<core::HumanBodySpec>& bodies) {
   std::string out;
-  for (const auto& b : bodies) out += (out.empty() ? "" : "; ") + body_label(b);
+  for (const auto& b : bodies) out += (out.empty() ? "" : "; ") + core::human_body_label(b);
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -18,6 +19,7 @@
 #include "hila/core/pose.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/core/ur_ik.hpp"
+#include "hila/online/receiving_scores.hpp"
 #include "plan_run.hpp"
 
 namespace hila::online {
@@ -77,7 +79,28 @@ const char* to_string(BoardPlanStatus status) {
 }
 
 BoardPlanner::BoardPlanner(const PlannerModel& model, const BoardPlanSettings& settings)
-    : model_(model), settings_(settings) {}
+    : model_(model), settings_(settings) {
+  // The natural posture's check reads the joints of a `hila human` model (its RULA mapping); a
+  // cell whose human is another model keeps Eq. 8 order, found out here rather than by an
+  // exception while planning.
+  const core::Cell& cell = model_.cell();
+  if (cell.human_arms().empty()) {
+    natural_check_works_ = false;
+  } else {
+    try {
+      const auto& arm = cell.human_arms().front();
+      const Eigen::VectorXd neutral = cell.human_neutral();
+      Eigen::VectorXd joints(arm.chain.dof());
+      for (int i = 0; i < arm.chain.dof(); ++i) {
+        joints[i] = neutral[arm.chain.model_variables()[static_cast<std::size_t>(i)]];
+      }
+      check_receiving_posture(cell, nullptr, cell.spec().human_stance, {{arm.spec.name, joints}},
+                              Eigen::Vector3d::Zero(), 1.0);
+    } catch (const std::exception&) {
+      natural_check_works_ = false;
+    }
+  }
+}
 
 BoardPlanner::~BoardPlanner() = default;
 
@@ -179,6 +202,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   const auto started = std::chrono::steady_clock::now();
   BoardPlan result;
   result.board = board;
+  result.worker = scene.worker;
   Run* running = nullptr;  // once it is under way
   auto finish = [&](BoardPlanStatus status, std::string reason) {
     if (running != nullptr) {
@@ -242,9 +266,13 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   if (!exchange_within_payload && !suction_within_payload && direct_within_payload.empty()) {
     return finish(BoardPlanStatus::kOverPayload, over_payload);
   }
-  // At the stance the goals were built for, their stored Q is the scene human's (the same
-  // lookup); elsewhere the comfort maps are looked up again.
-  const bool built_stance = scene.human_stance.isApprox(model_.cell().spec().human_stance, 1e-12);
+  // The worker the scene names (nullptr: the cell's own human, or a body that is the cell's
+  // human). At the stance the goals were built for, the cell human's stored Q is theirs (the
+  // same lookup); elsewhere, or for another body, the comfort maps are looked up again.
+  const core::HumanBody* body =
+      scene.worker != nullptr && !scene.worker->same_as_cell() ? scene.worker.get() : nullptr;
+  const bool built_stance =
+      body == nullptr && scene.human_stance.isApprox(model_.cell().spec().human_stance, 1e-12);
   const WorkerComfort* comfort = nullptr;
   if (!built_stance) {
     std::string error;
@@ -261,9 +289,17 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   // each goal once; a goal they do not reach is never tried.
   std::map<std::int64_t, WorkerComfort::GoalReach> reach_of;
   std::set<std::int64_t> out_of_reach;
-  auto reach = [&](const db::HandoverCandidateRecord& goal) -> const WorkerComfort::GoalReach& {
+  // `count`: a goal found out of reach counts in goals_out_of_reach (the goals to be tried; the
+  // natural posture's check looks at every goal without counting them).
+  auto reach = [&](const db::HandoverCandidateRecord& goal,
+                   bool count = true) -> const WorkerComfort::GoalReach& {
     const auto it = reach_of.find(goal.id);
-    if (it != reach_of.end()) return it->second;
+    if (it != reach_of.end()) {
+      if (count && !it->second.reachable && out_of_reach.insert(goal.id).second) {
+        ++result.goals_out_of_reach;
+      }
+      return it->second;
+    }
     WorkerComfort::GoalReach r;
     if (built_stance && goal.human_joints.size() > 0 &&
         (goal.second_arm.empty() || goal.second_joints.size() > 0)) {
@@ -272,10 +308,11 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       r.joints = goal.human_joints;
       r.second_joints = goal.second_joints;
     } else {  // the human arms' IK: no comfort maps needed
-      r = WorkerComfort::goal_reach(model_.cell(), goal, records->human_grasps, scene.human_stance);
+      r = WorkerComfort::goal_reach(model_.cell(), goal, records->human_grasps, scene.human_stance,
+                                    body);
       if (built_stance) r.quality = goal.quality;  // the stored Q is this human's
     }
-    if (!r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
+    if (count && !r.reachable && out_of_reach.insert(goal.id).second) ++result.goals_out_of_reach;
     return reach_of.emplace(goal.id, std::move(r)).first->second;
   };
   // The goals in Eq. 8 order that the scene's human can take: first those they take
@@ -286,9 +323,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   std::map<std::int64_t, double> worker_quality;  // by goal id
   double best_out_of_reach = 0.0;
   for (const auto& goal : records->goals) {
-    const double q = built_stance
-                         ? goal.quality
-                         : comfort->goal_quality(goal, records->human_grasps, scene.human_stance);
+    const double q =
+        built_stance ? goal.quality
+                     : comfort->goal_quality(goal, records->human_grasps, scene.human_stance, body);
     worker_quality[goal.id] = q;
     if (q >= std::min(settings_.worker_comfort_floor, goal.quality)) {
       goals.push_back(&goal);
@@ -296,18 +333,65 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       below_comfort.push_back(&goal);
     }
   }
+  // Goals a person would choose first: of the comfortable ones, then of those the worker reaches
+  // only uncomfortably, those whose receiving posture is natural (the part's centre between hip
+  // and shoulder height first: no inverse kinematics for the others).
+  std::set<std::int64_t> natural;
+  if (settings_.natural_posture_first && (body != nullptr || natural_check_works_)) {
+    std::vector<const db::HandoverCandidateRecord*> first;
+    const Eigen::Vector3d centre = records->part.mass_properties.com;
+    const core::HumanBody* checked_body = body;  // the cell's human: nullptr
+    std::vector<core::Pose> links;
+    const core::RobotModel& human = checked_body ? checked_body->model() : model_.cell().human();
+    human.link_poses(checked_body ? checked_body->neutral() : model_.cell().human_neutral(), links);
+    const auto& arms = checked_body ? checked_body->arms() : model_.cell().human_arms();
+    double hip_z = std::numeric_limits<double>::infinity(), shoulder_z = -hip_z;
+    for (const auto& arm : arms) {
+      const core::Pose base = scene.human_stance *
+                              links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
+      hip_z = std::min(hip_z, base.translation().z());
+      shoulder_z = std::max(shoulder_z, (base * arm.chain.first_joint_position()).z());
+    }
+    for (const auto* list : {&goals, &below_comfort}) {
+      for (const auto* goal : *list) {
+        const double z = (goal->board * centre).z();
+        if (z < hip_z || z > shoulder_z) continue;
+        const auto& r = reach(*goal, false);
+        if (!r.reachable) continue;
+        std::vector<std::pair<std::string, Eigen::VectorXd>> held{{goal->human_arm, r.joints}};
+        if (!goal->second_arm.empty()) held.emplace_back(goal->second_arm, r.second_joints);
+        const PostureCheck check =
+            check_receiving_posture(model_.cell(), checked_body, scene.human_stance, held,
+                                    goal->board * centre, part->mass);
+        if (!check.natural(settings_.natural_max_rula)) continue;
+        natural.insert(goal->id);
+        first.push_back(goal);
+        if (list == &below_comfort) worker_quality[goal->id] = r.quality;
+      }
+    }
+    result.goals_natural = static_cast<int>(first.size());
+    for (const auto* goal : goals) {
+      if (natural.count(goal->id) == 0) first.push_back(goal);
+    }
+    goals = std::move(first);
+  }
   for (const auto* goal : below_comfort) {
     if (goals.size() >= goal_limit) break;
+    if (natural.count(goal->id) > 0) continue;  // already first
     const auto& r = reach(*goal);
     if (r.reachable) {
       goals.push_back(goal);
       worker_quality[goal->id] = r.quality;
-      ++result.goals_uncomfortable;
     } else {
       best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal->id]);
     }
   }
   goals.resize(std::min(goals.size(), goal_limit));
+  {
+    const std::set<const db::HandoverCandidateRecord*> uncomfortable(below_comfort.begin(),
+                                                                     below_comfort.end());
+    for (const auto* goal : goals) result.goals_uncomfortable += uncomfortable.count(goal) > 0;
+  }
   // Where the scene's human can take none of the goals: says where they stand and how they face.
   auto human_out_of_reach = [&]() {
     const core::Pose& stance = scene.human_stance;
@@ -336,6 +420,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     result.theta_c_deg =
         robot_grasp_id == 0 ? 90.0 : run.robot_grasps().at(robot_grasp_id).theta_c_deg;
     result.quality = worker_quality.at(goal.id);
+    result.natural_posture = natural.count(goal.id) > 0;
     const auto& posture = reach_of.at(goal.id);
     result.human_arm = goal.human_arm;
     result.human_joints = posture.joints;
@@ -656,6 +741,7 @@ BoardPlan BoardPlanner::plan_after_tool_moved(const Scene& scene, const core::Pa
   BoardPlan result;
   if (!failure.empty()) {
     result.board = part.name;
+    result.worker = scene.worker;
     result.suction_arm = model_.suction_arm(part.name);
     result.status = BoardPlanStatus::kNoGoal;
     result.reason =

@@ -1,27 +1,39 @@
 #include "hila/online/receiving_scores.hpp"
 
+#include <algorithm>
+#include <limits>
 #include <utility>
+
+#include "hila/core/pose.hpp"
 
 namespace hila::online {
 
-ReceivingScores receiving_scores(const core::Cell& cell, const BoardPlan& plan, double load_kg) {
+namespace {
+
+// The whole configuration and the model it belongs to: the body's where there is one.
+Eigen::VectorXd posture_of(const core::Cell& cell, const core::HumanBody* body,
+                           const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms) {
+  return body != nullptr ? body->posture(arms) : core::human_posture(cell, arms);
+}
+
+}  // namespace
+
+ReceivingScores receiving_scores(const core::Cell& cell, const core::HumanBody* body,
+                                 const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms,
+                                 double load_kg) {
   ReceivingScores r;
-  if (plan.human_arm.empty() || plan.human_joints.size() == 0) return r;
-  std::vector<std::pair<std::string, Eigen::VectorXd>> arms{{plan.human_arm, plan.human_joints}};
-  if (!plan.second_human_arm.empty()) {
-    if (plan.second_human_joints.size() == 0) return r;
-    arms.emplace_back(plan.second_human_arm, plan.second_human_joints);
-  }
+  if (arms.empty()) return r;
   // Both hands hold the board at once: one configuration.
-  const Eigen::VectorXd q = core::human_posture(cell, arms);
+  const Eigen::VectorXd q = posture_of(cell, body, arms);
+  const core::RobotModel& human = body != nullptr ? body->model() : cell.human();
   r.two_hands = arms.size() > 1;
   r.load_kg = load_kg;
   for (const auto& [arm, joints] : arms) {
     HandScores h;
     h.arm = arm;
-    h.rula_inputs = core::rula_inputs_from_posture(cell.human(), q, arm, load_kg, r.two_hands);
+    h.rula_inputs = core::rula_inputs_from_posture(human, q, arm, load_kg, r.two_hands);
     h.rula = core::rula(h.rula_inputs);
-    h.reba_inputs = core::reba_inputs_from_posture(cell.human(), q, arm, load_kg);
+    h.reba_inputs = core::reba_inputs_from_posture(human, q, arm, load_kg);
     h.reba = core::reba(h.reba_inputs);
     r.hands.push_back(std::move(h));
   }
@@ -34,6 +46,63 @@ ReceivingScores receiving_scores(const core::Cell& cell, const BoardPlan& plan, 
   }
   r.scored = true;
   return r;
+}
+
+ReceivingScores receiving_scores(const core::Cell& cell, const BoardPlan& plan, double load_kg) {
+  if (plan.human_arm.empty() || plan.human_joints.size() == 0) return {};
+  std::vector<std::pair<std::string, Eigen::VectorXd>> arms{{plan.human_arm, plan.human_joints}};
+  if (!plan.second_human_arm.empty()) {
+    if (plan.second_human_joints.size() == 0) return {};
+    arms.emplace_back(plan.second_human_arm, plan.second_human_joints);
+  }
+  return receiving_scores(cell, plan.worker.get(), arms, load_kg);
+}
+
+PostureCheck check_receiving_posture(
+    const core::Cell& cell, const core::HumanBody* body, const core::Pose& stance,
+    const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms,
+    const Eigen::Vector3d& part_centre, double load_kg) {
+  PostureCheck c;
+  c.part_centre_z = part_centre.z();
+  if (arms.empty()) return c;
+  const core::RobotModel& human = body != nullptr ? body->model() : cell.human();
+  const std::vector<core::HumanArm>& human_arms =
+      body != nullptr ? body->arms() : cell.human_arms();
+  const Eigen::VectorXd q = posture_of(cell, body, arms);
+  std::vector<core::Pose> links;
+  human.link_poses(q, links);
+  c.shoulder_z = std::numeric_limits<double>::infinity();
+  c.elbow_below_shoulder = true;
+  for (const auto& entry : arms) {
+    const auto arm = std::find_if(human_arms.begin(), human_arms.end(),
+                                  [&](const auto& h) { return h.spec.name == entry.first; });
+    if (arm == human_arms.end()) continue;  // posture_of has refused it already
+    const core::Pose base =
+        stance * links[static_cast<std::size_t>(human.link_index(arm->spec.base_link))];
+    // The torso's joint is the hip: the arm base link's own joint, at the link's origin.
+    const int torso_joint =
+        human.links()[static_cast<std::size_t>(human.link_index(arm->spec.base_link))].parent_joint;
+    if (torso_joint >= 0) {
+      const int v = human.joints()[static_cast<std::size_t>(torso_joint)].variable;
+      if (v >= 0) c.trunk_flexion_deg = core::rad_to_deg(q[v]);
+    }
+    c.hip_z = base.translation().z();
+    const double shoulder = (base * arm->chain.first_joint_position()).z();
+    c.shoulder_z = std::min(c.shoulder_z, shoulder);
+    // The elbow: the chain's joint named so (else its fourth), at its child link's origin.
+    const auto& names = arm->chain.joint_names();
+    std::string elbow_name = names.size() > 3 ? names[3] : names.back();
+    for (const auto& n : names) {
+      if (n.find("elbow") != std::string::npos) elbow_name = n;
+    }
+    const auto& joint = human.joints()[static_cast<std::size_t>(human.joint_index(elbow_name))];
+    const double elbow =
+        (stance * links[static_cast<std::size_t>(joint.child_link)]).translation().z();
+    c.elbow_below_shoulder = c.elbow_below_shoulder && elbow < shoulder;
+  }
+  const ReceivingScores scores = receiving_scores(cell, body, arms, load_kg);
+  c.rula_grand = scores.scored ? scores.rula().grand : 0;
+  return c;
 }
 
 }  // namespace hila::online

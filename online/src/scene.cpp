@@ -114,7 +114,7 @@ Scene load_scene(const std::string& path, const core::Cell& cell,
                  const core::ProductSpec& product) {
   const core::YamlNode root = core::YamlNode::load_file(path);
   root.expect_only({"product", "files", "boards", "tool", "tool_in_hand", "assembly_frame",
-                    "finished", "human", "obstacles", "robot"});
+                    "finished", "human", "worker", "obstacles", "robot"});
   Scene s = nominal_scene(cell, product);
   s.file = path;
   const core::YamlNode name = root.at("product");
@@ -182,6 +182,29 @@ Scene load_scene(const std::string& path, const core::Cell& cell,
                       format_m(s.human_stance.translation().y()) +
                       ") m, under a cell obstacle's footprint");
     }
+  }
+
+  // The worker who is there: stature and sex, as `hila human` takes them.
+  if (const auto worker = root.find("worker")) {
+    if (!worker->is_map()) worker->fail("{stature: METRES, sex: male|female}", "not a map");
+    worker->expect_only({"stature", "sex"});
+    core::HumanBodySpec body;
+    const core::YamlNode stature = worker->at("stature");
+    body.stature = stature.as_double();
+    if (!std::isfinite(body.stature) || body.stature < core::kMinStature ||
+        body.stature > core::kMaxStature) {
+      stature.fail("an adult stature in metres within [" + core::format_number(core::kMinStature) +
+                       ", " + core::format_number(core::kMaxStature) + "]",
+                   core::format_number(body.stature) +
+                       (body.stature > 100.0 ? " (millimetres given as metres?)" : ""));
+    }
+    const core::YamlNode sex = worker->at("sex");
+    const std::string sex_name = sex.as_string();
+    if (sex_name != "male" && sex_name != "female")
+      sex.fail("male or female", "'" + sex_name + "'");
+    body.sex = sex_name == "male" ? core::Sex::Male : core::Sex::Female;
+    // The body's arms must be scaled copies of the cell's human arms (core::HumanBody).
+    s.worker = std::make_shared<const core::HumanBody>(cell, body, path, "worker");
   }
 
   if (const auto list = root.find("obstacles")) {

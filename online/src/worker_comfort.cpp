@@ -37,16 +37,19 @@ const WorkerComfort::Arm* WorkerComfort::arm(const std::string& name) const {
 WorkerComfort::GoalReach WorkerComfort::goal_reach(
     const core::Cell& cell, const db::HandoverCandidateRecord& goal,
     const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps, const core::Pose& stance,
-    const core::ComfortSettings& ik) {
+    const core::HumanBody* body, const core::ComfortSettings& ik) {
   std::vector<core::Pose> links;
   cell.human().link_poses(cell.human_neutral(), links);
+  const std::vector<core::HumanArm>& arms = body != nullptr ? body->arms() : cell.human_arms();
   auto hand = [&](const std::string& name, std::int64_t grasp_id, const Eigen::VectorXd& built) {
-    const auto a = std::find_if(cell.human_arms().begin(), cell.human_arms().end(),
+    const auto a = std::find_if(arms.begin(), arms.end(),
                                 [&](const core::HumanArm& h) { return h.spec.name == name; });
     const auto it = human_grasps.find(grasp_id);
-    if (a == cell.human_arms().end() || it == human_grasps.end()) return core::ComfortResult{};
+    if (a == arms.end() || it == human_grasps.end()) return core::ComfortResult{};
     const core::Pose base_in_stance =
-        links[static_cast<std::size_t>(cell.human().link_index(a->spec.base_link))];
+        body != nullptr
+            ? body->base_in_stance(static_cast<int>(a - arms.begin()))
+            : links[static_cast<std::size_t>(cell.human().link_index(a->spec.base_link))];
     const core::Pose in_base = (stance * base_in_stance).inverse() * (goal.board * it->second.hand);
     // Beyond the stretched arm from the shoulder: out of reach without solving.
     const double reach = core::characteristic_length(a->chain);
@@ -78,9 +81,16 @@ WorkerComfort::GoalReach WorkerComfort::goal_reach(
 }
 
 double WorkerComfort::hand_quality(const std::string& arm, const core::Pose& part,
-                                   const core::Pose& hand_in_part, const core::Pose& stance) const {
+                                   const core::Pose& hand_in_part, const core::Pose& stance,
+                                   const core::HumanBody* body) const {
   const Arm* a = this->arm(arm);
   if (a == nullptr) return 0.0;
+  if (body != nullptr) {  // the body's hand in its arm base, moved into the cell arm's map
+    const int b = body->arm_index(arm);
+    if (b < 0) return 0.0;
+    const core::Pose base = stance * body->base_in_stance(b);
+    return a->map.lookup(body->to_cell_arm(b, base.inverse() * (part * hand_in_part)));
+  }
   // As the build computes it: the arm base in the world, inverted, times the hand in the world.
   const core::Pose base = stance * a->base_in_stance;
   return a->map.lookup(base.inverse() * (part * hand_in_part));
@@ -88,11 +98,11 @@ double WorkerComfort::hand_quality(const std::string& arm, const core::Pose& par
 
 double WorkerComfort::goal_quality(const db::HandoverCandidateRecord& goal,
                                    const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
-                                   const core::Pose& stance) const {
+                                   const core::Pose& stance, const core::HumanBody* body) const {
   auto hand = [&](const std::string& arm, std::int64_t grasp_id) {
     const auto it = human_grasps.find(grasp_id);
     if (it == human_grasps.end()) return 0.0;
-    return hand_quality(arm, goal.board, it->second.hand, stance);
+    return hand_quality(arm, goal.board, it->second.hand, stance, body);
   };
   if (goal.human_arm.empty()) return 0.0;
   double q = hand(goal.human_arm, goal.human_grasp_id);

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "hila/core/mesh_symmetry.hpp"
 #include "hila/core/product.hpp"
 #include "hila/offline/ergonomics.hpp"
 #include "hila/offline/handover.hpp"
@@ -162,4 +166,25 @@ TEST(Ergonomics, EvaluateReturnsEachRecordsPostureAndRepeatsItself) {
   }
   EXPECT_EQ(with[0].method, "table");
   EXPECT_EQ(with[1].method, "alone");
+}
+
+// The re-orientation left counts the part's symmetries: the shelf (a box) whose target is its
+// initial pose turned by a half turn about its normal needs none, with its symmetries; without
+// them (an asymmetric part) the whole half turn.
+TEST(Ergonomics, ReorientationIsModuloThePartsSymmetries) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  offline::ErgonomicsInputs in;
+  in.initial = b.spec.initial;
+  in.target = b.spec.initial;
+  in.target.linear() = b.spec.initial.linear() *
+                       Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  in.human_grasps = &b.grasps;
+  const auto plain = offline::evaluate_ergonomics(*cell, comfort(), in, {});
+  in.symmetries = core::mesh_symmetries(b.spec.mesh);
+  ASSERT_EQ(in.symmetries.size(), 4u);
+  const auto modulo = offline::evaluate_ergonomics(*cell, comfort(), in, {});
+  ASSERT_EQ(plain.back().method, "alone");  // the board taken where it lies: only the turn left
+  EXPECT_NEAR(plain.back().reorientation_deg, 180.0, 1e-6);
+  EXPECT_NEAR(modulo.back().reorientation_deg, 0.0, 1e-6);
 }

@@ -2,21 +2,36 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
 
+#include "hila/core/ergonomic_scores.hpp"
+#include "hila/core/human_model.hpp"
+#include "hila/core/kinematic_chain.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/online/board_planner.hpp"
+#include "hila/online/worker_comfort.hpp"
 #include "util/quick_build.hpp"
 #include "util/test_util.hpp"
 
 using namespace hila;
 
 namespace {
+
+// The settings the fixture's cases plan with: the defaults with the goals in Eq. 8 order within
+// the comfort tiers (natural_posture_first off), the order these cases' premises are about (a
+// board going home along its way in, the nearest goal needing a bridge). The natural goals first
+// are tested on their own below.
+online::BoardPlanSettings eq8_order() {
+  online::BoardPlanSettings s;
+  s.natural_posture_first = false;
+  return s;
+}
 
 std::chrono::steady_clock::time_point in_seconds(double s) {
   return std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(s * 1e6));
@@ -206,7 +221,7 @@ class BoardPlanner : public ::testing::Test {
     const std::string path = database();
     model_ = online::PlannerModel::load(path, test::cell_path(), test::product_path());
     nominal_ = std::make_unique<Nominal>();
-    online::BoardPlanner planner(*model_);
+    online::BoardPlanner planner(*model_, eq8_order());
     online::Scene scene = online::load_scene(test::data_path("cabinet/scene.yaml"), model_->cell(),
                                              model_->product());
     for (const auto& part : model_->product().parts) {
@@ -250,7 +265,7 @@ class BoardPlanner : public ::testing::Test {
         return home_via(kv.second).find("stored") == 0;
       });
       if (it != plans().end()) {
-        online::BoardPlanSettings no_way_back;
+        online::BoardPlanSettings no_way_back = eq8_order();
         no_way_back.way_back_spacing = 0.0;
         auto without = online::BoardPlanner(*model_, no_way_back)
                            .plan(scene_of(it->first), it->first, in_seconds(120.0));
@@ -268,7 +283,7 @@ class BoardPlanner : public ::testing::Test {
       const std::string board = "lateral_right";
       online::Scene scene = scene_of(board);
       scene.obstacles.push_back(box_at("crate", plan_of(board).human_handover.translation(), 0.06));
-      auto plan = online::BoardPlanner(*model_).plan(scene, board, in_seconds(120.0));
+      auto plan = online::BoardPlanner(*model_, eq8_order()).plan(scene, board, in_seconds(120.0));
       print_plan(plan);
       blocked_ = Blocked{std::move(scene), std::move(plan)};
     }
@@ -340,10 +355,10 @@ TEST_F(BoardPlanner, MultiWaypointMotionsAreSmoothed) {
 // thread smoothed a step depends on timing; with every smoothing queued
 // (smooth_here_when_behind false) none is done on the planner's thread, whatever the timing.
 TEST_F(BoardPlanner, WhereAStepIsSmoothedAndValidatedDoesNotChangeThePlan) {
-  online::BoardPlanSettings in_order_settings;
+  online::BoardPlanSettings in_order_settings = eq8_order();
   in_order_settings.overlap_validation = false;
   online::BoardPlanner in_order_planner(model(), in_order_settings);
-  online::BoardPlanSettings all_queued_settings;
+  online::BoardPlanSettings all_queued_settings = eq8_order();
   all_queued_settings.smooth_here_when_behind = false;
   online::BoardPlanner all_queued_planner(model(), all_queued_settings);
   double queued_smoothing = 0.0;
@@ -386,7 +401,7 @@ TEST_F(BoardPlanner, EveryChainFailingEscalatesToLargerBridges) {
     if (needs_bridge.empty() && bridged(plan)) needs_bridge = name;
   }
   ASSERT_FALSE(needs_bridge.empty()) << "some board of the cabinet needs a bridge";
-  online::BoardPlanSettings no_bridges;
+  online::BoardPlanSettings no_bridges = eq8_order();
   no_bridges.motion.bridge_checks = 0;
   no_bridges.goals = 1;
   no_bridges.way_back_spacing = 0.0;
@@ -416,7 +431,7 @@ TEST_F(BoardPlanner, ACrateOnTheStoredPathIsPlannedAround) {
       (core::arm_base_in_world(model().cell(), arm) * arm.chain.fk(middle)).translation();
   online::Scene crated = scene_of(board);
   crated.obstacles.push_back(box_at("crate", gripper, 0.08));
-  const auto repaired = online::BoardPlanner(model()).plan(crated, board, in_seconds(120.0));
+  const auto repaired = online::BoardPlanner(model(), eq8_order()).plan(crated, board, in_seconds(120.0));
   print_plan(repaired);
   ASSERT_TRUE(repaired.solved()) << repaired.reason;
   expect_plan_well_formed(model(), crated, repaired);
@@ -454,7 +469,7 @@ TEST_F(BoardPlanner, ReachOfTheHumanPoseIsCheckedBeforeTheExchange) {
   const Blocked& blocked = crate_at_first_goal();
   const online::BoardPlan& fallback = blocked.plan;
   ASSERT_TRUE(fallback.solved()) << fallback.reason;
-  online::BoardPlanSettings exchange_first;
+  online::BoardPlanSettings exchange_first = eq8_order();
   exchange_first.reach_human_pose_first = false;
   const auto late = online::BoardPlanner(model(), exchange_first)
                         .plan(blocked.scene, "lateral_right", in_seconds(120.0));
@@ -483,7 +498,7 @@ TEST_F(BoardPlanner, ReachOfTheHumanPoseIsCheckedBeforeTheExchange) {
 // same attempts, every emitted step passing the stricter validator. (On this database lateral
 // right's first goal is rejected so, 15 times in order, and its second plans.)
 TEST_F(BoardPlanner, ARejectionFoundLateGivesThePlanOfValidatingInOrder) {
-  online::BoardPlanSettings strict;
+  online::BoardPlanSettings strict = eq8_order();
   strict.validator.slip_tolerance_deg = -2.0;
   online::BoardPlanSettings strict_in_order = strict;
   strict_in_order.overlap_validation = false;
@@ -518,7 +533,7 @@ TEST_F(BoardPlanner, AGraspWhoseReceiveFailedAtABoardPoseComesBackLast) {
   online::Scene boxed = scene_of(name);
   boxed.obstacles.push_back(box_at(
       "crate", plan_of(name).robot_handover.translation() + Eigen::Vector3d(0, 0.22, 0), 0.1));
-  const auto plan = online::BoardPlanner(model()).plan(boxed, name, in_seconds(120.0));
+  const auto plan = online::BoardPlanner(model(), eq8_order()).plan(boxed, name, in_seconds(120.0));
   print_plan(plan);
   ASSERT_TRUE(plan.solved()) << plan.reason;
   expect_plan_well_formed(model(), boxed, plan);
@@ -547,4 +562,90 @@ TEST(BoardPlannerPayload, APartOverThePayloadIsRefusedWithTheSums) {
   EXPECT_EQ(lateral.motions_planned, 0);
   const online::BoardPlan base = planner.plan(scene, "base", in_seconds(30));
   EXPECT_NE(base.status, online::BoardPlanStatus::kOverPayload) << base.reason;
+}
+
+// Goals a person would choose (BoardPlanSettings::natural_posture_first, on by default): the
+// first goal tried is the first in Eq. 8 order whose receiving posture has the trunk upright, the
+// elbows below the shoulders, the part's centre of mass between hip and shoulder height and RULA
+// grand <= 3 — computed here from the anthropometric ratios (hip 0.530 H, shoulder 0.818 H) and
+// the elbow by a chain of its own (torso to the elbow link), not by the planner's check. At the
+// built stance every stored goal is comfortable, and the posture is the build's where it stored
+// one, else the human arm's inverse kinematics (WorkerComfort::goal_reach). Brute force over
+// every stored goal of every board.
+TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
+  const core::Cell& cell = model().cell();
+  const online::BoardPlanSettings settings;
+  ASSERT_TRUE(settings.natural_posture_first);
+  const core::HumanDimensions dims = core::human_dimensions(core::HumanBodySpec{});
+  int reordered = 0, natural_boards = 0;
+  online::BoardPlanner planner(model(), settings);
+  for (const auto& part : model().product().parts) {
+    SCOPED_TRACE(part.name);
+    const online::BoardRecords* records = model().board_records(part.name);
+    ASSERT_NE(records, nullptr);
+    const online::BoardPlan plan = planner.plan(scene_of(part.name), part.name, in_seconds(120.0));
+    const core::Pose stance = scene_of(part.name).human_stance;
+    ASSERT_TRUE(stance.isApprox(cell.spec().human_stance, 1e-12));
+    const double hip_z = (stance * Eigen::Vector3d(0, 0, dims.hip_height)).z();
+    const double shoulder_z = (stance * Eigen::Vector3d(0, 0, dims.shoulder_height)).z();
+    std::vector<std::int64_t> natural;
+    for (const auto& goal : records->goals) {
+      const double centre_z = (goal.board * records->part.mass_properties.com).z();
+      if (centre_z < hip_z || centre_z > shoulder_z) continue;
+      online::WorkerComfort::GoalReach r;
+      if (goal.human_joints.size() > 0 && (goal.second_arm.empty() || goal.second_joints.size())) {
+        r.reachable = true;
+        r.joints = goal.human_joints;
+        r.second_joints = goal.second_joints;
+      } else {
+        r = online::WorkerComfort::goal_reach(cell, goal, records->human_grasps, stance);
+      }
+      if (!r.reachable) continue;
+      std::vector<std::pair<std::string, Eigen::VectorXd>> arms{{goal.human_arm, r.joints}};
+      if (!goal.second_arm.empty()) arms.emplace_back(goal.second_arm, r.second_joints);
+      bool elbows_low = true;
+      int rula = 0;
+      const Eigen::VectorXd q = core::human_posture(cell, arms);
+      for (const auto& [side, joints] : arms) {
+        const core::KinematicChain to_elbow(cell.human(), "torso", side + "_elbow_link");
+        ASSERT_EQ(to_elbow.dof(), 4);
+        const double elbow_in_torso = to_elbow.fk(joints.head(4)).translation().z();
+        elbows_low = elbows_low && elbow_in_torso < dims.shoulder_height - dims.hip_height;
+        rula = std::max(rula, core::rula(core::rula_inputs_from_posture(cell.human(), q, side,
+                                                                        part.mass, arms.size() > 1))
+                                  .grand);
+      }
+      const double trunk =
+          q[cell.human()
+                .joints()[static_cast<std::size_t>(cell.human().joint_index("torso_flexion"))]
+                .variable];
+      if (std::abs(trunk) < 1e-12 && elbows_low && rula <= 3) natural.push_back(goal.id);
+    }
+    EXPECT_EQ(plan.goals_natural, static_cast<int>(natural.size()));
+    ASSERT_FALSE(plan.attempts.empty());
+    if (natural.empty()) {
+      EXPECT_FALSE(plan.natural_posture);
+      continue;
+    }
+    ++natural_boards;
+    EXPECT_EQ(plan.attempts.front().candidate_id, natural.front());
+    // The goals tried go through the natural ones in Eq. 8 order before any other.
+    std::vector<std::int64_t> tried;  // distinct, in the order first tried (a second round
+                                      // with larger bridges starts over)
+    for (const auto& a : plan.attempts) {
+      if (std::find(tried.begin(), tried.end(), a.candidate_id) == tried.end()) {
+        tried.push_back(a.candidate_id);
+      }
+    }
+    for (std::size_t i = 0; i < tried.size() && i < natural.size(); ++i) {
+      EXPECT_EQ(tried[i], natural[i]) << "goal tried " << i;
+    }
+    if (plan.solved()) {
+      EXPECT_EQ(plan.natural_posture,
+                std::find(natural.begin(), natural.end(), plan.candidate_id) != natural.end());
+    }
+    reordered += natural.front() != records->goals.front().id ? 1 : 0;
+  }
+  EXPECT_GT(natural_boards, 0);
+  EXPECT_GT(reordered, 0);  // the tiers change a first goal on the cabinet
 }

@@ -9,6 +9,9 @@
 #include <random>
 #include <string>
 
+#include "hila/core/human_body.hpp"
+#include "hila/core/human_model.hpp"
+#include "hila/core/kinematic_chain.hpp"
 #include "hila/core/pose.hpp"
 #include "hila/db/database.hpp"
 #include "hila/offline/build.hpp"
@@ -217,4 +220,56 @@ TEST(ReceivingScores, CabinetGoalsStoredPostures) {
   EXPECT_GT(checked, goals / 2);
   std::cout << goals << " goals (" << two_hand << " two-hand), " << checked << " hands checked\n";
   if (!dir.empty()) std::filesystem::remove_all(dir);
+}
+
+// Where a receiving posture puts a worker of another body (BoardPlan::worker): the hip and
+// shoulder heights are the anthropometric ratios of that body (0.530 H, 0.818 H above the
+// stance), the elbow's height against the shoulder comes from a chain of its own (the torso to
+// the elbow link), the RULA grand score is that body's model's, and the natural predicate is
+// their conjunction. Seeded postures of one and two hands, two bodies, a raised stance.
+TEST(ReceivingScores, APostureCheckOfAWorkersBodyFollowsItsForwardKinematics) {
+  const auto cell = test::reference_cell();
+  std::mt19937_64 rng(36);
+  core::Pose stance = cell->spec().human_stance;
+  stance.translation().z() += 0.05;
+  int below = 0, above = 0, natural = 0;
+  for (const core::HumanBodySpec spec :
+       {core::HumanBodySpec{1.50, core::Sex::Female}, core::HumanBodySpec{1.95, core::Sex::Male}}) {
+    const core::HumanBody body(*cell, spec);
+    const core::HumanDimensions dims = core::human_dimensions(spec);
+    for (int trial = 0; trial < 200; ++trial) {
+      std::vector<std::pair<std::string, Eigen::VectorXd>> arms;
+      const auto& first = body.arms()[static_cast<std::size_t>(trial % 2)];
+      arms.emplace_back(first.spec.name, random_within(first.chain, rng));
+      if (trial % 3 == 0) {
+        const auto& second = body.arms()[static_cast<std::size_t>((trial + 1) % 2)];
+        arms.emplace_back(second.spec.name, random_within(second.chain, rng));
+      }
+      const Eigen::Vector3d centre = stance * Eigen::Vector3d(0.4, 0.0, 1.0 + 0.25 * (trial % 5));
+      const online::PostureCheck c =
+          online::check_receiving_posture(*cell, &body, stance, arms, centre, 0.8);
+      const double floor_z = stance.translation().z();
+      EXPECT_NEAR(c.hip_z, floor_z + dims.hip_height, 1e-9);
+      EXPECT_NEAR(c.shoulder_z, floor_z + dims.shoulder_height, 1e-9);
+      EXPECT_DOUBLE_EQ(c.part_centre_z, centre.z());
+      EXPECT_DOUBLE_EQ(c.trunk_flexion_deg, 0.0);
+      bool low = true;
+      for (const auto& [side, joints] : arms) {
+        const core::KinematicChain to_elbow(body.model(), "torso", side + "_elbow_link");
+        low = low && to_elbow.fk(joints.head(4)).translation().z() <
+                         dims.shoulder_height - dims.hip_height;
+      }
+      EXPECT_EQ(c.elbow_below_shoulder, low);
+      (low ? below : above) += 1;
+      const auto scores = online::receiving_scores(*cell, &body, arms, 0.8);
+      EXPECT_EQ(c.rula_grand, scores.rula().grand);
+      const bool expected =
+          low && c.rula_grand <= 3 && centre.z() >= c.hip_z && centre.z() <= c.shoulder_z;
+      EXPECT_EQ(c.natural(3), expected);
+      natural += expected ? 1 : 0;
+    }
+  }
+  EXPECT_GT(below, 20);  // both sides of the elbow test are exercised
+  EXPECT_GT(above, 20);
+  EXPECT_GT(natural, 0);
 }

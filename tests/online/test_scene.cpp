@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "hila/core/error.hpp"
 #include "hila/core/product.hpp"
 #include "hila/online/scene.hpp"
@@ -169,4 +171,58 @@ TEST(Scene, TheNominalSceneNamesTheCabinetsCellAndProductFiles) {
 
 TEST(Scene, MissingFileIsAnInputError) {
   test::expect_input_error([] { load("/nonexistent/scene.yaml"); }, {"/nonexistent/scene.yaml"});
+}
+
+// `worker:` names the body at the stance: a model of `hila human` for that stature and sex
+// (its shoulder where the anthropometric ratio puts it), the cell's own human when absent.
+TEST(Scene, TheWorkerWhoIsThereIsABodyOfThatStatureAndSex) {
+  EXPECT_EQ(load(scene_path()).worker, nullptr);
+  const online::Scene s =
+      load(write_scene("worker", "product: cabinet\nworker: {stature: 1.50, sex: female}\n"));
+  ASSERT_NE(s.worker, nullptr);
+  EXPECT_DOUBLE_EQ(s.worker->spec().stature, 1.50);
+  EXPECT_EQ(s.worker->spec().sex, core::Sex::Female);
+  EXPECT_FALSE(s.worker->same_as_cell());
+  // Shoulder 0.818 H above the floor, 0.115 H (biacromial 0.230 H / 2) from the midline.
+  for (int a = 0; a < static_cast<int>(s.worker->arms().size()); ++a) {
+    const Eigen::Vector3d shoulder =
+        s.worker->base_in_stance(a) *
+        s.worker->arms()[static_cast<std::size_t>(a)].chain.first_joint_position();
+    EXPECT_NEAR(shoulder.z(), 0.818 * 1.50, 1e-6);
+    EXPECT_NEAR(std::abs(shoulder.y()), 0.115 * 1.50, 1e-6);
+  }
+  // The scenes that follow keep the worker.
+  EXPECT_EQ(s.with_finished(cabinet(), "base").worker, s.worker);
+  // The cell's own body named is the cell's human.
+  const online::Scene same = load(
+      write_scene("worker_default", "product: cabinet\nworker: {stature: 1.722, sex: male}\n"));
+  ASSERT_NE(same.worker, nullptr);
+  EXPECT_TRUE(same.worker->same_as_cell());
+}
+
+TEST(Scene, ABadWorkerNamesTheFileTheFieldAndWhatWasExpected) {
+  auto expect = [](const std::string& name, const std::string& text,
+                   std::initializer_list<std::string> fragments) {
+    const std::string path = write_scene(name, "product: cabinet\n" + text);
+    std::vector<std::string> all{path};
+    all.insert(all.end(), fragments.begin(), fragments.end());
+    SCOPED_TRACE(name);
+    try {
+      load(path);
+      ADD_FAILURE() << "accepted";
+    } catch (const core::InputError& e) {
+      for (const auto& f : all)
+        EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
+            << "missing '" << f << "' in: " << e.what();
+    }
+  };
+  expect("millimetres", "worker: {stature: 1500, sex: female}\n",
+         {"worker.stature", "[1.3, 2.2]", "millimetres"});
+  expect("child", "worker: {stature: 1.0, sex: male}\n", {"worker.stature", "adult stature"});
+  expect("sex", "worker: {stature: 1.6, sex: woman}\n",
+         {"worker.sex", "male or female", "'woman'"});
+  expect("no_sex", "worker: {stature: 1.6}\n", {"worker", "sex"});
+  expect("typo", "worker: {stature: 1.6, sex: male, height: 1.6}\n", {"worker", "height"});
+  expect("not_a_map", "worker: 1.6\n", {"worker", "stature"});
+  expect("nan", "worker: {stature: .nan, sex: male}\n", {"worker.stature"});
 }

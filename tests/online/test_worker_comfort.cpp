@@ -8,6 +8,7 @@
 #include <random>
 
 #include "hila/core/comfort_map.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/offline/human_comfort.hpp"
 #include "hila/online/board_planner.hpp"
@@ -229,4 +230,92 @@ TEST_F(WorkerComfortTest, EveryPlanIsTakenByTheHumanWhoIsThere) {
   EXPECT_GT(uncomfortable, 0);
   EXPECT_GT(out_of_reach, 0);
   EXPECT_GT(solved, 0);
+}
+
+// The worker who is there: a 1.50 m woman and a 1.90 m man at the same stance. Where the
+// database's first goal (ranked for the cell's 1.722 m man) is out of her comfortable reach, her
+// plan takes another goal than his, and each plan's human posture holds the goal's grasp by
+// forward kinematics of that body's own arm (not the cell human's: the same joints put the cell
+// human's hand elsewhere). Eq. 8 order only (natural_posture_first off), so that the difference
+// is the bodies'.
+TEST_F(WorkerComfortTest, AShortWomanGetsAnotherGoalThanATallManWhereTheFirstIsOutOfHerReach) {
+  const auto& cell = model_->cell();
+  const auto woman = std::make_shared<const core::HumanBody>(
+      cell, core::HumanBodySpec{core::kFemaleStatureP5, core::Sex::Female});
+  const auto man =
+      std::make_shared<const core::HumanBody>(cell, core::HumanBodySpec{1.90, core::Sex::Male});
+  online::BoardPlanSettings settings;
+  settings.natural_posture_first = false;
+  online::BoardPlanner planner(*model_, settings);
+  online::Scene scene = online::nominal_scene(cell, model_->product());
+  const core::Pose stance = scene.human_stance;
+  // The body's arm holds `hand` (world) at joints q, within the limits, to 1e-6 m and rad.
+  auto holds = [&](const core::HumanBody& body, const std::string& arm, const Eigen::VectorXd& q,
+                   const core::Pose& hand) {
+    const int a = body.arm_index(arm);
+    if (a < 0) return false;
+    const auto& chain = body.arms()[static_cast<std::size_t>(a)].chain;
+    if (q.size() != chain.dof() || !chain.within_limits(q, 1e-9)) return false;
+    const core::Pose at = stance * body.base_in_stance(a) * chain.fk(q);
+    return (at.translation() - hand.translation()).norm() < 1e-6 &&
+           Eigen::AngleAxisd(at.linear().transpose() * hand.linear()).angle() < 1e-6;
+  };
+  int out_of_her_reach = 0, different = 0;
+  for (const auto& part : model_->product().parts) {
+    SCOPED_TRACE(part.name);
+    const online::BoardRecords* b = model_->board_records(part.name);
+    ASSERT_NE(b, nullptr);
+    const online::Scene here = scene;
+    scene = scene.with_finished(model_->product(), part.name);
+    if (b->goals.empty()) continue;
+    const auto& first = b->goals.front();
+    const double her_q =
+        model_->worker_comfort()->goal_quality(first, b->human_grasps, stance, woman.get());
+    const bool her_reach =
+        online::WorkerComfort::goal_reach(cell, first, b->human_grasps, stance, woman.get())
+            .reachable;
+    if (her_q >= settings.worker_comfort_floor && her_reach) continue;  // she takes it too
+    ++out_of_her_reach;
+    online::Scene for_her = here, for_him = here;
+    for_her.worker = woman;
+    for_him.worker = man;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    const online::BoardPlan hers = planner.plan(for_her, part.name, deadline);
+    const online::BoardPlan his = planner.plan(for_him, part.name, deadline);
+    EXPECT_EQ(hers.worker, woman);
+    EXPECT_EQ(his.worker, man);
+    for (const auto* pair : {&hers, &his}) {
+      const online::BoardPlan& plan = *pair;
+      if (!plan.solved()) continue;
+      const core::HumanBody& body = pair == &hers ? *woman : *man;
+      const auto& goal = *std::find_if(b->goals.begin(), b->goals.end(),
+                                       [&](const auto& g) { return g.id == plan.candidate_id; });
+      const core::Pose hand = goal.board * b->human_grasps.at(goal.human_grasp_id).hand;
+      EXPECT_TRUE(holds(body, goal.human_arm, plan.human_joints, hand)) << body.label();
+      if (!goal.second_arm.empty()) {
+        EXPECT_TRUE(holds(body, goal.second_arm, plan.second_human_joints,
+                          goal.board * b->human_grasps.at(goal.second_grasp_id).hand))
+            << body.label();
+      }
+      // The cell human's arm at the same joints does not hold it: the posture is this body's.
+      const core::HumanArm& cell_arm =
+          *std::find_if(cell.human_arms().begin(), cell.human_arms().end(),
+                        [&](const core::HumanArm& h) { return h.spec.name == goal.human_arm; });
+      std::vector<core::Pose> links;
+      cell.human().link_poses(cell.human_neutral(), links);
+      const core::Pose cell_at =
+          stance *
+          links[static_cast<std::size_t>(cell.human().link_index(cell_arm.spec.base_link))] *
+          cell_arm.chain.fk(plan.human_joints);
+      EXPECT_GT((cell_at.translation() - hand.translation()).norm(), 0.01) << body.label();
+    }
+    // Her first goal is not the one out of her comfortable reach, unless she takes it as the
+    // best she reaches (uncomfortably).
+    if (hers.solved() && hers.candidate_id == first.id) {
+      EXPECT_LT(hers.quality, settings.worker_comfort_floor);
+    }
+    if (hers.solved() && his.solved() && hers.candidate_id != his.candidate_id) ++different;
+  }
+  EXPECT_GT(out_of_her_reach, 0);
+  EXPECT_GT(different, 0);
 }

@@ -32,6 +32,7 @@ struct PlanOptions {
   bool output_given = false;  // -o was on the command line (perhaps as '')
   bool json = false;
   double deadline_s = 30.0;
+  bool eq8_order = false;  // BoardPlanSettings::natural_posture_first off
 };
 
 nlohmann::json pose_to_json(const core::Pose& pose) {
@@ -95,7 +96,8 @@ nlohmann::json hand_scores_json(const online::HandScores& h) {
 // The receiving posture's RULA and REBA (docs/online.md): the board's scores (the worse hand's)
 // and each hand's. Scored here, after planning; a human model the scores cannot read says why.
 nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& plan,
-                               double load_kg) {
+                               double load_kg, const core::Pose& stance,
+                               const Eigen::Vector3d& centre_of_mass) {
   online::ReceivingScores s;
   try {
     s = online::receiving_scores(cell, plan, load_kg);
@@ -105,7 +107,21 @@ nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& 
   if (!s.scored) return {{"error", "no receiving posture"}};
   nlohmann::json hands = nlohmann::json::array();
   for (const auto& h : s.hands) hands.push_back(hand_scores_json(h));
+  // Where the posture puts the worker (BoardPlanSettings::natural_posture_first).
+  std::vector<std::pair<std::string, Eigen::VectorXd>> arms{{plan.human_arm, plan.human_joints}};
+  if (!plan.second_human_arm.empty()) {
+    arms.emplace_back(plan.second_human_arm, plan.second_human_joints);
+  }
+  const online::PostureCheck c = online::check_receiving_posture(
+      cell, plan.worker.get(), stance, arms, plan.human_handover * centre_of_mass, load_kg);
   return {{"load_kg", s.load_kg},
+          {"posture",
+           {{"trunk_flexion_deg", c.trunk_flexion_deg},
+            {"elbow_below_shoulder", c.elbow_below_shoulder},
+            {"part_centre_z", c.part_centre_z},
+            {"hip_z", c.hip_z},
+            {"shoulder_z", c.shoulder_z},
+            {"natural", c.natural(online::BoardPlanSettings{}.natural_max_rula)}}},
           {"two_hands", s.two_hands},
           {"rula",
            {{"grand", s.rula().grand},
@@ -119,7 +135,17 @@ nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& 
           {"hands", hands}};
 }
 
-nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, double load_kg) {
+// The worker a plan is for: the scene's `worker` (stature and sex) or the cell's own human.
+nlohmann::json worker_json(const std::shared_ptr<const core::HumanBody>& worker,
+                           const core::Cell& cell) {
+  if (worker == nullptr) return {{"from", "cell"}, {"urdf", cell.spec().human_urdf}};
+  return {{"from", "scene"},
+          {"stature", worker->spec().stature},
+          {"sex", worker->spec().sex == core::Sex::Male ? "male" : "female"}};
+}
+
+nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, double load_kg,
+                         const core::Pose& stance, const Eigen::Vector3d& centre_of_mass) {
   nlohmann::json attempts = nlohmann::json::array();
   for (const auto& a : plan.attempts) {
     attempts.push_back({{"rank", a.rank},
@@ -152,6 +178,7 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
   nlohmann::json j = {{"board", plan.board},
                       {"status", online::to_string(plan.status)},
                       {"reason", plan.reason},
+                      {"worker", worker_json(plan.worker, cell)},
                       {"planning_ms", 1e3 * plan.planning_seconds},
                       {"planning_split_ms",
                        {{"motions", 1e3 * plan.times.motions},
@@ -162,7 +189,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
                       {"attempts", attempts},
                       {"rejected_motions", plan.rejected_motions},
                       {"goals_out_of_reach", plan.goals_out_of_reach},
-                      {"goals_uncomfortable", plan.goals_uncomfortable}};
+                      {"goals_uncomfortable", plan.goals_uncomfortable},
+                      {"goals_natural", plan.goals_natural}};
   if (plan.solved()) {
     // The way: who picks and how, the exchanges (from the cup to the other arm's gripper), who
     // delivers.
@@ -210,7 +238,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
     if (!plan.second_human_arm.empty())
       posture[plan.second_human_arm] = joints(plan.second_human_joints);
     j["human_posture_rad"] = posture;
-    j["ergonomics"] = ergonomics_json(cell, plan, load_kg);
+    j["natural_posture"] = plan.natural_posture;
+    j["ergonomics"] = ergonomics_json(cell, plan, load_kg, stance, centre_of_mass);
     if (plan.mode == online::DeliveryMode::kExchange) {
       j["robot_handover"] = pose_to_json(plan.robot_handover);
     }
@@ -254,11 +283,14 @@ int run_plan(const PlanOptions& opt) {
     }
     boards.push_back(opt.board);
   }
-  online::BoardPlanner planner(*model);
+  online::BoardPlanSettings settings;
+  settings.natural_posture_first = !opt.eq8_order;
+  online::BoardPlanner planner(*model, settings);
   nlohmann::json out = {{"hila_plan", 1},
                         {"database", opt.database},
                         {"scene", opt.scene},
                         {"product", model->product().name},
+                        {"worker", worker_json(scene.worker, model->cell())},
                         {"boards", nlohmann::json::array()}};
   int failed = 0;
   if (!opt.json) {
@@ -272,7 +304,10 @@ int run_plan(const PlanOptions& opt) {
     // Where the suction arm cannot take the tool where it is, the plan begins with the other arm
     // setting it down where it can (BoardPlan::tool_place).
     const online::BoardPlan plan = planner.plan(scene, board, deadline);
-    out["boards"].push_back(plan_json(plan, model->cell(), model->product().part(board).mass));
+    const online::BoardRecords* records = model->board_records(board);
+    out["boards"].push_back(plan_json(
+        plan, model->cell(), model->product().part(board).mass, scene.human_stance,
+        records != nullptr ? records->part.mass_properties.com : Eigen::Vector3d::Zero()));
     if (!opt.json) {
       std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;
       if (plan.solved()) {
@@ -321,6 +356,9 @@ void add_plan_command(CLI::App& app, Action& action) {
   CLI::Option* output =
       cmd->add_option("-o,--output", opt->output, "write the plan (JSON, docs/online.md)");
   cmd->add_flag("--json", opt->json, "print the plan as JSON instead of the table");
+  cmd->add_flag("--eq8-order", opt->eq8_order,
+                "try the goals in Eq. 8 order within the comfort tiers only, not the goals with a "
+                "natural receiving posture first");
   cmd->add_option("--deadline", opt->deadline_s, "seconds per board (default 30)")
       ->check(number_in(kMinDeadlineSeconds, kMaxDeadlineSeconds, false, "seconds"));
   cmd->callback([opt, output, &action] {

@@ -13,7 +13,9 @@
 #include "hila/core/comfort_map.hpp"
 #include "hila/core/ergonomic_scores.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/mesh_symmetry.hpp"
 #include "hila/core/pose.hpp"
+#include "hila/core/product.hpp"
 #include "hila/db/database.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/offline/ergonomics.hpp"
@@ -39,6 +41,9 @@ struct ReportOptions {
 
 // RULA and REBA of one way's receiving posture.
 struct PostureScores {
+  // The re-orientation left (deg), modulo the part's symmetries where they are known; negative
+  // when the way was not evaluated again (the stored value stands).
+  double reorientation_deg = -1.0;
   bool scored = false;
   std::string why;  // not scored: why
   bool two_hands = false;
@@ -54,10 +59,9 @@ struct PostureScores {
 // scored: the arm's joints on the cell's human at that torso flexion, the rest neutral, holding
 // the part's mass (two hands where the part has no one-hand grasp, or hila's goal is a two-hand
 // one: the one arm's posture stands for both, as in the build). By method.
-std::map<std::string, PostureScores> score_postures(const core::Cell& cell,
-                                                    const offline::HumanComfort& comfort,
-                                                    const db::Database& database,
-                                                    const db::PartRecord& part) {
+std::map<std::string, PostureScores> score_postures(
+    const core::Cell& cell, const offline::HumanComfort& comfort, const db::Database& database,
+    const db::PartRecord& part, const std::vector<Eigen::Matrix3d>& symmetries) {
   std::map<std::string, PostureScores> out;
   const auto grasps = database.human_grasps(part.id);
   offline::ErgonomicsInputs in;
@@ -69,6 +73,7 @@ std::map<std::string, PostureScores> score_postures(const core::Cell& cell,
     in.table_placement = placements.front().part_in_plane;
   }
   in.human_grasps = &grasps;
+  in.symmetries = symmetries;
   bool goal_two_hands = false;
   for (const auto& goal : database.handover_goals(part.id)) {
     if (goal.rank != 0) continue;
@@ -93,12 +98,13 @@ std::map<std::string, PostureScores> score_postures(const core::Cell& cell,
   const int torso = human.joints()[human.joint_index("torso_flexion")].variable;
   for (const auto& e : stored) {
     PostureScores& s = out[e.method];
+    const auto it = std::find_if(again.begin(), again.end(),
+                                 [&](const auto& r) { return r.method == e.method; });
+    if (it != again.end()) s.reorientation_deg = it->reorientation_deg;
     if (!e.reachable) {
       s.why = "unreachable";
       continue;
     }
-    const auto it = std::find_if(again.begin(), again.end(),
-                                 [&](const auto& r) { return r.method == e.method; });
     const std::size_t k = static_cast<std::size_t>(it - again.begin());
     if (it == again.end() || !it->reachable || it->arm != e.arm ||
         std::abs(it->torso_flexion_deg - e.torso_flexion_deg) > kSameAngleDeg ||
@@ -162,7 +168,12 @@ std::string compare(double ours, double theirs, double tolerance, const char* be
   return "the same";
 }
 
-nlohmann::json ergonomics_json(const db::Database& database, const core::Cell& cell) {
+// The part's symmetries by part name, from the product file's meshes where they are the meshes
+// the database was built from (the same hash); a part without is charged the plain angle.
+using Symmetries = std::map<std::string, std::vector<Eigen::Matrix3d>>;
+
+nlohmann::json ergonomics_json(const db::Database& database, const core::Cell& cell,
+                               const Symmetries& symmetries) {
   nlohmann::json boards = nlohmann::json::array();
   std::map<std::string, Totals> totals;
   // Without comfort maps, or with a human model the scores cannot read, every board says why.
@@ -176,9 +187,14 @@ nlohmann::json ergonomics_json(const db::Database& database, const core::Cell& c
   for (const auto& part : database.parts()) {
     nlohmann::json row = {{"part", part.name}, {"order", part.assembly_order}};
     std::map<std::string, PostureScores> scores;
+    const auto sym = symmetries.find(part.name);
+    row["symmetries"] =
+        sym != symmetries.end() ? nlohmann::json(sym->second.size()) : nlohmann::json(nullptr);
     if (comfort) {
       try {
-        scores = score_postures(cell, *comfort, database, part);
+        scores =
+            score_postures(cell, *comfort, database, part,
+                           sym != symmetries.end() ? sym->second : std::vector<Eigen::Matrix3d>{});
       } catch (const core::InputError& e) {
         no_scores = e.what();
       }
@@ -205,9 +221,12 @@ nlohmann::json ergonomics_json(const db::Database& database, const core::Cell& c
       } else {
         ++t.unreachable;
       }
-      t.reorientation += e.reorientation_deg;
-      m["reorientation_deg"] = e.reorientation_deg;
       const auto sc = scores.find(e.method);
+      const double reorientation = sc != scores.end() && sc->second.reorientation_deg >= 0.0
+                                       ? sc->second.reorientation_deg
+                                       : e.reorientation_deg;
+      t.reorientation += reorientation;
+      m["reorientation_deg"] = reorientation;
       if (sc != scores.end() && sc->second.scored) {
         const PostureScores& p = sc->second;
         ++t.scored;
@@ -326,7 +345,23 @@ int run_report(ReportOptions opt) {
   const db::Database database = db::Database::open(opt.database);
   const auto cell =
       core::Cell::load(opt.html.cell_file.empty() ? default_cell_path() : opt.html.cell_file);
-  const auto j = ergonomics_json(database, *cell);
+  // The parts' symmetries, from the product file where its meshes are the database's.
+  Symmetries symmetries;
+  try {
+    const core::ProductSpec product = core::load_product(
+        opt.html.product_file.empty() ? default_product_path() : opt.html.product_file);
+    for (const auto& part : database.parts()) {
+      for (const auto& p : product.parts) {
+        if (p.name == part.name && offline::mesh_hash(p.mesh) == part.mesh_hash) {
+          symmetries[part.name] = core::mesh_symmetries(p.mesh);
+        }
+      }
+    }
+  } catch (const core::InputError&) {
+    // No product file at hand: the stored re-orientation (the build's, modulo the symmetries
+    // where it knew them) stands.
+  }
+  const auto j = ergonomics_json(database, *cell, symmetries);
   if (opt.json) {
     std::cout << j.dump(2) << "\n";
     return 0;
@@ -397,7 +432,8 @@ void add_report_command(CLI::App& app, Action& action) {
                      "ergonomics, html without --plan: the database's cell YAML (default: the "
                      "bundled)");
   report->add_option("--product", opt->html.product_file,
-                     "html without --plan: the database's product YAML (default: the cabinet)");
+                     "ergonomics (the parts' symmetries), html without --plan: the database's "
+                     "product YAML (default: the cabinet)");
   report->add_option("-o,--output", opt->html.output, "html: the page to write");
   report->add_option("--three-js", opt->html.three_dir, "html: three.js folder (libjs-three)")
       ->capture_default_str();

@@ -19,6 +19,9 @@ inline constexpr double kFemaleStatureMean = 1.595;
 inline constexpr double kFemaleStatureP5 = 1.50;  // 5th-percentile woman
 inline constexpr double kMaleStatureP95 = 1.82;   // 95th-percentile man
 inline constexpr double kTallStature = 1.95;      // a tall man beyond the survey's 95th percentile
+// The statures human_dimensions accepts (m): adults, with room beyond the tested range.
+inline constexpr double kMinStature = 1.30;
+inline constexpr double kMaxStature = 2.20;
 
 struct HumanBodySpec {
   // Default: mean young Japanese adult male (AIST 1991-92 body-dimension survey).

@@ -119,6 +119,9 @@ std::string settings_hash(const BuildSettings& settings);
 // builds it.
 std::uint64_t part_seed(std::uint64_t seed, const std::string& part_name, std::uint64_t stream);
 
+// SHA-256 of a mesh as loaded (vertices and triangles, metres): db::PartRecord::mesh_hash.
+std::string mesh_hash(const core::TriangleMesh& mesh);
+
 // Builds the product database: part analysis, robot grasps with theta_c, suction and human
 // grasps and the human comfort maps (in parallel over parts and arms), then per board its
 // handover goals and the ergonomics comparison (in parallel over boards); written atomically

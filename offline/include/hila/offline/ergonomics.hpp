@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,10 @@ struct ErgonomicsInputs {
   core::Pose goal = core::Pose::Identity();
   int goal_arm = -1;
   int goal_grasp = -1;
+  // The part's symmetries (core::mesh_symmetries, part frame): the re-orientation left is the
+  // least over them (a board handed over turned by a half turn it is symmetric under needs none).
+  // Empty: the plain angle.
+  std::vector<Eigen::Matrix3d> symmetries;
 };
 
 // The three ways of getting one board to the human (records in the order hila, table, alone;

@@ -1,13 +1,15 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/comfort_map.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/core/human_model.hpp"
 #include "hila/core/pose.hpp"
-#include "hila/core/comfort_map.hpp"
 
 namespace hila::offline {
 
@@ -42,16 +44,13 @@ class HumanComfort {
 
  private:
   struct Body {
-    core::HumanBodySpec spec;
-    std::vector<core::Pose> world_to_base;  // per arm: inverse of the torso pose
-    std::vector<Eigen::Vector3d> shoulder;  // per arm, base frame
-    double scale = 1.0;                     // cell reach / this body's reach
+    std::shared_ptr<const core::HumanBody> body;  // its model and the scaled lookup
+    std::vector<core::Pose> world_to_base;        // per arm: inverse of the torso pose
   };
   std::vector<core::ComfortMap> maps_;
   std::vector<std::string> arm_names_;
   std::vector<core::Pose> arm_base_;
   std::vector<core::Pose> world_to_base_;
-  std::vector<Eigen::Vector3d> shoulder_;
   std::vector<Body> bodies_;
 };
 

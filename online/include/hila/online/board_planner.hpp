@@ -69,6 +69,19 @@ struct BoardPlanSettings {
   // human's arm reaches by inverse kinematics, uncomfortably; the rest are never tried. The
   // build's comfort threshold (paper §VI-B).
   double worker_comfort_floor = 0.06;
+  // Goals a person would choose. Among the goals the worker can take, those whose receiving
+  // posture (check_receiving_posture in receiving_scores.hpp: the worker's posture from the
+  // human arms' inverse kinematics, as the plan returns it) has no forward bend, every receiving
+  // elbow below its shoulder, the part's centre of mass between the worker's hip and shoulder
+  // height and a RULA grand score of at most natural_max_rula come first (the comfortable ones,
+  // then the uncomfortable, each in Eq. 8 order); then the others as without it. Eq. 8 ranks by
+  // the arm's manipulability, which a hand above the shoulder can have; ergonomists would not
+  // choose it. false: the comfort tiers and Eq. 8 order only (also where the cell's human model
+  // is not one of `hila human`, whose joints the check reads).
+  bool natural_posture_first = true;
+  // RULA grand score a natural receiving posture keeps to: 3 and below is action level 1-2
+  // ("acceptable", or "investigate further" at 3), what the issue asks of every handover.
+  int natural_max_rula = 3;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
@@ -160,11 +173,18 @@ struct BoardPlan {
   std::int64_t pick_grasp_id = 0;
   core::Pose set_down = core::Pose::Identity();
   double theta_c_deg = 90.0;
+  // The worker planned for: the scene's `worker` (Scene::worker), nullptr for the cell's own
+  // human. Its body's arms give human_joints and its model the receiving scores.
+  std::shared_ptr<const core::HumanBody> worker;
   double quality = 0.0;  // the comfort Q of the scene's human at the goal (paper Eq. 4)
   // Stored goals the scene's human reaches only uncomfortably (tried after the comfortable ones)
   // or not at all (never tried), among those checked (BoardPlanSettings::worker_comfort_floor).
   int goals_out_of_reach = 0;
   int goals_uncomfortable = 0;
+  // Goals whose receiving posture is natural (BoardPlanSettings::natural_posture_first), among
+  // those checked, and whether the chosen goal's is.
+  int goals_natural = 0;
+  bool natural_posture = false;
   // The human's receiving posture at the goal: each hand's arm and its joints (rad), from the
   // human arm's inverse kinematics for the scene's stance (the build's own where it stands as
   // built). Empty second arm for a one-hand goal.
@@ -254,6 +274,9 @@ class BoardPlanner {
 
   const PlannerModel& model_;
   BoardPlanSettings settings_;
+  // The cell's human is a model the natural posture's check reads (a `hila human` body); else
+  // the goals keep Eq. 8 order within the comfort tiers.
+  bool natural_check_works_ = true;
   // The LazyPRM baseline's roadmaps, kept between queries (settings.motion.planner kLazyPrm).
   std::map<std::string, std::unique_ptr<core::LazyPrmPlanner>> lazy_prm_;
 };

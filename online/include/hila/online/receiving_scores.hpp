@@ -1,10 +1,13 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hila/core/cell.hpp"
 #include "hila/core/ergonomic_scores.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/online/board_planner.hpp"
 
 namespace hila::online {
@@ -33,12 +36,43 @@ struct ReceivingScores {
   const core::RebaScore& reba() const { return hands[static_cast<std::size_t>(worst_reba)].reba; }
 };
 
+// RULA and REBA of a receiving posture: the arms' chain joints (`arms`: the goal's hand first),
+// the rest of the human at its neutral posture, on `body` (nullptr: the cell's human), holding
+// `load_kg` (two hands where `arms` has two). Throws core::InputError as below.
+ReceivingScores receiving_scores(const core::Cell& cell, const core::HumanBody* body,
+                                 const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms,
+                                 double load_kg);
+
+// Where a receiving posture puts the worker (docs/online.md, "Goals a person would choose"):
+// the torso's forward bend, whether every receiving elbow is below its shoulder, and the part's
+// centre of mass against the worker's hip and shoulder heights (world z, the human at `stance`),
+// with the posture's RULA grand score (the worse hand's).
+struct PostureCheck {
+  double trunk_flexion_deg = 0.0;     // the torso joint, forward positive
+  bool elbow_below_shoulder = false;  // every receiving hand's elbow joint below its shoulder
+  double part_centre_z = 0.0;         // m, world
+  double hip_z = 0.0;                 // m, world: the torso's hip joint
+  double shoulder_z = 0.0;            // m, world: the lower receiving shoulder joint
+  int rula_grand = 0;
+  // No forward bend (within core::kNeutralBandDeg), the elbows below the shoulders, the centre
+  // between hip and shoulder height, RULA grand at most `max_rula`.
+  bool natural(int max_rula) const {
+    return trunk_flexion_deg <= core::kNeutralBandDeg && elbow_below_shoulder &&
+           part_centre_z >= hip_z && part_centre_z <= shoulder_z && rula_grand <= max_rula;
+  }
+};
+PostureCheck check_receiving_posture(
+    const core::Cell& cell, const core::HumanBody* body, const core::Pose& stance,
+    const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms,
+    const Eigen::Vector3d& part_centre, double load_kg);
+
 // Scores the posture the planner hands the board over at: plan.human_joints on plan.human_arm
 // (and plan.second_human_joints on plan.second_human_arm), the rest of the human at
-// cell.human_neutral() (core::human_posture), holding `load_kg`. RULA scores each hand with its
-// share of the load (half with two hands), REBA with the whole load. Nothing scored (scored
-// false) for a plan without a posture. Throws core::InputError where the cell's human model is
-// not one of generate_human_urdf or its arms are not named "left" and "right"; meant for the
+// cell.human_neutral() (core::human_posture), holding `load_kg`; on the plan's worker's body
+// where it names one (BoardPlan::worker: its model, its neutral posture). RULA scores each hand
+// with its share of the load (half with two hands), REBA with the whole load. Nothing scored
+// (scored false) for a plan without a posture. Throws core::InputError where the cell's human model
+// is not one of generate_human_urdf or its arms are not named "left" and "right"; meant for the
 // output edge, after planning.
 ReceivingScores receiving_scores(const core::Cell& cell, const BoardPlan& plan, double load_kg);
 

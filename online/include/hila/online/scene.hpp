@@ -2,11 +2,13 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/core/mesh.hpp"
 #include "hila/core/pose.hpp"
 #include "hila/core/product.hpp"
@@ -42,6 +44,11 @@ struct Scene {
   core::Pose assembly_frame = core::Pose::Identity();  // where the assembly stands (world)
   std::vector<FinishedBoard> finished;                 // in assembly order
   core::Pose human_stance = core::Pose::Identity();
+  // The worker who is there (`worker:`): a body of `hila human` standing at human_stance, for
+  // which the goals' comfort, reach and posture are evaluated; nullptr: the cell's own human.
+  // Built with core::HumanBody(cell, spec), once per scene file; shared by the scenes that
+  // follow from it (with_finished).
+  std::shared_ptr<const core::HumanBody> worker;
   std::vector<SceneObstacle> obstacles;
   std::map<std::string, Eigen::VectorXd> robot;  // arm name -> current joints (every arm)
 
@@ -62,7 +69,8 @@ SceneFiles read_scene_files(const std::string& path);
 
 // Reads and checks a scene file against the cell and the product: unknown boards, arms or
 // fields, non-finite numbers, a board detected below the table top, a board both finished and
-// detected, joints outside their limits, a human stance over the table. Throws core::InputError
+// detected, joints outside their limits, a human stance over the table, a worker's stature or
+// sex out of their domain or a body the cell's human arms do not fit. Throws core::InputError
 // "FILE: FIELD: expected X, got Y".
 Scene load_scene(const std::string& path, const core::Cell& cell, const core::ProductSpec& product);
 

@@ -8,6 +8,7 @@
 #include "hila/core/cell.hpp"
 #include "hila/core/comfort.hpp"
 #include "hila/core/comfort_map.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/core/pose.hpp"
 #include "hila/db/records.hpp"
 
@@ -21,6 +22,9 @@ namespace hila::online {
 // The maps are in each human arm's base frame (the torso at the neutral posture), so the same
 // map serves any stance: the arm base moves with the stance frame. The lookup is the build's
 // (offline::HumanComfort::quality), so at the cell's stance a goal's quality is the stored one.
+// A worker of another body (`worker:` in the scene, a core::HumanBody) is served by the same maps
+// through the scaled-copy property (core::HumanBody::to_cell_arm, the build's lookup for a body
+// set); every function takes that body, nullptr for the cell's own human.
 // Immutable after construction; safe to share between threads.
 class WorkerComfort {
  public:
@@ -30,22 +34,25 @@ class WorkerComfort {
                 const std::string& database_path);
 
   // Q with hand `arm` holding the part by `hand_in_part` while the part is at `part` (world),
-  // for the human standing at `stance`; 0 out of reach (or for an arm the cell has not).
+  // for the human of `body` (nullptr: the cell's) standing at `stance`; 0 out of reach (or for an
+  // arm the cell has not).
   double hand_quality(const std::string& arm, const core::Pose& part,
-                      const core::Pose& hand_in_part, const core::Pose& stance) const;
+                      const core::Pose& hand_in_part, const core::Pose& stance,
+                      const core::HumanBody* body = nullptr) const;
 
   // The goal's quality for the human at `stance`: its human grasp's, or the weaker hand's for a
   // two-hand goal. `human_grasps` by id (the part's). 0 when a grasp is missing.
   double goal_quality(const db::HandoverCandidateRecord& goal,
                       const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
-                      const core::Pose& stance) const;
+                      const core::Pose& stance, const core::HumanBody* body = nullptr) const;
 
   // Whether the human at `stance` reaches the goal's grasp with every hand it needs, by inverse
   // kinematics of the human arm (core::best_comfort, as the build confirms its first goals): from
   // the build's posture where the goal has one (a human a few centimetres off the built stance
   // is a few iterations away), then up to 8 seeded restarts, stopping at the first solution. The
   // weaker hand's Q at the postures found. The maps are sampled (a bin no sample reached reads
-  // 0), so a low map Q does not mean out of reach; this does.
+  // 0), so a low map Q does not mean out of reach; this does. With `body`, that body's own arms
+  // (its chains, its torso at the stance; the build's posture is only the first seed).
   struct GoalReach {
     bool reachable = false;
     double quality = 0.0;                   // the weaker hand's Q at the postures found
@@ -54,7 +61,7 @@ class WorkerComfort {
   // Needs the cell's human arms only, not the maps: callable without loading them.
   static GoalReach goal_reach(const core::Cell& cell, const db::HandoverCandidateRecord& goal,
                               const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
-                              const core::Pose& stance,
+                              const core::Pose& stance, const core::HumanBody* body = nullptr,
                               const core::ComfortSettings& ik = reach_settings());
   // For a reach check: 8 attempts, stopping at the first solution, to 1e-7 m and rad (far below
   // what a human hand notices).
