@@ -49,7 +49,7 @@ constexpr const char* kUsage =
     "usage: bench_online [--db FILE] [--scene FILE] [--variations N] [--boards a,b]\n"
     "                    [--deadline S] [--planners hila,rrt_connect,lazy_prm] [--seed N]\n"
     "                    [--overlap-validation yes|no] [--held-resolution RAD]\n"
-    "                    [--way-orders fixed,cheapest] [--json FILE]\n"
+    "                    [--variants fixed,cheapest,fixed+eq8] [--json FILE]\n"
     "  --db          the cabinet database (default: $HILA_BENCH_DATABASE, else\n"
     "                out/cabinet.hila)\n"
     "  --scene       the nominal scene (default: meshes/cabinet/scene.yaml)\n"
@@ -64,9 +64,10 @@ constexpr const char* kUsage =
     "  --held-resolution\n"
     "                rad between the checked samples of a held board's motions, for every\n"
     "                planner (MotionSettings::held_resolution, default 0.04)\n"
-    "  --way-orders  also hila with other orders of the ways (BoardPlanSettings::way_order),\n"
-    "                interleaved: fixed (each goal's direct, regrasp, suction, exchange) and\n"
-    "                cheapest (every goal's ways by estimated robot time alone)\n"
+    "  --variants    also hila with other settings, interleaved; each a '+'-joined list of:\n"
+    "                fixed (each goal's ways in the order direct, regrasp, suction, exchange),\n"
+    "                cheapest (every goal's ways by estimated robot time alone), eq8 (goals in\n"
+    "                Eq. 8 order, natural receiving postures not first): fixed+eq8 is 0.14.0's\n"
     "  --json        also write every problem's figures to FILE\n";
 
 constexpr const char* kBuildHint =
@@ -86,7 +87,12 @@ struct Options {
                                                      online::MotionPlannerKind::kLazyPrm};
   std::uint64_t seed = 1;
   bool overlap_validation = true;
-  std::vector<online::WayOrder> way_orders;  // extra hila variants
+  struct Variant {
+    std::string name;
+    online::WayOrder way_order = online::WayOrder::kEstimatedTime;
+    bool natural_posture_first = true;
+  };
+  std::vector<Variant> variants;  // extra hila variants
   std::string json;
 };
 
@@ -161,15 +167,24 @@ Options parse(int argc, char** argv) {
           usage_error("--overlap-validation: expected yes or no, got '" + value + "'");
         }
         opt.overlap_validation = value == "yes";
-      } else if (arg == "--way-orders") {
+      } else if (arg == "--variants") {
         for (const auto& name : split_list(value)) {
-          if (name == "fixed") {
-            opt.way_orders.push_back(online::WayOrder::kFixed);
-          } else if (name == "cheapest") {
-            opt.way_orders.push_back(online::WayOrder::kCheapestFirst);
-          } else {
-            usage_error("--way-orders: expected fixed or cheapest, got '" + name + "'");
+          Options::Variant v;
+          v.name = name;
+          std::stringstream parts(name);
+          for (std::string part; std::getline(parts, part, '+');) {
+            if (part == "fixed") {
+              v.way_order = online::WayOrder::kFixed;
+            } else if (part == "cheapest") {
+              v.way_order = online::WayOrder::kCheapestFirst;
+            } else if (part == "eq8") {
+              v.natural_posture_first = false;
+            } else {
+              usage_error("--variants: expected fixed, cheapest or eq8 joined by '+', got '" +
+                          name + "'");
+            }
           }
+          opt.variants.push_back(v);
         }
       } else if (arg == "--json") {
         opt.json = value;
@@ -432,14 +447,15 @@ int main(int argc, char** argv) {
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
     names.emplace_back(online::to_string(kind));
   }
-  for (const auto order : opt.way_orders) {  // after the planners: their indices stay
+  for (const auto& v : opt.variants) {  // after the planners: their indices stay
     online::BoardPlanSettings s;
     s.overlap_validation = opt.overlap_validation;
     s.motion.held_resolution = opt.held_resolution;
-    s.way_order = order;
+    s.way_order = v.way_order;
+    s.natural_posture_first = v.natural_posture_first;
     settings.push_back(s);
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
-    names.push_back(std::string("hila (ways: ") + online::to_string(order) + ")");
+    names.push_back("hila (" + v.name + ")");
   }
 
   std::vector<Problem> problems;
