@@ -352,8 +352,11 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       hip_z = std::min(hip_z, base.translation().z());
       shoulder_z = std::max(shoulder_z, (base * arm.chain.first_joint_position()).z());
     }
+    // Only the first goal_limit goals are tried: once that many are natural, the rest are not
+    // looked at (the same goals, in the same order).
     for (const auto* list : {&goals, &below_comfort}) {
       for (const auto* goal : *list) {
+        if (first.size() >= goal_limit) break;
         const double z = (goal->board * centre).z();
         if (z < hip_z || z > shoulder_z) continue;
         const auto& r = reach(*goal, false);

@@ -621,7 +621,9 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
                 .variable];
       if (std::abs(trunk) < 1e-12 && elbows_low && rula <= 3) natural.push_back(goal.id);
     }
-    EXPECT_EQ(plan.goals_natural, static_cast<int>(natural.size()));
+    // The planner looks no further once it has as many natural goals as it tries.
+    EXPECT_EQ(plan.goals_natural,
+              std::min(static_cast<int>(natural.size()), online::BoardPlanSettings{}.goals));
     ASSERT_FALSE(plan.attempts.empty());
     if (natural.empty()) {
       EXPECT_FALSE(plan.natural_posture);
