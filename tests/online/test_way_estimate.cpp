@@ -206,7 +206,8 @@ TEST_F(WayEstimate, AnExchangesEstimateIsItsStoredDurationsAndStraightMoves) {
 // With a crate where the first goals hand the board over, the planner runs through many of
 // their ways: within each goal they come in the order of their estimates (exchanges the offline
 // graph connected first), and in the fixed order (the baseline) they do not always — so the
-// check tells the two apart. Neither order plans anything invalid.
+// check tells the two apart. With every goal's ways by estimate alone (kCheapestFirst) the whole
+// sequence is in that order. No order plans anything invalid.
 TEST_F(WayEstimate, AGoalsWaysArePlannedInTheOrderOfTheirEstimates) {
   const online::PlannerModel& m = model();
   const online::Scene scene = crate_scene(m, "lateral_right", 3);
@@ -256,7 +257,25 @@ TEST_F(WayEstimate, AGoalsWaysArePlannedInTheOrderOfTheirEstimates) {
   EXPECT_GE(timed_pairs, 3) << "too few ways of one goal tried to see their order";
   EXPECT_GT(out_of_order(baseline, baseline_pairs), 0)
       << "the fixed order happened to be the estimates' here: the check cannot fail";
-  for (const auto* plan : {&timed, &baseline}) {
+  // Every goal's ways by estimate alone (the measurement setting): one sequence across goals.
+  online::BoardPlanSettings cheapest;
+  cheapest.way_order = online::WayOrder::kCheapestFirst;
+  const online::BoardPlan across =
+      online::BoardPlanner(m, cheapest).plan(scene, "lateral_right", in_seconds(120.0));
+  std::set<std::int64_t> receive_failed;
+  int across_pairs = 0, across_wrong = 0;
+  for (std::size_t i = 0; i + 1 < across.attempts.size(); ++i) {
+    const auto& a = across.attempts[i];
+    const auto& b = across.attempts[i + 1];
+    if (a.step.rfind("receiving_", 0) == 0) receive_failed.insert(a.robot_grasp_id);
+    if (a.larger_bridges || b.larger_bridges || receive_failed.count(b.robot_grasp_id) > 0) continue;
+    ++across_pairs;
+    across_wrong += std::make_pair(!connected(b), b.estimated_seconds) <
+                    std::make_pair(!connected(a), a.estimated_seconds);
+  }
+  EXPECT_EQ(across_wrong, 0);
+  EXPECT_GE(across_pairs, 3);
+  for (const auto* plan : {&timed, &baseline, &across}) {
     if (plan->solved()) EXPECT_TRUE(plan->validated);
     for (const auto& a : plan->attempts) EXPECT_GT(a.estimated_seconds, 0.0);
   }
