@@ -276,7 +276,9 @@ TEST_F(WayEstimate, AGoalsWaysArePlannedInTheOrderOfTheirEstimates) {
   EXPECT_EQ(across_wrong, 0);
   EXPECT_GE(across_pairs, 3);
   for (const auto* plan : {&timed, &baseline, &across}) {
-    if (plan->solved()) EXPECT_TRUE(plan->validated);
+    if (plan->solved()) {
+      EXPECT_TRUE(plan->validated);
+    }
     for (const auto& a : plan->attempts) EXPECT_GT(a.estimated_seconds, 0.0);
   }
 }
