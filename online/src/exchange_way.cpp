@@ -24,18 +24,11 @@ constexpr double kSameCupAxis = 1.0 - 1e-9;
 }  // namespace
 
 bool Run::connected_offline(const db::HandoverCandidateRecord& goal,
-                            const db::SharedGraspRecord& shared) const {
-  for (const auto& e : edges_) {
-    if (!e.connected || e.kind != "transfer" || e.arm != receiving_.spec.name) continue;
-    const auto* to = node(e.to_node);
-    const auto* from = node(e.from_node);
-    if (to != nullptr && from != nullptr && to->candidate_id == goal.id &&
-        to->grasp_id == shared.robot_grasp_id &&
-        from->robot_handover_id == shared.robot_handover_id) {
-      return true;
-    }
-  }
-  return false;
+                            const db::SharedGraspRecord& shared) {
+  // A connected transfer of the receiving arm, stored by the build, from this exchange with this
+  // grasp to this goal (looked up in the index the estimates use).
+  return estimate_index().to_human.count(
+             {shared.robot_handover_id, shared.robot_grasp_id, goal.id}) > 0;
 }
 
 bool Run::receive_failed_at_same_pose(const db::SharedGraspRecord& shared) const {

@@ -154,7 +154,7 @@ class Run {
 
   // Whether the offline regrasp graph connected this goal with this shared grasp.
   bool connected_offline(const db::HandoverCandidateRecord& goal,
-                         const db::SharedGraspRecord& shared) const;
+                         const db::SharedGraspRecord& shared);
 
   // Whether the receiving arm's reach of the exchange failed with this shared grasp's robot grasp
   // at its board pose, under another robot-robot pose of the same board pose (another suction
@@ -306,7 +306,8 @@ class Run {
     std::map<std::pair<std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*> to_exchange;
     // (robot handover, robot grasp): the receiving arm's transit from home.
     std::map<std::pair<std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*> way_in;
-    // (robot handover, robot grasp, goal): the receiving arm's transfer to the human.
+    // (robot handover, robot grasp, goal): the receiving arm's transfer to the human (also what
+    // connected_offline() asks).
     std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*>
         to_human;
     // (arm, suction grasp, goal): the suction delivery's transfer from the pick.

@@ -37,8 +37,8 @@ const Run::EstimateIndex& Run::estimate_index() {
       index.way_in.try_emplace({to->robot_handover_id, to->grasp_id}, &e);
     } else if (e.kind == "transfer" && from->kind == "pick" && to->kind == "robot_handover") {
       index.to_exchange.try_emplace({to->robot_handover_id, from->grasp_id}, &e);
-    } else if (e.kind == "transfer" && from->kind == "robot_handover" &&
-               to->kind == "human_handover") {
+    } else if (e.kind == "transfer" && e.arm == receiving_.spec.name &&
+               from->kind == "robot_handover" && to->kind == "human_handover") {
       index.to_human.try_emplace({from->robot_handover_id, to->grasp_id, to->candidate_id}, &e);
     } else if (e.kind == "transfer" && from->kind == "pick" && to->kind == "human_handover") {
       index.on_cup.try_emplace({e.arm, to->grasp_id, to->candidate_id}, &e);
