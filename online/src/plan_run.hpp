@@ -219,6 +219,8 @@ class Run {
   // planner's speed scale. The tool is taken from (or set down on) its place where the way needs
   // it. Left out: the straight approaches, lifts and retreats of a few centimetres, which every
   // way has, and the detour a planned motion makes around what the straight move would cross.
+  // Infinite where no estimate can be made (a record naming an arm or pose the run lacks, the
+  // tool out of the suction arm's reach): such a way is tried after the others.
   double estimate(const db::HandoverCandidateRecord& goal, const db::DirectGraspRecord& direct);
   double estimate(const db::HandoverCandidateRecord& goal, const db::TableRegraspRecord& regrasp);
   double estimate(const db::HandoverCandidateRecord& goal,

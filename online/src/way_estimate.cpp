@@ -1,13 +1,24 @@
 // A way's estimated robot time before it is planned: what BoardPlanner orders a goal's ways by.
 
+#include <limits>
+
 #include "hila/core/time_parameterization.hpp"
 #include "plan_run.hpp"
 
 namespace hila::online::detail {
 
+namespace {
+
+// A way whose estimate cannot be made (its record names an arm or pose the run does not have, or
+// the tool it needs is out of the suction arm's reach): tried after every way that has one, where
+// its chain says why it fails.
+constexpr double kNoEstimate = std::numeric_limits<double>::infinity();
+
+}  // namespace
+
 double Run::straight_seconds(const core::Arm& arm, const Eigen::VectorXd& from,
                              const Eigen::VectorXd& to) const {
-  if (from.size() != to.size() || from.size() == 0) return 0.0;
+  if (from.size() != to.size() || from.size() == 0) return kNoEstimate;  // a malformed record
   return core::rest_to_rest_duration({from, to}, arm.spec.max_velocity,
                                      arm.spec.max_acceleration, settings_.speed_scale);
 }
@@ -51,9 +62,8 @@ double Run::tool_seconds() {
   if (tool_seconds_) return *tool_seconds_;
   const core::Pose tcp = scene_.tool * cell_.spec().suction.handle_in_tcp.inverse();
   const auto at = solutions(cell_, suction_, tcp, suction_.spec.home);
-  // Without an IK solution the tool way fails when planned; until then it counts as nothing.
   tool_seconds_ =
-      at.empty() ? 0.0 : 2.0 * straight_seconds(suction_, suction_.spec.home, at.front());
+      at.empty() ? kNoEstimate : 2.0 * straight_seconds(suction_, suction_.spec.home, at.front());
   return *tool_seconds_;
 }
 
@@ -64,7 +74,7 @@ Eigen::VectorXd Run::start_joints(const core::Arm& arm) const {
 double Run::estimate(const db::HandoverCandidateRecord& /*goal*/,
                      const db::DirectGraspRecord& direct) {
   const core::Arm* arm = arm_named(direct.arm);
-  if (arm == nullptr) return 0.0;
+  if (arm == nullptr) return kNoEstimate;
   // The suction arm sets the tool down first, from home.
   const bool tool_down = arm == &suction_ && start_.tool_in_hand;
   const Eigen::VectorXd from = tool_down ? arm->spec.home : start_joints(*arm);
@@ -77,7 +87,7 @@ double Run::estimate(const db::HandoverCandidateRecord& /*goal*/,
                      const db::TableRegraspRecord& regrasp) {
   const core::Arm* picker = arm_named(regrasp.arm);
   const core::Arm* repicker = arm_named(regrasp.repick_arm);
-  if (picker == nullptr || repicker == nullptr) return 0.0;
+  if (picker == nullptr || repicker == nullptr) return kNoEstimate;
   const bool tool_down = (picker == &suction_ || repicker == &suction_) && start_.tool_in_hand;
   auto from = [&](const core::Arm& arm) {
     return tool_down && &arm == &suction_ ? arm.spec.home : start_joints(arm);
@@ -98,7 +108,7 @@ double Run::estimate(const db::HandoverCandidateRecord& /*goal*/,
 double Run::estimate(const db::HandoverCandidateRecord& goal,
                      const db::SuctionDeliveryRecord& delivery) {
   const core::Arm* arm = arm_named(delivery.arm);
-  if (arm == nullptr) return 0.0;
+  if (arm == nullptr) return kNoEstimate;
   const bool tool_up = arm == &suction_ && !start_.tool_in_hand;
   const Eigen::VectorXd from = tool_up ? arm->spec.home : start_joints(*arm);
   double t = tool_up ? tool_seconds() : 0.0;
@@ -118,7 +128,7 @@ double Run::estimate(const db::HandoverCandidateRecord& goal,
 double Run::estimate(const db::HandoverCandidateRecord& goal,
                      const db::SharedGraspRecord& shared) {
   const auto rr_it = handovers_.find(shared.robot_handover_id);
-  if (rr_it == handovers_.end()) return 0.0;
+  if (rr_it == handovers_.end()) return kNoEstimate;
   const db::RobotHandoverRecord& rr = rr_it->second;
   // The suction arm: the tool where it is not in hand, the pick, the transfer to the exchange,
   // home once the other arm holds the board.
