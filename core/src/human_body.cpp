@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "hila/core/comfort.hpp"
 #include "hila/core/error.hpp"
@@ -112,6 +113,23 @@ Eigen::VectorXd HumanBody::posture(
     for (std::size_t i = 0; i < vars.size(); ++i) q[vars[i]] = joints[static_cast<Eigen::Index>(i)];
   }
   return q;
+}
+
+HeightBand natural_height_band(const Cell& cell, const HumanBody* body, const Pose& stance) {
+  const RobotModel& human = body != nullptr ? body->model() : cell.human();
+  std::vector<Pose> links;
+  human.link_poses(body != nullptr ? body->neutral() : cell.human_neutral(), links);
+  const std::vector<HumanArm>& arms = body != nullptr ? body->arms() : cell.human_arms();
+  HeightBand band;
+  band.hip_z = std::numeric_limits<double>::infinity();
+  band.shoulder_z = -band.hip_z;
+  for (const HumanArm& arm : arms) {
+    const Pose base =
+        stance * links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
+    band.hip_z = std::min(band.hip_z, base.translation().z());
+    band.shoulder_z = std::max(band.shoulder_z, (base * arm.chain.first_joint_position()).z());
+  }
+  return band;
 }
 
 }  // namespace hila::core

@@ -295,7 +295,7 @@ std::string settings_hash(const BuildSettings& s) {
        << ' ' << h.table_regrasp.placements << ' ' << h.table_regrasp.yaws << ' '
        << h.table_regrasp.support_tolerance << ' ' << h.swap_roles << ' ' << h.suction_delivery
        << ' ' << h.table_regrasp.relay << ' ' << h.table_regrasp.relay_spots << ' '
-       << h.table_regrasp.relay_spacing;
+       << h.table_regrasp.relay_spacing << ' ' << h.natural_candidates << ' ' << h.body_candidates;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& t = s.tool_relay;
   text << "\ntool_relay " << t.spacing << ' ' << t.yaw_steps << ' ' << t.clearance;
@@ -482,6 +482,13 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     s.comfortable = st.comfortable;
     s.comfortable_default_body = st.comfortable_default_body;
     s.goals = st.goals;
+    s.goals_per_body.assign(settings.human_bodies.size(), 0);
+    for (const auto& c : r.handover.candidates) {
+      if (c.status != "goal") continue;
+      for (std::size_t b = 0; b < s.goals_per_body.size(); ++b) {
+        if ((c.bodies >> b) & 1U) ++s.goals_per_body[b];
+      }
+    }
     s.robot_handovers = st.robot_handovers;
     s.two_hands = st.two_hands;
     s.handover_failure = st.failure;

@@ -29,6 +29,8 @@ const core::Pose kParked = core::Pose(Eigen::Translation3d(100.0, 100.0, 100.0))
 constexpr std::size_t kReachCensus = 200;
 // The human's fingers open this much wider than the grasp's aperture around the board.
 constexpr double kHandOpeningMargin = 0.01;
+// m: a natural band's candidates keep the part's centre this far inside the band's ends.
+constexpr double kBandMargin = 0.03;
 const Eigen::Vector3d kDown(0.0, 0.0, -1.0);
 
 double uniform01(std::mt19937_64& rng) {
@@ -99,7 +101,8 @@ void park_hand(core::CollisionData& data, const HandBodies& h) {
 
 // The human's choice at one candidate pose.
 struct HumanChoice {
-  double quality = 0.0;          // over the body set (weaker hand for two hands)
+  int body = -1;         // the worker chosen for: -1 the cell's human, else a body of the set
+  double quality = 0.0;  // that worker's (weaker hand for two hands)
   double default_quality = 0.0;  // the cell's human alone
   int arm = -1, grasp = -1;
   double arm_quality = 0.0;
@@ -113,15 +116,17 @@ struct ScoredGrasp {
   int grasp;
 };
 
-// Grasps of `arm` at `board`, best first, with positive Q.
-std::vector<ScoredGrasp> score_grasps(const HumanComfort& comfort, int arm, const core::Pose& board,
+// Grasps of `arm` at `board`, best first by the Q of worker `body` (-1: the cell's human, else a
+// body of the set), with positive Q.
+std::vector<ScoredGrasp> score_grasps(const HumanComfort& comfort, int body, int arm,
+                                      const core::Pose& board,
                                       const std::vector<db::HumanGraspRecord>& grasps,
                                       const std::vector<int>& eligible) {
   std::vector<ScoredGrasp> out;
   for (const int g : eligible) {
     const core::Pose hand = board * grasps[static_cast<std::size_t>(g)].hand;
-    const double q = comfort.worst_quality(arm, hand);
-    const double q0 = comfort.body_count() ? comfort.quality(arm, hand) : q;
+    const double q0 = comfort.quality(arm, hand);
+    const double q = body < 0 ? q0 : comfort.body_quality(body, arm, hand);
     if (q > 0.0 || q0 > 0.0) out.push_back({q, q0, g});
   }
   std::stable_sort(out.begin(), out.end(), [](const ScoredGrasp& a, const ScoredGrasp& b) {
@@ -279,14 +284,19 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     park_hand(screen_data, screen_hands[0]);
     park_hand(screen_data, screen_hands[1]);
   };
+  // The worker the human's grasps are chosen for (choose_human, rechoose_human): -1 the cell's
+  // human, else a body of the set.
+  int choosing_for = -1;
   auto choose_human = [&](const core::Pose& board) {
     HumanChoice best;
+    best.body = choosing_for;
     screen_data.set_body_pose(screen_board, board);
     const int arms = comfort.arm_count();
     if (!stage.two_hands) {
       for (int a = 0; a < arms; ++a) {
         int tried = 0;
-        for (const auto& s : score_grasps(comfort, a, board, grasps.human, eligible)) {
+        for (const auto& s :
+             score_grasps(comfort, choosing_for, a, board, grasps.human, eligible)) {
           if (s.quality <= best.quality && s.default_quality <= best.default_quality) break;
           if (++tried > 12) break;
           if (!human_hand_clear(board, 0, s.grasp)) continue;
@@ -306,13 +316,45 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     if (arms < 2) return best;
     std::vector<ScoredGrasp> lists[2];
     for (int a = 0; a < 2; ++a) {
-      for (const auto& s : score_grasps(comfort, a, board, grasps.human, both_hands)) {
+      for (const auto& s :
+           score_grasps(comfort, choosing_for, a, board, grasps.human, both_hands)) {
         if (lists[a].size() >= 10) break;
         if (human_hand_clear(board, a, s.grasp)) lists[a].push_back(s);
       }
     }
     choose_pair(board, lists, best);
     return best;
+  };
+
+  // The comfort of the human's choice h at candidate c for each worker: the cell human's Q
+  // (weaker hand) as the candidate's quality, what the online planner reads for the cell's
+  // human, and the bodies of the set that take it above comfort_threshold (c.bodies).
+  auto worker_quality = [&](const db::HandoverCandidateRecord& c, const HumanChoice& h, int body) {
+    auto one = [&](int arm, int grasp) {
+      const core::Pose hand = c.board * grasps.human[static_cast<std::size_t>(grasp)].hand;
+      return body < 0 ? comfort.quality(arm, hand) : comfort.body_quality(body, arm, hand);
+    };
+    const double q = one(h.arm, h.grasp);
+    return h.second_grasp >= 0 ? std::min(q, one(h.second_arm, h.second_grasp)) : q;
+  };
+  // `comfort_of_cell`: also the cell human's Q by the maps as the candidate's quality and each
+  // hand's (false where the cell human's own IK has just given them).
+  auto record_worker_set = [&](db::HandoverCandidateRecord& c, const HumanChoice& h,
+                               bool comfort_of_cell = true) {
+    c.bodies = 0;
+    if (h.grasp < 0) return;
+    if (comfort_of_cell) {
+      c.human_quality =
+          comfort.quality(h.arm, c.board * grasps.human[static_cast<std::size_t>(h.grasp)].hand);
+      if (h.second_grasp >= 0) {
+        c.second_quality = comfort.quality(
+            h.second_arm, c.board * grasps.human[static_cast<std::size_t>(h.second_grasp)].hand);
+      }
+      c.quality = worker_quality(c, h, -1);
+    }
+    for (int b = 0; b < comfort.body_count(); ++b) {
+      if (worker_quality(c, h, b) > settings.comfort_threshold) c.bodies |= 1U << b;
+    }
   };
 
   // --- Eq. 1 candidates and S ----------------------------------------------------------------
@@ -322,12 +364,39 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   double best_q = 0.0;
   // S's threshold: comfort_threshold, lowered towards comfort_floor for a part with no goal.
   double threshold = settings.comfort_threshold;
-  auto sample_candidates = [&](int until) {
-    while (static_cast<int>(result.candidates.size()) < until && stage.draws < settings.max_draws) {
-      ++stage.draws;
+  // Eq. 1: within max_rotation of the target's orientation and max_offset of its position.
+  auto draw_eq1 = [&] {
+    core::Pose pose = core::Pose::Identity();
+    pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
+    pose.translation() = target.translation() + random_in_ball(settings.max_offset, rng);
+    return pose;
+  };
+  // A natural band's: the orientation and the horizontal position of the part's centre as
+  // Eq. 1's (within max_rotation and max_offset of the target's), its height within the band
+  // (kept kBandMargin inside its ends): the target lowered or raised to where the worker holds
+  // it in front of the chest.
+  const Eigen::Vector3d target_centre = target * grasps.com;
+  auto draw_in_band = [&](const core::HeightBand& band) {
+    return [&, band] {
       core::Pose pose = core::Pose::Identity();
       pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
-      pose.translation() = target.translation() + random_in_ball(settings.max_offset, rng);
+      Eigen::Vector3d centre = target_centre + random_in_ball(settings.max_offset, rng);
+      centre.z() = band.hip_z + kBandMargin +
+                   uniform01(rng) * std::max(0.0, band.shoulder_z - band.hip_z - 2 * kBandMargin);
+      pose.translation() = centre - pose.linear() * grasps.com;
+      return pose;
+    };
+  };
+  // Candidates until there are `until`, drawn by `draw`, the human's grasps chosen for worker
+  // `body` (-1: the cell's human, else a body of the set).
+  std::vector<int> drawn_for;  // Eq. 1 and band candidates per worker (index body + 1)
+  auto sample_candidates = [&](int until, const auto& draw, int body) {
+    choosing_for = body;
+    drawn_for.resize(static_cast<std::size_t>(comfort.body_count() + 1), 0);
+    const int before = static_cast<int>(result.candidates.size());
+    while (static_cast<int>(result.candidates.size()) < until && stage.draws < settings.max_draws) {
+      ++stage.draws;
+      const core::Pose pose = draw();
       screen_data.set_body_pose(screen_board, pose);
       if (core::in_collision(screen, screen_data, {screen_board})) continue;
       db::HandoverCandidateRecord c;
@@ -351,6 +420,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         c.second_grasp_id = h.second_grasp;
         c.second_quality = h.second_quality;
       }
+      if (comfort.body_count() > 0) record_worker_set(c, h);
       if (h.default_quality > settings.comfort_threshold) ++stage.comfortable_default_body;
       if (h.quality > settings.comfort_threshold) ++stage.comfortable;
       if (h.quality > threshold) c.status = "no_shared_grasp";
@@ -359,6 +429,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     screen_data.set_body_pose(screen_board, kParked);
     stage.candidates = static_cast<int>(result.candidates.size());
+    drawn_for[static_cast<std::size_t>(body + 1)] += stage.candidates - before;
   };
   auto finish = [&](const std::string& failure) {
     stage.failure = failure;
@@ -419,7 +490,20 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       !(settings.suction_delivery && suction_within_payload)) {
     return finish(over_payload);
   }
-  sample_candidates(settings.candidates);
+  // Each worker's candidates: the cell's human's, then each body's of the set, each with the
+  // human's grasps chosen for that worker; then those of the workers' natural bands.
+  const int workers = comfort.body_count() + 1;  // worker w: body w - 1 (-1 the cell's human)
+  for (int w = 0; w < workers; ++w) {
+    sample_candidates(stage.candidates + (w == 0 ? settings.candidates : settings.body_candidates),
+                      draw_eq1, w - 1);
+  }
+  for (int w = 0; w < workers; ++w) {
+    const core::HeightBand band = core::natural_height_band(
+        cell, w == 0 ? nullptr : &comfort.body(w - 1), cell.spec().human_stance);
+    if (settings.natural_candidates > 0 && !band.contains(target_centre.z())) {
+      sample_candidates(stage.candidates + settings.natural_candidates, draw_in_band(band), w - 1);
+    }
+  }
   // Nothing to search for: no candidate, or none the human takes even at the comfort floor.
   if (!no_candidate_reason().empty() && settings.max_candidates <= settings.candidates &&
       (stage.candidates == 0 || best_q <= std::min(settings.comfort_floor, threshold))) {
@@ -900,10 +984,15 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   core::ComfortSettings ik_settings;
   ik_settings.ik_attempts = 12;
   ik_settings.seed = settings.seed;
-  auto solve_human = [&](const core::Pose& board, int arm, int grasp) {
-    const auto& chain = cell.human_arms()[static_cast<std::size_t>(arm)].chain;
-    const core::Pose hand = comfort.arm_base(arm).inverse() * board *
-                            grasps.human[static_cast<std::size_t>(grasp)].hand;
+  // `body` -1: the cell's human; else that body of the set, its own arm.
+  auto solve_human = [&](const core::Pose& board, int arm, int grasp, int body = -1) {
+    const auto a = static_cast<std::size_t>(arm);
+    const auto& chain = body < 0 ? cell.human_arms()[a].chain : comfort.body(body).arms()[a].chain;
+    const core::Pose base = body < 0
+                                ? comfort.arm_base(arm)
+                                : cell.spec().human_stance * comfort.body(body).base_in_stance(arm);
+    const core::Pose hand =
+        base.inverse() * board * grasps.human[static_cast<std::size_t>(grasp)].hand;
     const Eigen::VectorXd seed = Eigen::VectorXd::Zero(chain.dof())
                                      .cwiseMax(chain.lower_limits())
                                      .cwiseMin(chain.upper_limits());
@@ -919,14 +1008,15 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     auto& c = result.candidates[static_cast<std::size_t>(ci)];
     HumanChoice& h = choices[static_cast<std::size_t>(ci)];
     const int arms = std::min(comfort.arm_count(), 2);
-    // Per arm, the grasps of `from` the IK confirms, with the IK's Q.
+    choosing_for = h.body;  // chosen again for the worker the candidate was drawn for
+    // Per arm, the grasps of `from` the IK confirms (that worker's arm), with the IK's Q.
     auto confirm = [&](const std::vector<int>& from, std::vector<ScoredGrasp>(&out)[2]) {
       for (int a = 0; a < arms; ++a) {
         int tried = 0;
-        for (const auto& sg : score_grasps(comfort, a, c.board, grasps.human, from)) {
+        for (const auto& sg : score_grasps(comfort, choosing_for, a, c.board, grasps.human, from)) {
           if (++tried > 12) break;
           if (!human_hand_clear(c.board, a, sg.grasp)) continue;
-          const core::ComfortResult r = solve_human(c.board, a, sg.grasp);
+          const core::ComfortResult r = solve_human(c.board, a, sg.grasp, h.body);
           if (r.reachable && r.quality > threshold) out[a].push_back({r.quality, 0.0, sg.grasp});
         }
         park_hand(screen_data, screen_hands[a]);
@@ -934,6 +1024,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     };
     screen_data.set_body_pose(screen_board, c.board);
     HumanChoice best;
+    best.body = h.body;
     if (!eligible.empty()) {
       std::vector<ScoredGrasp> one[2];
       confirm(eligible, one);
@@ -964,9 +1055,13 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       c.second_arm = comfort.arm_name(best.second_arm);
       c.second_quality = best.second_quality;
     }
+    if (comfort.body_count() > 0) record_worker_set(c, h, h.body >= 0);
     return true;
   };
-  int verified = 0;
+  // Goals per worker (index body + 1).
+  std::vector<int> goals_of(static_cast<std::size_t>(comfort.body_count() + 1), 0);
+  // Goals confirmed by the human's IK, per worker (index body + 1).
+  std::vector<int> verified(static_cast<std::size_t>(comfort.body_count() + 1), 0);
   int human_ik_rejected = 0;  // candidates a way served that the human's own IK then rejected
   // At the robot-human pose the receiving arm and the board it holds move against the rest.
   std::vector<int> rh_bodies = receiving_bodies;
@@ -1151,10 +1246,16 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         if (shared == 0 && direct == 0 && regrasps == 0 && on_cup == 0) continue;
         // The first goals are confirmed by direct IK of the human arm(s): the map's orientation
         // bins are coarse, so a bin's Q may come from a neighbouring hand orientation.
-        if (verified < settings.human_ik_goals) {
-          const core::ComfortResult first = solve_human(c.board, h.arm, h.grasp);
+        int& confirmed = verified[static_cast<std::size_t>(h.body + 1)];
+        if (confirmed < settings.human_ik_goals) {
+          // The worker it was drawn for confirms it: a goal for a body other than the cell's
+          // human keeps no posture (the online planner solves the worker's own).
+          const int who = h.body;
+          const core::ComfortResult first = solve_human(c.board, h.arm, h.grasp, who);
           core::ComfortResult second;
-          if (h.second_grasp >= 0) second = solve_human(c.board, h.second_arm, h.second_grasp);
+          if (h.second_grasp >= 0) {
+            second = solve_human(c.board, h.second_arm, h.second_grasp, who);
+          }
           const double q =
               h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
           if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) || q <= threshold) {
@@ -1176,35 +1277,46 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
             }
             // Not comfortable after all: out of S.
             c.status = "uncomfortable";
-            c.quality = q;
+            if (who < 0) c.quality = q;  // the cell human's own IK; a body's leaves the maps' Q
             ++human_ik_rejected;
             if (threshold == settings.comfort_threshold) --stage.comfortable;
             if (!rechoose_allowed) ik_rejected.push_back(ci);
             continue;
           }
-          ++verified;
-          // Below the stated threshold the goal says how comfortable the human's own IK found it
-          // where that is less than the maps' Q: the plan reports it as delivered below.
-          if (threshold < settings.comfort_threshold) c.quality = std::min(c.quality, q);
-          c.human_joints = first.joints;
-          c.human_quality = first.quality;
-          if (h.second_grasp >= 0) {
-            c.second_joints = second.joints;
-            c.second_quality = second.quality;
+          ++confirmed;
+          if (who < 0) {
+            // Below the stated threshold the goal says how comfortable the human's own IK found
+            // it where that is less than the maps' Q: the plan reports it as delivered below.
+            if (threshold < settings.comfort_threshold) c.quality = std::min(c.quality, q);
+            c.human_joints = first.joints;
+            c.human_quality = first.quality;
+            if (h.second_grasp >= 0) {
+              c.second_joints = second.joints;
+              c.second_quality = second.quality;
+            }
           }
         }
         c.status = "goal";
         ++stage.goals;
+        ++goals_of[static_cast<std::size_t>(h.body + 1)];
       }
     }
     reset_state();
   };
   search_shared();
-  // Thin boards (few goals in the first batch) get more candidates, batch by batch.
-  while (stage.goals < settings.min_goals && stage.candidates < settings.max_candidates &&
-         stage.draws < settings.max_draws) {
-    sample_candidates(std::min(settings.max_candidates, stage.candidates + settings.candidates));
-    search_shared();
+  // Thin boards (a worker with few goals after the first batches) get more candidates for each
+  // such worker, batch by batch, up to max_candidates drawn for that worker.
+  for (bool thin = true; thin && stage.draws < settings.max_draws;) {
+    thin = false;
+    for (int w = 0; w < workers; ++w) {
+      const auto wi = static_cast<std::size_t>(w);
+      if (goals_of[wi] >= settings.min_goals || drawn_for[wi] >= settings.max_candidates) continue;
+      thin = true;
+      const int batch = std::min(w == 0 ? settings.candidates : settings.body_candidates,
+                                 settings.max_candidates - drawn_for[wi]);
+      sample_candidates(stage.candidates + batch, draw_eq1, w - 1);
+    }
+    if (thin) search_shared();
   }
   // No goal: the candidates the human's IK rejected, with the human's grasps chosen again by IK.
   rechoose_allowed = true;
@@ -1237,7 +1349,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       const HumanChoice& h = choices[i];
       if (c.status == "uncomfortable" && h.grasp >= 0 && h.quality > threshold) {
         c.status = "no_shared_grasp";
-        c.quality = h.quality;
+        c.quality = comfort.body_count() > 0 ? worker_quality(c, h, -1) : h.quality;
       }
     }
     searched = 0;

@@ -1,11 +1,12 @@
 #include "hila/offline/human_comfort.hpp"
 
+#include <algorithm>
 #include <sstream>
 
+#include "hila/core/comfort.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/kinematic_chain.hpp"
 #include "hila/core/robot_model.hpp"
-#include "hila/core/comfort.hpp"
 
 namespace hila::offline {
 
@@ -54,11 +55,10 @@ double HumanComfort::body_quality(int body, int arm, const core::Pose& hand) con
   return maps_[a].lookup(b.body->to_cell_arm(arm, b.world_to_base[a] * hand));
 }
 
-double HumanComfort::worst_quality(int arm, const core::Pose& hand) const {
-  if (bodies_.empty()) return quality(arm, hand);
-  double worst = 1.0;
-  for (int b = 0; b < body_count(); ++b) worst = std::min(worst, body_quality(b, arm, hand));
-  return worst;
+double HumanComfort::best_quality(int arm, const core::Pose& hand) const {
+  double best = quality(arm, hand);
+  for (int b = 0; b < body_count(); ++b) best = std::max(best, body_quality(b, arm, hand));
+  return best;
 }
 
 std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,

@@ -336,29 +336,22 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   // Goals a person would choose first: of the comfortable ones, then of those the worker reaches
   // only uncomfortably, those whose receiving posture is natural (the part's centre between hip
   // and shoulder height first: no inverse kinematics for the others).
-  std::set<std::int64_t> natural;
+  std::set<std::int64_t> natural, placed_first;  // natural ones; all put first (upright too)
   if (settings_.natural_posture_first && (body != nullptr || natural_check_works_)) {
-    std::vector<const db::HandoverCandidateRecord*> first;
+    // Natural (upright, RULA within natural_max_rula), then upright with a higher RULA: the
+    // elbow below the shoulder and the part in front of the chest wherever a goal allows it.
+    std::vector<const db::HandoverCandidateRecord*> first, upright;
     const Eigen::Vector3d centre = records->part.mass_properties.com;
     const core::HumanBody* checked_body = body;  // the cell's human: nullptr
-    std::vector<core::Pose> links;
-    const core::RobotModel& human = checked_body ? checked_body->model() : model_.cell().human();
-    human.link_poses(checked_body ? checked_body->neutral() : model_.cell().human_neutral(), links);
-    const auto& arms = checked_body ? checked_body->arms() : model_.cell().human_arms();
-    double hip_z = std::numeric_limits<double>::infinity(), shoulder_z = -hip_z;
-    for (const auto& arm : arms) {
-      const core::Pose base = scene.human_stance *
-                              links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
-      hip_z = std::min(hip_z, base.translation().z());
-      shoulder_z = std::max(shoulder_z, (base * arm.chain.first_joint_position()).z());
-    }
+    const core::HeightBand band =
+        core::natural_height_band(model_.cell(), checked_body, scene.human_stance);
     // Only the first goal_limit goals are tried: once that many are natural, the rest are not
     // looked at (the same goals, in the same order).
     for (const auto* list : {&goals, &below_comfort}) {
       for (const auto* goal : *list) {
         if (first.size() >= goal_limit) break;
         const double z = (goal->board * centre).z();
-        if (z < hip_z || z > shoulder_z) continue;
+        if (!band.contains(z)) continue;
         const auto& r = reach(*goal, false);
         if (!r.reachable) continue;
         std::vector<std::pair<std::string, Eigen::VectorXd>> held{{goal->human_arm, r.joints}};
@@ -366,21 +359,27 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
         const PostureCheck check =
             check_receiving_posture(model_.cell(), checked_body, scene.human_stance, held,
                                     goal->board * centre, part->mass);
-        if (!check.natural(settings_.natural_max_rula)) continue;
+        if (!check.upright()) continue;
+        if (list == &below_comfort) worker_quality[goal->id] = r.quality;
+        if (!check.natural(settings_.natural_max_rula)) {
+          upright.push_back(goal);
+          continue;
+        }
         natural.insert(goal->id);
         first.push_back(goal);
-        if (list == &below_comfort) worker_quality[goal->id] = r.quality;
       }
     }
     result.goals_natural = static_cast<int>(first.size());
+    first.insert(first.end(), upright.begin(), upright.end());
+    for (const auto* goal : first) placed_first.insert(goal->id);
     for (const auto* goal : goals) {
-      if (natural.count(goal->id) == 0) first.push_back(goal);
+      if (placed_first.count(goal->id) == 0) first.push_back(goal);
     }
     goals = std::move(first);
   }
   for (const auto* goal : below_comfort) {
     if (goals.size() >= goal_limit) break;
-    if (natural.count(goal->id) > 0) continue;  // already first
+    if (placed_first.count(goal->id) > 0) continue;  // already first
     const auto& r = reach(*goal);
     if (r.reachable) {
       goals.push_back(goal);

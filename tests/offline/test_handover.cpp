@@ -23,16 +23,19 @@ const core::ProductSpec& product() {
 }
 
 // Maps with a third of the default samples: sparser, which only makes S smaller.
-const offline::HumanComfort& comfort() {
-  static const offline::HumanComfort c = [] {
+const std::vector<core::ComfortMap>& comfort_maps() {
+  static const std::vector<core::ComfortMap> maps = [] {
     const auto cell = test::reference_cell();
-    std::vector<core::ComfortMap> maps;
+    std::vector<core::ComfortMap> m;
     core::ComfortMapSettings s;
     s.samples = 1000000;
-    for (const auto& arm : cell->human_arms())
-      maps.push_back(core::ComfortMap::build(arm.chain, s));
-    return offline::HumanComfort(*cell, maps);
+    for (const auto& arm : cell->human_arms()) m.push_back(core::ComfortMap::build(arm.chain, s));
+    return m;
   }();
+  return maps;
+}
+const offline::HumanComfort& comfort() {
+  static const offline::HumanComfort c(*test::reference_cell(), comfort_maps());
   return c;
 }
 
@@ -114,7 +117,7 @@ void check_stage(std::size_t index) {
   int comfortable = 0, goals = 0;
   for (const auto& c : result.candidates) {
     EXPECT_LT(angle_between(c.board.linear(), target.linear()), core::deg_to_rad(45.0));
-    EXPECT_LT((c.board.translation() - target.translation()).norm(), 0.5);
+    EXPECT_LT((c.board.translation() - target.translation()).norm(), 0.5);  // no band (below)
     for (std::size_t f = 0; f < index; ++f) {
       const auto& other = product().parts[f];
       EXPECT_FALSE(boxes_overlap(board_box(part, c.board),
@@ -464,4 +467,125 @@ TEST(Handover, ACellWithoutAnalyticIkIsAClearError) {
         offline::plan_handover_goals(*cell, product(), 0, board_grasps(0), comfort(), settings);
       },
       {"cell.yaml", "kinematics", "UR DH parameters"});
+}
+
+// The cabinet's top is fitted with its centre above the cell human's shoulder. Besides Eq. 1's
+// candidates the build draws natural_candidates with the centre between the human's hip and
+// shoulder height (core::natural_height_band), checked here independently of how they are drawn:
+// the orientation within 45 degrees of the target's, the centre within 0.5 m of the target's
+// horizontally and inside the band (recomputed from the human's link poses). Some become goals;
+// with the band off no goal has its centre there.
+TEST(Handover, APartFittedAboveTheShoulderGetsGoalsBetweenHipAndShoulder) {
+  const auto cell = test::reference_cell();
+  std::size_t index = 0;
+  while (product().parts[index].name != "top") ++index;
+  const auto& part = product().parts[index];
+  const auto grasps = board_grasps(index);
+  const core::Pose target = product().target_in_world(part);
+  const Eigen::Vector3d target_centre = target * grasps.com;
+  // The band from the human's link poses: the torso (arm base) to the higher shoulder joint.
+  std::vector<core::Pose> links;
+  cell->human().link_poses(cell->human_neutral(), links);
+  double hip = 1e9, shoulder = -1e9;
+  for (const auto& arm : cell->human_arms()) {
+    const core::Pose base =
+        cell->spec().human_stance *
+        links[static_cast<std::size_t>(cell->human().link_index(arm.spec.base_link))];
+    hip = std::min(hip, base.translation().z());
+    shoulder = std::max(shoulder, (base * arm.chain.first_joint_position()).z());
+  }
+  ASSERT_GT(target_centre.z(), shoulder) << "the top is no longer fitted above the shoulder";
+  offline::HandoverSettings settings;
+  const auto result =
+      offline::plan_handover_goals(*cell, product(), index, grasps, comfort(), settings);
+  ASSERT_EQ(result.stage.failure, "");
+  int band = 0, band_goals = 0;
+  for (const auto& c : result.candidates) {
+    if (c.sample < settings.candidates) continue;  // Eq. 1's
+    ++band;
+    const Eigen::Vector3d centre = c.board * grasps.com;
+    EXPECT_LT(angle_between(c.board.linear(), target.linear()), core::deg_to_rad(45.0));
+    EXPECT_LT((centre - target_centre).head<2>().norm(), 0.5);
+    EXPECT_GE(centre.z(), hip);
+    EXPECT_LE(centre.z(), shoulder);
+    band_goals += c.status == "goal" ? 1 : 0;
+  }
+  EXPECT_GE(band, settings.natural_candidates);
+  EXPECT_GT(band_goals, 0);
+
+  settings.natural_candidates = 0;
+  const auto without =
+      offline::plan_handover_goals(*cell, product(), index, grasps, comfort(), settings);
+  for (const auto& c : without.candidates) {
+    if (c.status != "goal") continue;
+    const double z = (c.board * grasps.com).z();
+    EXPECT_FALSE(z >= hip && z <= shoulder) << "goal " << c.sample << " in the band without it";
+  }
+}
+
+// A worker set (the cell's human, a 1.50 m woman and a 1.95 m man): each goal records the bodies
+// that take it comfortably, checked against each body's own comfort lookup at the stored grasps;
+// its quality is the cell human's (by the maps); and the woman, who has her own candidates and
+// grasps, takes more goals comfortably than in a build for the cell's human alone.
+TEST(Handover, AWorkerSetBuildsGoalsForEachBodyAndRecordsWhoTakesThem) {
+  const auto cell = test::reference_cell();
+  const std::vector<core::HumanBodySpec> bodies = {{1.50, core::Sex::Female},
+                                                   {1.95, core::Sex::Male}};
+  const offline::HumanComfort set(*cell, comfort_maps(), bodies);
+  const std::size_t index = 2;  // back_lower: one hand
+  const auto grasps = board_grasps(index);
+  offline::HandoverSettings settings;
+  const auto result = offline::plan_handover_goals(*cell, product(), index, grasps, set, settings);
+  ASSERT_EQ(result.stage.failure, "");
+  EXPECT_GE(result.stage.candidates, settings.candidates + 2 * settings.body_candidates);
+  auto arm_of = [&](const std::string& name) {
+    int a = 0;
+    while (set.arm_name(a) != name) ++a;
+    return a;
+  };
+  // Q of worker `body` (-1: the cell's human) at c's stored grasps, the weaker hand.
+  auto q_of = [&](const db::HandoverCandidateRecord& c, int body) {
+    auto one = [&](const std::string& arm, std::int64_t grasp) {
+      const core::Pose hand = c.board * grasps.human[static_cast<std::size_t>(grasp)].hand;
+      return body < 0 ? set.quality(arm_of(arm), hand) : set.body_quality(body, arm_of(arm), hand);
+    };
+    const double q = one(c.human_arm, c.human_grasp_id);
+    return c.second_arm.empty() ? q : std::min(q, one(c.second_arm, c.second_grasp_id));
+  };
+  int goals_for[2] = {0, 0};
+  for (const auto& c : result.candidates) {
+    if (c.human_grasp_id < 0) continue;
+    // (A candidate the cell human's own IK found uncomfortable keeps the IK's lower Q.)
+    if (c.status == "uncomfortable") {
+      EXPECT_LE(c.quality, q_of(c, -1) + 1e-12) << "candidate " << c.sample;
+    } else {
+      EXPECT_NEAR(c.quality, q_of(c, -1), 1e-12) << "candidate " << c.sample;
+    }
+    for (int b = 0; b < 2; ++b) {
+      const bool takes = q_of(c, b) > settings.comfort_threshold;
+      EXPECT_EQ((c.bodies >> b) & 1U, takes ? 1U : 0U) << "candidate " << c.sample << " body " << b;
+      if (takes && c.status == "goal") ++goals_for[b];
+    }
+  }
+  EXPECT_GT(goals_for[1], 0);
+  // The cell's human alone, the same maps: goals the woman takes comfortably.
+  const offline::HumanComfort woman_only(*cell, comfort_maps(), {bodies[0]});
+  const auto alone =
+      offline::plan_handover_goals(*cell, product(), index, grasps, comfort(), settings);
+  int hers_alone = 0;
+  for (const auto& c : alone.candidates) {
+    if (c.status == "goal" && c.human_grasp_id >= 0) {
+      const core::Pose hand =
+          c.board * grasps.human[static_cast<std::size_t>(c.human_grasp_id)].hand;
+      double q = woman_only.body_quality(0, arm_of(c.human_arm), hand);
+      if (!c.second_arm.empty()) {
+        q = std::min(q,
+                     woman_only.body_quality(
+                         0, arm_of(c.second_arm),
+                         c.board * grasps.human[static_cast<std::size_t>(c.second_grasp_id)].hand));
+      }
+      hers_alone += q > settings.comfort_threshold ? 1 : 0;
+    }
+  }
+  EXPECT_GT(goals_for[0], hers_alone);
 }

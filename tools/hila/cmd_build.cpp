@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "hila/core/cell.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/core/product.hpp"
 #include "hila/db/database.hpp"
 #include "hila/db/provenance.hpp"
@@ -138,8 +139,8 @@ int run_build(const BuildOptions& opt) {
               << std::setprecision(2) << m.seconds << " s)\n";
   }
   std::cout << "  handover goals (Eq. 1 candidates, S comfortable"
-            << (settings.human_bodies.empty() ? "" : " for every body")
-            << ", 𝕊 with a shared grasp):\n";
+            << (settings.human_bodies.empty() ? "" : " for one worker of the set at least")
+            << ", 𝕊 with a shared grasp; goal Q the cell human's):\n";
   std::cout
       << "  #  part           candidates    |S|    |𝕊|  rr poses  goal Q  distance m   time s\n";
   for (const auto& p : summary.parts) {
@@ -187,9 +188,14 @@ int run_build(const BuildOptions& opt) {
   }
   if (!settings.human_bodies.empty()) {
     std::cout << "  body set: " << offline::format_human_bodies(settings.human_bodies) << "\n";
+    std::cout << "    goals each body takes comfortably (of |𝕊|):\n";
     for (const auto& p : summary.parts) {
-      std::cout << "    " << p.name << ": " << p.comfortable << " of " << p.comfortable_default_body
-                << " comfortable candidates survive for every body\n";
+      std::cout << "    " << std::left << std::setw(14) << p.name << std::right;
+      for (std::size_t b = 0; b < p.goals_per_body.size(); ++b) {
+        std::cout << "  " << core::human_body_label(settings.human_bodies[b]) << " "
+                  << p.goals_per_body[b];
+      }
+      std::cout << "  (of " << p.goals << ")\n";
     }
   }
   const auto failed = summary.failed_parts();
@@ -244,8 +250,10 @@ void add_build_command(CLI::App& app, Action& action) {
                    "(the threshold itself: none below it)")
       ->capture_default_str()
       ->check(number_in(0.0, 1.0));
-  build->add_option("--bodies", opt->bodies,
-                    "human bodies every goal must suit, e.g. 1.50:female,1.722,1.88:male");
+  build->add_option(
+      "--bodies", opt->bodies,
+      "a worker set besides the cell's human: goals are built for each body and record which "
+      "bodies take them comfortably, e.g. 1.50:female,1.595:female,1.82:male,1.95:male");
   build
       ->add_option("--roadmap-nodes", opt->roadmap_nodes,
                    "PRM milestones per robot arm roadmap (fewer: a faster, sparser build)")

@@ -73,4 +73,14 @@ class HumanBody {
 // "1.5 female" (format_number of the stature).
 std::string human_body_label(const HumanBodySpec& spec);
 
+// The heights (m, world z) between which a worker holds a part in a natural posture: from the
+// hip (the arms' base link, the lower of the two) to the shoulder (the arms' first joint, the
+// higher), at the neutral posture standing at `stance`. `body` nullptr: the cell's human.
+struct HeightBand {
+  double hip_z = 0.0;
+  double shoulder_z = 0.0;
+  bool contains(double z) const { return z >= hip_z && z <= shoulder_z; }
+};
+HeightBand natural_height_band(const Cell& cell, const HumanBody* body, const Pose& stance);
+
 }  // namespace hila::core

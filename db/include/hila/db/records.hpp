@@ -129,7 +129,7 @@ struct HandoverCandidateRecord {
   int sample = 0;                             // index among the Eq. 1 candidates
   core::Pose board = core::Pose::Identity();  // world
   double distance = 0.0;  // Eq. 8: position offset + rotation weight * rotation angle, m
-  double quality = 0.0;   // best human Q (weaker hand for two-hand boards, worst body of the set)
+  double quality = 0.0;   // the cell human's best Q (weaker hand for two-hand boards)
   std::string status;
   int rank = -1;                    // 0-based among the goals, -1 for the others
   std::string human_arm;            // arm of the best human grasp ("" when none)
@@ -140,6 +140,9 @@ struct HandoverCandidateRecord {
   double second_quality = 0.0;
   Eigen::VectorXd human_joints;   // goals: best-Q IK of human_arm (empty otherwise), rad
   Eigen::VectorXd second_joints;  // goals of two-hand boards: IK of second_arm
+  // Bit i: body i of meta.human_bodies (the build's worker set) takes it above the comfort
+  // threshold at these grasps; 0 without a body set.
+  std::uint32_t bodies = 0;
 };
 
 // A robot grasp valid at both handover poses of a goal (the receiving arm's IK at each): the
@@ -185,7 +188,7 @@ struct TableRegraspRecord {
   Eigen::VectorXd joints_pick;                    // pick_grasp at the part's initial pose, rad
   Eigen::VectorXd joints_place;                   // pick_grasp at the placement
   Eigen::VectorXd joints_repick;                  // robot_grasp at the placement (repick_arm)
-  Eigen::VectorXd joints_rh;  // robot_grasp at the robot-human pose (repick_arm)
+  Eigen::VectorXd joints_rh;          // robot_grasp at the robot-human pose (repick_arm)
   double inclination_pick_deg = 0.0;  // opening axis vs gravity at each pose (<= theta_c)
   double inclination_place_deg = 0.0;
   double inclination_repick_deg = 0.0;

@@ -57,6 +57,9 @@ struct PartBuildSummary {
   int comfortable = 0;               // |S|
   int comfortable_default_body = 0;  // |S| for the cell's human alone
   int goals = 0;                     // |𝕊|
+  // With a body set: goals each body of the set takes comfortably (its bit of
+  // HandoverCandidateRecord::bodies), in the set's order.
+  std::vector<int> goals_per_body;
   int robot_handovers = 0;
   bool two_hands = false;
   double goal_quality = 0.0;     // the first goal's

@@ -22,6 +22,16 @@ struct HandoverSettings {
   int max_draws = 100000;          // give up drawing after this many
   double max_rotation_deg = 45.0;  // from the target orientation
   double max_offset = 0.5;         // m from the target position
+  // Natural bands: for each worker (the cell's human and every body of the set) whose natural
+  // band (core::natural_height_band: hip to shoulder height) the part's centre at its target
+  // lies outside of, this many more candidates with the part's centre in that band (the target's
+  // orientation within max_rotation_deg, its horizontal position within max_offset): goals the
+  // worker takes with the elbow low and the part in front of the chest, which the online planner
+  // tries first (BoardPlanSettings::natural_posture_first). 0: Eq. 1's candidates only.
+  int natural_candidates = 200;
+  // With a body set (BuildSettings::human_bodies), each body's own Eq. 1 candidates besides the
+  // cell human's `candidates`: the human's grasps chosen and the goal confirmed for that body.
+  int body_candidates = 250;
   // S (Eq. 9): the best human grasp's Q must exceed this. The cell human's Q peaks near 0.15
   // (a 7-DoF arm with the reach as length scale); 0.06 keeps the better ~40 % of the reachable
   // hand poses.

@@ -31,9 +31,9 @@ enum class WayOrder { kEstimatedTime, kFixed, kCheapestFirst };
 const char* to_string(WayOrder order);
 
 struct BoardPlanSettings {
-  double approach = 0.05;     // m: straight approach and retreat along the cup's / gripper's axis
-  double lift = 0.15;         // m: straight up from the table after the suction pick
-  int goals = 10;             // goals tried in Eq. 8 order
+  double approach = 0.05;  // m: straight approach and retreat along the cup's / gripper's axis
+  double lift = 0.15;      // m: straight up from the table after the suction pick
+  int goals = 10;          // goals tried in Eq. 8 order
   WayOrder way_order = WayOrder::kEstimatedTime;  // within each goal
   int exchange_bridges = 2;   // receiving-arm IK branches at the exchange given a bridge
   double speed_scale = 0.5;   // of the arms' velocity and acceleration limits
@@ -74,7 +74,9 @@ struct BoardPlanSettings {
   // human arms' inverse kinematics, as the plan returns it) has no forward bend, every receiving
   // elbow below its shoulder, the part's centre of mass between the worker's hip and shoulder
   // height and a RULA grand score of at most natural_max_rula come first (the comfortable ones,
-  // then the uncomfortable, each in Eq. 8 order); then the others as without it. Eq. 8 ranks by
+  // then the uncomfortable, each in Eq. 8 order), then the upright ones with a higher RULA (the
+  // elbow low and the part in front of the chest wherever a goal allows it, the first
+  // preference); then the others as without it. Eq. 8 ranks by
   // the arm's manipulability, which a hand above the shoulder can have; ergonomists would not
   // choose it. false: the comfort tiers and Eq. 8 order only (also where the cell's human model
   // is not one of `hila human`, whose joints the check reads).
@@ -117,7 +119,7 @@ struct GoalAttempt {
   int rank = -1;
   std::int64_t candidate_id = 0;
   DeliveryMode mode = DeliveryMode::kExchange;
-  std::string arm;  // the delivering arm
+  std::string arm;                     // the delivering arm
   std::int64_t robot_grasp_id = 0;     // 0 for the suction way
   std::int64_t suction_grasp_id = 0;   // the suction way's cup (the database's), else 0
   std::int64_t robot_handover_id = 0;  // 0 for a direct pick
@@ -195,8 +197,8 @@ struct BoardPlan {
   std::vector<PlanStep> steps;
   std::vector<GoalAttempt> attempts;
   double planning_seconds = 0.0;
-  PlanTimes times;           // of planning_seconds
-  double duration = 0.0;     // s, the robot's motion
+  PlanTimes times;        // of planning_seconds
+  double duration = 0.0;  // s, the robot's motion
   // The chosen way's estimated robot time (GoalAttempt::estimated_seconds), before the tool is
   // put back: beside `duration`, how good the estimate was.
   double estimated_seconds = 0.0;

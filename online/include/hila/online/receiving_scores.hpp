@@ -55,11 +55,13 @@ struct PostureCheck {
   double shoulder_z = 0.0;            // m, world: the lower receiving shoulder joint
   int rula_grand = 0;
   // No forward bend (within core::kNeutralBandDeg), the elbows below the shoulders, the centre
-  // between hip and shoulder height, RULA grand at most `max_rula`.
-  bool natural(int max_rula) const {
+  // between hip and shoulder height.
+  bool upright() const {
     return trunk_flexion_deg <= core::kNeutralBandDeg && elbow_below_shoulder &&
-           part_centre_z >= hip_z && part_centre_z <= shoulder_z && rula_grand <= max_rula;
+           part_centre_z >= hip_z && part_centre_z <= shoulder_z;
   }
+  // Upright, and RULA grand at most `max_rula`.
+  bool natural(int max_rula) const { return upright() && rula_grand <= max_rula; }
 };
 PostureCheck check_receiving_posture(
     const core::Cell& cell, const core::HumanBody* body, const core::Pose& stance,
