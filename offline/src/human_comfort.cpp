@@ -91,6 +91,12 @@ std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,
   if (bodies.empty()) {
     throw core::InputError("command line", field, "at least one STATURE[:SEX] item", "nothing");
   }
+  // Each goal records the bodies that take it as bits of a 32-bit mask.
+  if (bodies.size() > kMaxHumanBodies) {
+    throw core::InputError("command line", field,
+                           "at most " + std::to_string(kMaxHumanBodies) + " bodies",
+                           std::to_string(bodies.size()));
+  }
   return bodies;
 }
 

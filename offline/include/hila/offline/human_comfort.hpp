@@ -56,6 +56,10 @@ class HumanComfort {
   std::vector<Body> bodies_;
 };
 
+// The most bodies a set may have: each goal records which take it as bits of a 32-bit mask
+// (HandoverCandidateRecord::bodies).
+inline constexpr std::size_t kMaxHumanBodies = 32;
+
 // Parses a body set: "STATURE[:SEX]" items joined by commas, e.g. "1.50:female,1.722,1.90:male"
 // (sex defaults to male). Throws InputError naming `field`.
 std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,
