@@ -140,6 +140,9 @@ struct HandoverCandidateRecord {
   double second_quality = 0.0;
   Eigen::VectorXd human_joints;   // goals: best-Q IK of human_arm (empty otherwise), rad
   Eigen::VectorXd second_joints;  // goals of two-hand boards: IK of second_arm
+  // Bit i: body i of meta.human_bodies (the build's worker set) takes it above the comfort
+  // threshold at these grasps; 0 without a body set.
+  std::uint32_t bodies = 0;
 };
 
 // A robot grasp valid at both handover poses of a goal (the receiving arm's IK at each): the
