@@ -507,7 +507,8 @@ TEST(Cli, InspectGraphShowsEachStoredEdgesCostAndEstimatedTime) {
   EXPECT_LT(estimated, blocks) << "handover edges have no path, so no time";
 
   // A file migrated from schema 8 (made from this one: regrasp_edges as versions 4 to 8 declared
-  // it, the 3 -> 4 step's text, then migrated), whose durations were never estimated: the text
+  // it, the 3 -> 4 step's text, handover_candidates without its schema 10 column, then migrated),
+  // whose durations were never estimated: the text
   // shows the cost without a time, the JSON 0.
   const std::string& step_v4 = db::detail::migration_steps().at(2).sql;
   const std::string to_v8 =
@@ -516,6 +517,7 @@ TEST(Cli, InspectGraphShowsEachStoredEdgesCostAndEstimatedTime) {
       "INSERT INTO regrasp_edges SELECT id, part_id, kind, arm, from_node, to_node, filter_id, "
       "connected, cost, path_nodes, via, path_dof, path_waypoints, path FROM regrasp_edges_v9;"
       "DROP TABLE regrasp_edges_v9;"
+      "ALTER TABLE handover_candidates DROP COLUMN bodies;"  // schema 10's, as in schema 8 to 9
       "UPDATE meta SET value = '8' WHERE key = 'schema_version';";
   sqlite3* handle = nullptr;
   ASSERT_EQ(sqlite3_open(db_path.c_str(), &handle), SQLITE_OK);
