@@ -622,11 +622,12 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.arm = s.next_text();
         r.joints = read_joints(s, path, "robot_handovers", "joints", r.id, fix);
       });
+  const std::size_t body_count = human_body_labels(db.meta_.human_bodies).size();
   db.handover_candidates_ = load_table<HandoverCandidateRecord>(
       *connection, "handover_candidates",
       "sample, " + pose_columns("board") +
           ", distance, quality, status, rank, human_arm, human_grasp_id, human_quality, "
-          "second_arm, second_grasp_id, second_quality, human_joints, second_joints",
+          "second_arm, second_grasp_id, second_quality, human_joints, second_joints, bodies",
       fix, verify, [&](detail::Statement& s, HandoverCandidateRecord& r) {
         r.sample = static_cast<int>(s.next_int64());
         r.board = read_pose(s, path, "handover_candidates", "board", r.id, fix);
@@ -642,6 +643,16 @@ Database Database::open(const std::string& path, const OpenOptions& options) {
         r.second_quality = s.next_double();
         r.human_joints = read_joints(s, path, "handover_candidates", "human_joints", r.id, fix);
         r.second_joints = read_joints(s, path, "handover_candidates", "second_joints", r.id, fix);
+        // Schema version 10: bit i for body i of meta.human_bodies. The file's CHECK bounds it to
+        // 32 bits (but is not verified on this read-only connection); the body count it cannot
+        // know.
+        const std::int64_t bodies = s.next_int64();
+        if (!detail::body_mask_fits(bodies, body_count)) {
+          throw DatabaseError(path, "handover_candidates.bodies (id " + std::to_string(r.id) + ")",
+                              detail::body_mask_expectation(db.meta_.human_bodies),
+                              std::to_string(bodies), fix);
+        }
+        r.bodies = static_cast<std::uint32_t>(bodies);
       });
   db.shared_grasps_ = load_rows<SharedGraspRecord>(
       *connection, "shared_grasps",

@@ -1,5 +1,6 @@
 #include "schema.hpp"
 
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -17,9 +18,22 @@ std::string hila_version() {
   return HILA_VERSION;
 }
 
+std::vector<std::string> human_body_labels(const std::string& human_bodies) {
+  static const std::string kSeparator = "; ";
+  std::vector<std::string> labels;
+  std::size_t begin = 0;
+  while (begin <= human_bodies.size()) {
+    std::size_t end = human_bodies.find(kSeparator, begin);
+    if (end == std::string::npos) end = human_bodies.size();
+    if (end > begin) labels.push_back(human_bodies.substr(begin, end - begin));
+    begin = end + kSeparator.size();
+  }
+  return labels;
+}
+
 // Bump together with a new entry in migration_steps() and a schema_sql() change.
 int current_schema_version() {
-  return 9;
+  return 10;
 }
 
 namespace detail {
@@ -53,7 +67,8 @@ CREATE TABLE comfort_maps (
 
 // The handover and ergonomics tables as schema version 3 defines them, one constant per table
 // (with its indexes). Both the current schema and the 2 -> 3 migration step create them from this
-// text; like kCreateComfortMapsV2, a later change goes into schema_sql() and leaves these to the
+// text, but for handover_candidates, which version 10 changed (kCreateHandoverCandidatesV10): like
+// kCreateComfortMapsV2, a later change goes into a constant of its own and leaves these to the
 // step.
 //
 // handover_stages.finished_parts is the part names joined by "\n" ("" for none); joint vectors
@@ -143,10 +158,79 @@ CREATE TABLE ergonomics (
 );
 )sql";
 
-// Every table schema version 3 adds, in schema order.
+// Every table schema version 3 adds, in schema order, as version 3 declared them (the 2 -> 3
+// step; schema_sql() has the version 10 handover_candidates, create_tables_v10()).
 std::string create_tables_v3() {
   return std::string(kCreateHandoverStagesV3) + kCreateRobotHandoversV3 +
          kCreateHandoverCandidatesV3 + kCreateSharedGraspsV3 + kCreateErgonomicsV3;
+}
+
+// The handover_candidates table as schema version 10 defines it (with its index): version 3's
+// with bodies, the bodies of meta.human_bodies (the build's worker set) that take the candidate
+// above the comfort threshold at its stored grasps, bit i for body i in stored order
+// (records::HandoverCandidateRecord::bodies, an unsigned 32-bit mask; 0 without a body set, and on
+// every row migrated from version 9 or earlier: not computed). Created by schema_sql() and by the
+// 9 -> 10 step (rebuild_handover_candidates_v10) from this text; kCreateHandoverCandidatesV3 stays
+// for the 2 -> 3 step.
+constexpr const char* kCreateHandoverCandidatesV10 = R"sql(
+CREATE TABLE handover_candidates (
+  id INTEGER PRIMARY KEY,
+  part_id INTEGER NOT NULL REFERENCES parts(id),
+  sample INTEGER NOT NULL,
+  board_x REAL NOT NULL, board_y REAL NOT NULL, board_z REAL NOT NULL,
+  board_qw REAL NOT NULL, board_qx REAL NOT NULL, board_qy REAL NOT NULL, board_qz REAL NOT NULL,
+  distance REAL NOT NULL,
+  quality REAL NOT NULL,
+  status TEXT NOT NULL CHECK (status IN ('uncomfortable', 'no_shared_grasp', 'goal')),
+  rank INTEGER NOT NULL,
+  human_arm TEXT NOT NULL,
+  human_grasp_id INTEGER NOT NULL,
+  human_quality REAL NOT NULL,
+  second_arm TEXT NOT NULL,
+  second_grasp_id INTEGER NOT NULL,
+  second_quality REAL NOT NULL,
+  human_joints BLOB NOT NULL,
+  second_joints BLOB NOT NULL,
+  bodies INTEGER NOT NULL CHECK (bodies >= 0 AND bodies < 4294967296),
+  CHECK ((status = 'goal' AND rank >= 0) OR (status <> 'goal' AND rank = -1))
+);
+CREATE INDEX handover_candidates_part_id ON handover_candidates(part_id);
+)sql";
+
+// The 9 -> 10 step: the version 10 handover_candidates in place of the version 9 one (which is
+// version 3's), every row kept with bodies 0 (not computed). The column is first added as ALTER
+// TABLE adds one, at the end, every row's its DEFAULT 0 (and the step fails, leaving the file as it
+// was, on a table that has the column already: a version 10 file whose version was set back). Then
+// the table is rebuilt, as the 8 -> 9 step rebuilt regrasp_edges, so that the file declares it
+// exactly as a fresh one does (an added column keeps its DEFAULT): the old table renamed out of the
+// way (its index dropped, so the name is free), the version 10 one created, the rows copied with
+// their ids, the old one dropped. Unlike regrasp_edges, handover_candidates is referred to by
+// shared_grasps, direct_grasps, table_regrasps, suction_deliveries and regrasp_nodes: the rename
+// runs with legacy_alter_table on (and the migration's connection has foreign_keys off), so that
+// their REFERENCES handover_candidates(id) are left as they are, naming the new table once it is
+// created, rather than rewritten to the old one's new name.
+constexpr const char* kHandoverCandidatesColumnsV10 =
+    "id, part_id, sample, board_x, board_y, board_z, board_qw, board_qx, board_qy, board_qz, "
+    "distance, quality, status, rank, human_arm, human_grasp_id, human_quality, second_arm, "
+    "second_grasp_id, second_quality, human_joints, second_joints, bodies";
+
+std::string rebuild_handover_candidates_v10() {
+  return std::string(
+             "ALTER TABLE handover_candidates ADD COLUMN bodies INTEGER NOT NULL DEFAULT 0;\n"
+             "DROP INDEX handover_candidates_part_id;\n"
+             "PRAGMA legacy_alter_table = ON;\n"
+             "ALTER TABLE handover_candidates RENAME TO handover_candidates_v9;\n"
+             "PRAGMA legacy_alter_table = OFF;\n") +
+         kCreateHandoverCandidatesV10 + "INSERT INTO handover_candidates (" +
+         kHandoverCandidatesColumnsV10 + ")\n  SELECT " + kHandoverCandidatesColumnsV10 +
+         " FROM handover_candidates_v9 ORDER BY id;\n" + "DROP TABLE handover_candidates_v9;\n";
+}
+
+// The handover and ergonomics tables as schema version 10 has them: version 3's with
+// kCreateHandoverCandidatesV10. What schema_sql() creates.
+std::string create_tables_v10() {
+  return std::string(kCreateHandoverStagesV3) + kCreateRobotHandoversV3 +
+         kCreateHandoverCandidatesV10 + kCreateSharedGraspsV3 + kCreateErgonomicsV3;
 }
 
 // The roadmap and regrasp-graph tables as schema version 4 defines them, one constant per table
@@ -432,11 +516,11 @@ CREATE INDEX suction_deliveries_candidate_id ON suction_deliveries(candidate_id)
 
 // Written out in full (not generated) so this file is the readable reference of the schema (the
 // comfort_maps table is kCreateComfortMapsV2 above, the handover and ergonomics tables the
-// kCreate...V3 constants, the roadmap and regrasp-graph tables the kCreate...V4 ones but for
-// regrasp_edges, kCreateRegraspEdgesV9, the direct_grasps table kCreateDirectGraspsV5, the
-// table_regrasps table kCreateTableRegraspsV8, the suction_deliveries table
-// kCreateSuctionDeliveriesV8).
-// Poses are (x, y, z) in metres and a unit quaternion (qw, qx, qy, qz) with qw >= 0.
+// kCreate...V3 constants but for handover_candidates, kCreateHandoverCandidatesV10, the roadmap and
+// regrasp-graph tables the kCreate...V4 ones but for regrasp_edges, kCreateRegraspEdgesV9, the
+// direct_grasps table kCreateDirectGraspsV5, the table_regrasps table kCreateTableRegraspsV8, the
+// suction_deliveries table kCreateSuctionDeliveriesV8). Poses are (x, y, z) in metres and a unit
+// quaternion (qw, qx, qy, qz) with qw >= 0.
 const std::string& schema_sql() {
   static const std::string sql = R"sql(
 CREATE TABLE meta (
@@ -516,7 +600,7 @@ CREATE TABLE human_grasps (
 );
 CREATE INDEX human_grasps_part_id ON human_grasps(part_id);
 )sql" + std::string(kCreateComfortMapsV2) +
-                                 create_tables_v3() + create_tables_v9() + kCreateDirectGraspsV5 +
+                                 create_tables_v10() + create_tables_v9() + kCreateDirectGraspsV5 +
                                  kCreateTableRegraspsV8 + kCreateSuctionDeliveriesV8;
   return sql;
 }
@@ -552,6 +636,10 @@ const std::vector<MigrationStep>& migration_steps() {
       // estimated, the online planner times the stored path itself). The migration rewrites every
       // table's digest after its last step.
       {8, rebuild_regrasp_edges_v9()},
+      // 9 -> 10: handover_candidates.bodies (the table rebuilt with the column, every row's 0: not
+      // computed, as a file without a body set has it). The migration rewrites every table's digest
+      // after its last step.
+      {9, rebuild_handover_candidates_v10()},
   };
   return steps;
 }
@@ -600,6 +688,22 @@ const std::vector<ColumnSpec>& schema_columns(const std::string& table) {
   static const std::vector<ColumnSpec> none;
   const auto it = by_table.find(table);
   return it == by_table.end() ? none : it->second;
+}
+
+bool body_mask_fits(std::int64_t mask, std::size_t body_count) {
+  if (mask < 0 || mask > std::int64_t{0xffffffff}) return false;
+  return body_count >= 32 || (mask >> body_count) == 0;
+}
+
+std::string body_mask_expectation(const std::string& human_bodies) {
+  const std::size_t count = human_body_labels(human_bodies).size();
+  if (count == 0) return "0 (meta.human_bodies names no body: the cell's human only)";
+  const std::int64_t largest =
+      count >= 32 ? std::int64_t{0xffffffff} : (std::int64_t{1} << count) - 1;
+  return "a mask of the " + std::to_string(count) + " bod" + (count == 1 ? "y" : "ies") +
+         " of meta.human_bodies ('" + human_bodies + "'): bits 0 to " +
+         std::to_string(std::min<std::size_t>(count, 32) - 1) + ", from 0 to " +
+         std::to_string(largest);
 }
 
 std::string pose_columns(const std::string& prefix) {

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -61,6 +63,15 @@ struct ColumnSpec {
 // The columns of `table` in the current schema, in declaration order (read once from schema_sql()
 // run on an in-memory database, so they cannot drift from it). Empty for an unknown table.
 const std::vector<ColumnSpec>& schema_columns(const std::string& table);
+
+// Whether `mask` (HandoverCandidateRecord::bodies, handover_candidates.bodies) sets only bits
+// below `body_count`, one per body of meta.human_bodies (human_body_labels), and fits in 32 bits.
+bool body_mask_fits(std::int64_t mask, std::size_t body_count);
+
+// What a mask of `human_bodies`' bodies may be, for the "expected" of a refusal, e.g. "a mask of
+// the 2 bodies of meta.human_bodies ('1.5 female; 1.82 male'): bits 0 to 1, from 0 to 3", or "0
+// (meta.human_bodies names no body: the cell's human only)".
+std::string body_mask_expectation(const std::string& human_bodies);
 
 // Column lists of a pose ("p_x, p_y, p_z, p_qw, p_qx, p_qy, p_qz") and a vector ("v_x, v_y, v_z").
 std::string pose_columns(const std::string& prefix);

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -158,6 +159,8 @@ struct DatabaseWriter::Impl {
       select_robot_grasp, select_suction_grasp;
   std::map<std::int64_t, RoadmapShape> roadmaps;  // by id
   bool meta_written = false;
+  std::string human_bodies;  // meta.human_bodies as written (the bodies a candidate's mask names)
+  std::uint32_t bodies_written = 0;  // every bit any written candidate's bodies sets
   bool committed = false;
   std::string failure;  // the first error: a writer that failed never commits
 
@@ -314,7 +317,7 @@ DatabaseWriter::DatabaseWriter(const std::string& target_path) : impl_(std::make
                    "part_id, sample, " + pose_columns("board") +
                        ", distance, quality, status, rank, human_arm, human_grasp_id, "
                        "human_quality, second_arm, second_grasp_id, second_quality, human_joints, "
-                       "second_joints"),
+                       "second_joints, bodies"),
         m.context("handover_candidates"));
     m.insert_shared.emplace(
         *m.connection,
@@ -404,6 +407,14 @@ void DatabaseWriter::write_meta(const Meta& meta) {
       m.insert_meta->bind_next(value);
       m.insert_meta->run();
     };
+    // The candidates written before name bodies of this set (schema version 10).
+    const std::size_t bodies = human_body_labels(meta.human_bodies).size();
+    if (!detail::body_mask_fits(m.bodies_written, bodies)) {
+      refuse("write_meta", "meta.human_bodies", "the candidates written before",
+             "expected the bodies their masks name (handover_candidates.bodies: bits 0 to " +
+                 std::to_string(std::bit_width(m.bodies_written) - 1) + "), got " +
+                 std::to_string(bodies) + " ('" + meta.human_bodies + "')");
+    }
     put("schema_version", std::to_string(current_schema_version()));
     put("hila_version", meta.hila_version.empty() ? hila_version() : meta.hila_version);
     put("product_name", meta.product_name);
@@ -418,6 +429,7 @@ void DatabaseWriter::write_meta(const Meta& meta) {
     // Only where there is one: a file without the key (as every file written before) has none.
     if (meta.tool_relay) put("tool_relay", detail::format_pose_text(*meta.tool_relay));
     m.meta_written = true;
+    m.human_bodies = meta.human_bodies;
   });
 }
 
@@ -622,6 +634,7 @@ std::vector<std::int64_t> DatabaseWriter::add_handover_candidates(
   return m.guarded("add_handover_candidates", [&] {
     const std::string owner = "part id " + std::to_string(part_id);
     FiniteCheck check("add_handover_candidates", "handover_candidates");
+    const std::size_t body_count = human_body_labels(m.human_bodies).size();
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       const auto& c = candidates[i];
       check.set_record(record_label(i, candidates.size(), owner));
@@ -632,6 +645,17 @@ std::vector<std::int64_t> DatabaseWriter::add_handover_candidates(
       check.value("second_quality", c.second_quality);
       check.joints("human_joints", c.human_joints);
       check.joints("second_joints", c.second_joints);
+      // Bit i: body i of meta.human_bodies (schema version 10), so none before write_meta.
+      if (!detail::body_mask_fits(c.bodies, body_count)) {
+        refuse("add_handover_candidates", "handover_candidates.bodies",
+               record_label(i, candidates.size(), owner),
+               "expected " +
+                   (m.meta_written ? detail::body_mask_expectation(m.human_bodies)
+                                   : std::string("0 before write_meta (bit i: body i of "
+                                                 "meta.human_bodies)")) +
+                   ", got HandoverCandidateRecord::bodies = " + std::to_string(c.bodies) +
+                   " (bit " + std::to_string(std::bit_width(c.bodies) - 1) + " set)");
+      }
     }
     detail::Statement& s = *m.insert_candidate;
     s.set_context(m.context("handover_candidates (" + owner + ")"));
@@ -653,8 +677,10 @@ std::vector<std::int64_t> DatabaseWriter::add_handover_candidates(
       s.bind_next(c.second_quality);
       bind_joints(s, c.human_joints);
       bind_joints(s, c.second_joints);
+      s.bind_next(static_cast<std::int64_t>(c.bodies));
       s.run();
       ids.push_back(m.last_id());
+      m.bodies_written |= c.bodies;
     }
     return ids;
   });

@@ -160,6 +160,10 @@ inline void add_handover_records(Sample& s, std::mt19937_64& rng) {
       c.quality = i == 0 ? 1e-310 : 0.5 + 0.01 * static_cast<double>(i);
       c.status = statuses[i];
       c.rank = c.status == "goal" ? goal_ranks[goal++] : -1;
+      // The bodies of meta.human_bodies (two) that take it (schema version 10): every mask of two
+      // bits, on goals and on the others.
+      static constexpr std::uint32_t kBodies[2][6] = {{0, 3, 1, 2, 3, 0}, {2, 0, 1}};
+      c.bodies = kBodies[k][i];
       if (c.status != "uncomfortable" || i == 5) {
         c.human_arm = "right";
         c.human_grasp_id = 2 - static_cast<std::int64_t>(i % 2);
@@ -774,6 +778,22 @@ inline std::string regrasp_edges_before_v9_sql() {
 inline void clear_durations(Sample& sample) {
   for (auto& p : sample.parts) {
     for (auto& e : p.regrasp_edges) e.duration = 0.0;
+  }
+}
+
+// SQL that turns a current file's handover_candidates back into the table of schema versions 3 to
+// 9 (without bodies), every other value kept: for a version 9 (or older) file made from the
+// sample. SQLite's DROP COLUMN cuts the column's text out of the CREATE statement, which leaves it
+// exactly as the 2 -> 3 step declares the table (test_migration checks it), and rewrites no
+// table referring to it.
+inline std::string handover_candidates_before_v10_sql() {
+  return "ALTER TABLE handover_candidates DROP COLUMN bodies;\n";
+}
+
+// The sample as a file migrated from version 9 or earlier holds it: no candidate's bodies.
+inline void clear_bodies(Sample& sample) {
+  for (auto& p : sample.parts) {
+    for (auto& c : p.handover_candidates) c.bodies = 0;
   }
 }
 

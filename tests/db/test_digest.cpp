@@ -74,8 +74,18 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
   });
   add("comfort map arm name", [](Sample& s) { s.comfort_maps[1].arm = "Left"; });
   // Schema version 3: the handover and ergonomics tables and meta.human_bodies.
-  add("meta human bodies", [](Sample& s) { s.meta.human_bodies = "1.75 male"; });
-  add("no human bodies", [](Sample& s) { s.meta.human_bodies.clear(); });
+  // (Fewer bodies only with masks that name none beyond them: the writer refuses others.)
+  add("meta human bodies", [](Sample& s) { s.meta.human_bodies = "1.75 male; 1.56 female"; });
+  add("one human body", [](Sample& s) {
+    s.meta.human_bodies = "1.75 male";
+    for (auto& p : s.parts) {
+      for (auto& c : p.handover_candidates) c.bodies &= 1u;
+    }
+  });
+  add("no human bodies", [](Sample& s) {
+    s.meta.human_bodies.clear();
+    clear_bodies(s);
+  });
   add("stage failure", [](Sample& s) { s.parts[1].handover_stage->failure += "."; });
   add("stage finished parts order", [](Sample& s) {
     auto& names = s.parts[1].handover_stage->finished_parts;
@@ -204,6 +214,18 @@ TEST(Digest, EveryKindOfChangeIsSeen) {
   });
   add("regrasp edge duration subnormal to 0",
       [](Sample& s) { s.parts[1].regrasp_edges[1].duration = 0.0; });
+  // Schema version 10: the bodies of meta.human_bodies each candidate takes.
+  add("candidate takes a body more",
+      [](Sample& s) { s.parts[0].handover_candidates[2].bodies = 3; });
+  add("candidate takes a body less",
+      [](Sample& s) { s.parts[0].handover_candidates[1].bodies = 1; });
+  add("candidate takes the other body",
+      [](Sample& s) { s.parts[1].handover_candidates[0].bodies = 1; });
+  add("candidate bodies swapped", [](Sample& s) {
+    auto& c = s.parts[0].handover_candidates;
+    std::swap(c[2].bodies, c[3].bodies);
+  });
+  add("no candidate takes a body", [](Sample& s) { clear_bodies(s); });
   // Schema version 5: direct grasps.
   add("direct grasp pick inclination ulp", [](Sample& s) {
     double& a = s.parts[0].direct_grasps[3].inclination_pick_deg;

@@ -65,7 +65,7 @@ TEST(DirectGrasps, EveryFieldRoundTripsPerCandidateInIdOrder) {
   const Sample sample = make_sample();
   write_sample(path, sample);
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
 
   const auto& written = sample.parts[0].direct_grasps;
   ASSERT_EQ(written.size(), 7u);

@@ -70,6 +70,7 @@ void expect_same(const HandoverCandidateRecord& got, const HandoverCandidateReco
   EXPECT_EQ(got.second_quality, want.second_quality);
   expect_same_joints(got.human_joints, want.human_joints);
   expect_same_joints(got.second_joints, want.second_joints);
+  EXPECT_EQ(got.bodies, want.bodies);
 }
 
 void expect_same(const SharedGraspRecord& got, const SharedGraspRecord& want) {
@@ -133,7 +134,7 @@ class HandoverRoundTrip : public ::testing::Test {
 TEST_F(HandoverRoundTrip, MetaHumanBodies) {
   const Database db = Database::open(path_);
   EXPECT_EQ(db.meta().human_bodies, "1.75 male; 1.55 female");
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
 }
 
 TEST_F(HandoverRoundTrip, Stages) {
@@ -189,6 +190,66 @@ TEST_F(HandoverRoundTrip, CandidatesInIdOrder) {
   EXPECT_EQ(all[0].quality, 1e-310) << "subnormal";
   EXPECT_EQ(db.handover_candidates(ids_[1])[0].second_quality, -1e300);
   EXPECT_TRUE(db.handover_candidates(99).empty());
+}
+
+TEST_F(HandoverRoundTrip, CandidateBodiesBitForBit) {
+  // Schema version 10: the bodies of meta.human_bodies (the build's worker set) each candidate is
+  // comfortable for, bit i for body i, as written: every mask of the sample's two bodies.
+  const Database db = Database::open(path_);
+  ASSERT_EQ(human_body_labels(db.meta().human_bodies),
+            (std::vector<std::string>{"1.75 male", "1.55 female"}));
+  std::vector<std::uint32_t> got;
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (const auto& c : db.handover_candidates(ids_[k])) got.push_back(c.bodies);
+  }
+  EXPECT_EQ(got, (std::vector<std::uint32_t>{0, 3, 1, 2, 3, 0, 2, 0, 1}));
+  const auto goals = db.handover_goals(ids_[0]);
+  ASSERT_EQ(goals.size(), 3u);
+  EXPECT_EQ(goals[0].bodies, 2u) << "goals carry theirs";
+  // Each value in its own column, an INTEGER.
+  const auto probe = [&](const std::string& count_sql, int expected) {
+    detail::execute_script(
+        path_, "CREATE TEMP TABLE probe (n INTEGER CHECK (n = " + std::to_string(expected) +
+                   ")); INSERT INTO probe " + count_sql);
+  };
+  probe("SELECT count(*) FROM handover_candidates WHERE typeof(bodies) = 'integer'", 9);
+  probe("SELECT count(*) FROM handover_candidates WHERE bodies = 3 AND id IN (2, 5)", 2);
+  probe("SELECT count(*) FROM handover_candidates WHERE bodies = 0", 3);
+}
+
+TEST_F(HandoverRoundTrip, CandidateBodiesChecksInTheFile) {
+  // The file's CHECK keeps a mask to 32 unsigned bits, for rows edited by hand; it cannot know
+  // how many bodies meta.human_bodies names (Database::open checks that).
+  for (const std::string sql : {
+           "UPDATE handover_candidates SET bodies = -1 WHERE id = 1",
+           "UPDATE handover_candidates SET bodies = 4294967296 WHERE id = 2",
+           "UPDATE handover_candidates SET bodies = -9223372036854775808 WHERE id = 3",
+           "UPDATE handover_candidates SET bodies = NULL WHERE id = 1",
+       }) {
+    SCOPED_TRACE(sql);
+    expect_input_error(
+        [&] { detail::execute_script(path_, sql); },
+        {std::string(sql.find("NULL") == std::string::npos ? "CHECK constraint failed"
+                                                           : "NOT NULL constraint failed")});
+  }
+  EXPECT_NO_THROW(
+      detail::execute_script(path_, "UPDATE handover_candidates SET bodies = 0 WHERE id = 2"));
+  EXPECT_NO_THROW(detail::execute_script(
+      path_, "UPDATE handover_candidates SET bodies = 4294967295 WHERE id = 3"));
+}
+
+TEST(HumanBodyLabels, TheItemsOfMetaHumanBodiesInStoredOrder) {
+  EXPECT_TRUE(human_body_labels("").empty());
+  EXPECT_EQ(human_body_labels("1.5 female"), std::vector<std::string>{"1.5 female"});
+  EXPECT_EQ(human_body_labels("1.5 female; 1.82 male"),
+            (std::vector<std::string>{"1.5 female", "1.82 male"}));
+  EXPECT_EQ(human_body_labels("1.82 male; 1.5 female; 1.722 male"),
+            (std::vector<std::string>{"1.82 male", "1.5 female", "1.722 male"}));
+  // Only "; " separates; empty items are none.
+  EXPECT_EQ(human_body_labels("; 1.5 female; ; 1.82 male; "),
+            (std::vector<std::string>{"1.5 female", "1.82 male"}));
+  EXPECT_EQ(human_body_labels("1.5 female;1.82 male"),
+            std::vector<std::string>{"1.5 female;1.82 male"});
 }
 
 TEST_F(HandoverRoundTrip, GoalsByRank) {
@@ -421,6 +482,140 @@ TEST(HandoverWriter, NonFiniteValuesAreInvalidArgumentsNamingTableAndColumn) {
   }
 }
 
+TEST(HandoverWriter, BodiesBeyondTheBodySetAreRefused) {
+  // Bit i of a candidate's bodies names body i of meta.human_bodies (schema version 10): a bit at
+  // or beyond the body count names none, refused before anything of the call is written (and the
+  // writer then refuses to commit).
+  const std::string dir = temp_dir("db_handover_bodies");
+  const auto refused = [&](const std::string& name, const std::string& human_bodies,
+                           const std::function<void(DatabaseWriter&, const Sample&)>& write,
+                           std::initializer_list<std::string> fragments) {
+    SCOPED_TRACE(name);
+    Fixture f(dir + "/p.db");
+    f.sample.meta.human_bodies = human_bodies;
+    f.writer->write_meta(f.sample.meta);
+    try {
+      write(*f.writer, f.sample);
+      ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& e) {
+      for (const auto& fragment : fragments) {
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos)
+            << "missing '" << fragment << "' in: " << e.what();
+      }
+    }
+    EXPECT_THROW(f.writer->commit(), std::logic_error);
+  };
+  refused("bit 2 of two bodies", "1.75 male; 1.55 female",
+          [](DatabaseWriter& w, const Sample& s) {
+            auto records = s.parts[0].handover_candidates;
+            records[4].bodies = 4;
+            w.add_handover_candidates(1, records);
+          },
+          {"DatabaseWriter::add_handover_candidates: handover_candidates.bodies (record 4 of 6, "
+           "part id 1): expected a mask of the 2 bodies of meta.human_bodies ('1.75 male; 1.55 "
+           "female'): bits 0 to 1, from 0 to 3, got HandoverCandidateRecord::bodies = 4 (bit 2 "
+           "set)"});
+  refused("bit 31 of two bodies", "1.75 male; 1.55 female",
+          [](DatabaseWriter& w, const Sample& s) {
+            auto records = s.parts[1].handover_candidates;
+            records[2].bodies = 0x80000001u;
+            w.add_handover_candidates(2, records);
+          },
+          {"handover_candidates.bodies (record 2 of 3, part id 2)",
+           "got HandoverCandidateRecord::bodies = 2147483649 (bit 31 set)"});
+  refused("bit 1 of one body", "1.75 male",
+          [](DatabaseWriter& w, const Sample& s) {
+            w.add_handover_candidates(1, s.parts[0].handover_candidates);  // record 1 has 3
+          },
+          {"handover_candidates.bodies (record 1 of 6, part id 1): expected a mask of the 1 body "
+           "of meta.human_bodies ('1.75 male'): bits 0 to 0, from 0 to 1, got "
+           "HandoverCandidateRecord::bodies = 3 (bit 1 set)"});
+  refused("any bit without a body set", "",
+          [](DatabaseWriter& w, const Sample& s) {
+            auto records = s.parts[1].handover_candidates;
+            records[0].bodies = 0;
+            w.add_handover_candidates(2, records);  // record 2 has 1
+          },
+          {"handover_candidates.bodies (record 2 of 3, part id 2): expected 0 (meta.human_bodies "
+           "names no body: the cell's human only), got HandoverCandidateRecord::bodies = 1 (bit "
+           "0 set)"});
+  refused("a body set of empty items", "; ",
+          [](DatabaseWriter& w, const Sample& s) {
+            auto records = s.parts[1].handover_candidates;
+            records[0].bodies = 0;
+            w.add_handover_candidates(2, records);
+          },
+          {"expected 0 (meta.human_bodies names no body"});
+  // Before write_meta the writer knows no body: only 0.
+  {
+    DatabaseWriter writer(dir + "/early.db");
+    PartRecord part;
+    part.mass = 1.0;
+    const std::int64_t id = writer.add_part(part);
+    HandoverCandidateRecord c;
+    c.status = "uncomfortable";
+    c.bodies = 1;
+    try {
+      writer.add_handover_candidates(id, {c});
+      ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("handover_candidates.bodies (record 0 of 1, part id 1): "
+                                           "expected 0 before write_meta"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // A body set written after the candidates must still cover their masks.
+  {
+    DatabaseWriter writer(dir + "/late.db");
+    PartRecord part;
+    part.mass = 1.0;
+    Meta meta;
+    meta.human_bodies = "1.75 male; 1.55 female";
+    writer.write_meta(meta);
+    const std::int64_t id = writer.add_part(part);
+    HandoverCandidateRecord c;
+    c.status = "uncomfortable";
+    c.bodies = 2;
+    writer.add_handover_candidates(id, {c});
+    meta.human_bodies = "1.75 male";
+    try {
+      writer.write_meta(meta);
+      ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(
+                    "DatabaseWriter::write_meta: meta.human_bodies (the candidates written "
+                    "before): expected the bodies their masks name (handover_candidates.bodies: "
+                    "bits 0 to 1), got 1 ('1.75 male')"),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_THROW(writer.commit(), std::logic_error);
+  }
+  // Every bit of a 32-bit mask names a body of 32 (or more); 0 is always fine.
+  {
+    const std::string path = dir + "/many.db";
+    {
+      Fixture f(path);
+      std::string bodies;
+      for (int i = 0; i < 33; ++i) bodies += (i ? "; " : "") + std::to_string(150 + i) + " male";
+      f.sample.meta.human_bodies = bodies;
+      f.writer->write_meta(f.sample.meta);
+      auto records = f.sample.parts[1].handover_candidates;
+      records[0].bodies = 0xffffffffu;
+      records[1].bodies = 0x80000000u;
+      records[2].bodies = 0;
+      f.writer->add_handover_candidates(2, records);
+      f.writer->commit();
+    }
+    const auto read = Database::open(path).handover_candidates(2);
+    ASSERT_EQ(read.size(), 3u);
+    EXPECT_EQ(read[0].bodies, 0xffffffffu);
+    EXPECT_EQ(read[1].bodies, 0x80000000u);
+    EXPECT_EQ(read[2].bodies, 0u);
+  }
+}
+
 TEST(HandoverWriter, RefusedValueFailsTheWriterAndLeavesNoFile) {
   const std::string dir = temp_dir("db_handover_refused");
   Fixture f(dir + "/p.db");
@@ -608,11 +803,76 @@ TEST(HandoverReader, DamagedJointBlobIsADatabaseError) {
                      {"handover_candidates.board (id 5)", "a unit quaternion"});
 }
 
+TEST(HandoverReader, BodiesBeyondTheBodySetAreDatabaseErrors) {
+  // A mask with a bit at or beyond the body count of meta.human_bodies names no body: the writer
+  // refuses it, so in a file it is an edit, which Database::open refuses naming the row (before
+  // the content digest: the more specific check speaks first). The file's CHECK bounds a mask to
+  // 32 bits only, and a value past it (written with the CHECKs ignored; SQLite does not verify
+  // them on open's read-only connection) is refused the same way.
+  const std::string path = temp_dir("db_handover_bodies_edited") + "/p.db";
+  write_sample(path, make_sample());
+  const std::string pristine = read_file(path);
+  const auto damaged = [&](const std::string& name, const std::string& sql,
+                           std::initializer_list<std::string> fragments) {
+    SCOPED_TRACE(name);
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << pristine;
+    detail::execute_script(path, "PRAGMA ignore_check_constraints = ON;" + sql);
+    expect_input_error([&] { Database::open(path); }, fragments);
+  };
+  damaged("bit 2 of two bodies", "UPDATE handover_candidates SET bodies = 4 WHERE id = 2",
+          {path +
+           ": handover_candidates.bodies (id 2): expected a mask of the 2 bodies of "
+           "meta.human_bodies ('1.75 male; 1.55 female'): bits 0 to 1, from 0 to 3, got "
+           "4; rebuild with: hila build meshes/cabinet/product.yaml -o " +
+           path});
+  damaged("bit 31", "UPDATE handover_candidates SET bodies = 2147483648 WHERE id = 7",
+          {path + ": handover_candidates.bodies (id 7): expected a mask of the 2 bodies",
+           "got 2147483648"});
+  damaged(
+      "negative", "UPDATE handover_candidates SET bodies = -1 WHERE id = 1",
+      {path + ": handover_candidates.bodies (id 1): expected a mask of the 2 bodies", "got -1"});
+  damaged("beyond 32 bits", "UPDATE handover_candidates SET bodies = 4294967297 WHERE id = 3",
+          {path + ": handover_candidates.bodies (id 3)", "got 4294967297"});
+  damaged("not an integer", "UPDATE handover_candidates SET bodies = 1.5 WHERE id = 3",
+          {path + ": handover_candidates.bodies (id 3): expected an INTEGER (the column is "
+                  "INTEGER NOT NULL), got the REAL 1.5"});
+  // The body count is meta's: one body fewer, and the masks with bit 1 (ids 2, 4, 5, 7) name none.
+  damaged("a body set edited to one body",
+          "UPDATE meta SET value = '1.75 male' WHERE key = 'human_bodies'",
+          {path + ": handover_candidates.bodies (id 2): expected a mask of the 1 body of "
+                  "meta.human_bodies ('1.75 male'): bits 0 to 0, from 0 to 1, got 3"});
+  damaged("a body set edited away", "UPDATE meta SET value = '' WHERE key = 'human_bodies'",
+          {path + ": handover_candidates.bodies (id 2): expected 0 (meta.human_bodies names no "
+                  "body: the cell's human only), got 3"});
+  // Within the body set, an edit only the digest sees.
+  damaged("another mask of the two bodies",
+          "UPDATE handover_candidates SET bodies = 1 WHERE id = 2",
+          {path + ": handover_candidates: expected the content digest stored when it was "
+                  "written (meta.digest.handover_candidates = "});
+}
+
+TEST(HandoverReader, ACurrentFileWithoutBodiesIsRefused) {
+  // A current file whose handover_candidates lacks the column (a version 9 table with a current
+  // version number, or damaged by hand) cannot open; a version 9 file is migrated instead
+  // (test_migration).
+  const std::string path = temp_dir("db_handover_no_bodies") + "/p.db";
+  write_sample(path, make_sample());
+  detail::execute_script(path, handover_candidates_before_v10_sql());
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": handover_candidates: expected a readable hila table",
+                      "no such column: bodies", "rebuild with: hila build"});
+}
+
 TEST(HandoverReader, MissingHumanBodiesKeyIsAnEditTheMetaDigestRefuses) {
   // The writer always stores the key, so a file without it was edited since: meta's stored
   // content digest no longer matches. The content digest, which verifies nothing, still reads it.
+  // (Without a body set its candidates take no body: otherwise their masks would name bodies the
+  // file no longer has, which the loader reports first, as BodiesBeyondTheBodySetAreDatabaseErrors
+  // shows.)
   const std::string path = temp_dir("db_handover_meta") + "/p.db";
-  write_sample(path, make_sample());
+  Sample sample = make_sample();
+  clear_bodies(sample);
+  write_sample(path, sample);
   detail::execute_script(path, "DELETE FROM meta WHERE key = 'human_bodies'");
   expect_input_error([&] { Database::open(path); },
                      {path + ": meta: expected the content digest stored when it was written"});

@@ -63,8 +63,8 @@ std::vector<std::string> declared_sql(const std::string& path, const std::string
   Connection connection(path, SQLITE_OPEN_READONLY, path);
   std::vector<std::string> statements;
   {
-    Statement select(connection,
-                     "SELECT sql FROM sqlite_master WHERE name GLOB ? ORDER BY name", context);
+    Statement select(connection, "SELECT sql FROM sqlite_master WHERE name GLOB ? ORDER BY name",
+                     context);
     select.bind_next(table + "*");
     while (select.step()) statements.push_back(select.column_text(0));
   }
@@ -78,6 +78,33 @@ std::vector<std::string> table_regrasps_sql(const std::string& path) {
 
 std::vector<std::string> regrasp_edges_sql(const std::string& path) {
   return declared_sql(path, "regrasp_edges");
+}
+
+std::vector<std::string> handover_candidates_sql(const std::string& path) {
+  return declared_sql(path, "handover_candidates");
+}
+
+// Every CREATE statement sqlite_master holds, name -> statement: how the file declares all its
+// tables and indexes.
+std::map<std::string, std::string> all_declared_sql(const std::string& path) {
+  const ErrorContext context{"(sqlite_master)", "a readable schema", ""};
+  Connection connection(path, SQLITE_OPEN_READONLY, path);
+  std::map<std::string, std::string> statements;
+  {
+    Statement select(connection, "SELECT name, sql FROM sqlite_master WHERE sql IS NOT NULL",
+                     context);
+    while (select.step()) statements[select.column_text(0)] = select.column_text(1);
+  }
+  connection.close();
+  return statements;
+}
+
+// handover_candidates as the 2 -> 3 step declares it (versions 3 to 9), as sqlite_master holds a
+// CREATE statement: without the ';'.
+std::string handover_candidates_v3_sql() {
+  const std::string& step_v3 = migration_steps().at(1).sql;
+  const std::size_t begin = step_v3.find("CREATE TABLE handover_candidates (");
+  return step_v3.substr(begin, step_v3.find("\n);", begin) + 2 - begin);
 }
 
 // The meta table's digest.* rows, key -> value.
@@ -763,7 +790,7 @@ Database open_migrated(const std::string& path) {
 
 // After rows were added by SQL, the per-table digests of the file as it now is, written the only
 // way outside the writer, by a migration: set back to version `version` - 1, a step to `version`
-// that changes no table (the real one would add regrasp_edges.duration again), after which the
+// that changes no table (the real one would add handover_candidates.bodies again), after which the
 // migration writes them, for the tables of `version`.
 void reseal(const std::string& path, int version = current_schema_version()) {
   execute_script(path, "UPDATE meta SET value = '" + std::to_string(version - 1) +
@@ -792,7 +819,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v1 = content_digest(path);  // an old file still has a digest
 
-  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9
+  migrate_in_place(path);  // 1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9 -> 10
 
   // Readable now, but still what hila 0.1.0 built: refused unless any hila version is accepted.
   expect_input_error([&] { Database::open(path); },
@@ -800,7 +827,7 @@ TEST(Migration, Version1FileIsUpgradedToTheCurrentVersion) {
                           hila_version() + "), got one built by hila 0.1.0 (an older hila",
                       "rebuild with: hila build product.yaml -o " + path});
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   EXPECT_EQ(db.meta().product_name, "cabinet");
   EXPECT_EQ(db.meta().seed, 18446744073709551615ull);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
@@ -835,16 +862,16 @@ TEST(Migration, Version2FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), got one "
        "written by schema version 2 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   EXPECT_THROW(Database::open(path), DatabaseError);
   const std::string digest_v2 = content_digest(path);
 
-  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9
+  migrate_in_place(path);  // 2 -> 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9 -> 10
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   expect_v1_records(db);
   ASSERT_EQ(db.comfort_maps().size(), 1u) << "the comfort map is kept";
@@ -876,15 +903,15 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), got one "
        "written by schema version 3 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v3 = content_digest(path);
 
-  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9
+  migrate_in_place(path);  // 3 -> 4 -> 5 -> 6 -> 7 -> 8 -> 9 -> 10
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -901,6 +928,7 @@ TEST(Migration, Version3FileIsUpgradedToTheCurrentVersion) {
   ASSERT_EQ(goals.size(), 1u);
   EXPECT_EQ(goals[0].human_quality, 0.875);
   EXPECT_EQ(goals[0].human_joints, Eigen::VectorXd::Constant(1, -2.0));
+  EXPECT_EQ(goals[0].bodies, 0u) << "the 9 -> 10 step: no body";
   ASSERT_EQ(db.shared_grasps(1).size(), 1u);
   EXPECT_EQ(db.shared_grasps(1)[0].inclination_rh_deg, 45.0);
   ASSERT_EQ(db.ergonomics(1).size(), 1u);
@@ -966,15 +994,15 @@ TEST(Migration, Version4FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), got one "
        "written by schema version 4 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v4 = content_digest(path);
 
-  migrate_in_place(path);  // 4 -> 5 -> 6 -> 7 -> 8 -> 9
+  migrate_in_place(path);  // 4 -> 5 -> 6 -> 7 -> 8 -> 9 -> 10
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -1070,15 +1098,15 @@ TEST(Migration, Version5FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), got one "
        "written by schema version 5 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v5 = content_digest(path);
 
-  migrate_in_place(path);  // 5 -> 6 -> 7 -> 8 -> 9
+  migrate_in_place(path);  // 5 -> 6 -> 7 -> 8 -> 9 -> 10
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -1195,15 +1223,15 @@ TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), got one "
        "written by schema version 6 (an older hila); rebuild with: hila build product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v6 = content_digest(path);
 
-  migrate_in_place(path);  // 6 -> 7 -> 8 -> 9
+  migrate_in_place(path);  // 6 -> 7 -> 8 -> 9 -> 10
 
   const Database db = open_migrated(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   EXPECT_EQ(db.meta().created_at, "2024-06-11T10:00:00Z") << "meta kept as it was";
   EXPECT_EQ(db.meta().human_bodies, "1.75 male") << "meta kept as it was";
   expect_v1_records(db);
@@ -1286,9 +1314,10 @@ TEST(Migration, Version6FileIsUpgradedToTheCurrentVersion) {
 
 TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
   // A version 7 file as this hila's writer would have made it: no suction_deliveries table, no
-  // table_regrasps.repick_arm, no regrasp_edges.duration, and a stored digest for every table. The
-  // 7 -> 8 step adds the table and the column (each row's its arm), the 8 -> 9 step the duration
-  // (0), the migration the digests of all of them, the new one included.
+  // table_regrasps.repick_arm, no regrasp_edges.duration, no handover_candidates.bodies, and a
+  // stored digest for every table. The 7 -> 8 step adds the table and the column (each row's its
+  // arm), the 8 -> 9 step the duration (0), the 9 -> 10 step the bodies (0), the migration the
+  // digests of all of them, the new one included.
   const std::string dir = temp_dir("db_migration_v7");
   Sample sample = make_sample();
   sample.parts[0].suction_deliveries.clear();  // a version 7 file cannot hold any
@@ -1298,11 +1327,12 @@ TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
                  "DROP TABLE suction_deliveries;"
                  "DELETE FROM meta WHERE key = 'digest.suction_deliveries';"
                  "ALTER TABLE table_regrasps DROP COLUMN repick_arm;" +
-                     regrasp_edges_before_v9_sql() +
+                     regrasp_edges_before_v9_sql() + handover_candidates_before_v10_sql() +
                      "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
   // What this hila writes for the same records: every regrasp taken again by its own arm, no
-  // edge's duration estimated.
+  // edge's duration estimated, no candidate's bodies.
   clear_durations(sample);
+  clear_bodies(sample);
   std::size_t relays = 0;
   for (auto& r : sample.parts[0].table_regrasps) {
     relays += r.repick_arm != r.arm ? 1 : 0;
@@ -1316,14 +1346,15 @@ TEST(Migration, Version7FileIsUpgradedWithItsDigestsRewritten) {
                       "(or migrate it in place with hila::db::migrate_in_place)"});
   const std::string digest_v7 = content_digest(path);
 
-  migrate_in_place(path);  // 7 -> 8 -> 9
+  migrate_in_place(path);  // 7 -> 8 -> 9 -> 10
 
   // Built by this hila: opens with the default options, every stored digest checked.
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   for (const auto& e : db.regrasp_edges(1)) EXPECT_EQ(e.duration, 0.0) << e.id;
   for (const auto& c : db.handover_candidates(1)) {
     EXPECT_TRUE(db.suction_deliveries(c.id).empty()) << c.id;
+    EXPECT_EQ(c.bodies, 0u) << c.id;
   }
   std::size_t regrasps = 0;
   for (const auto& c : db.handover_candidates(1)) {
@@ -1363,18 +1394,19 @@ TEST(Migration, Version7FileThatAlreadyHasTheNewTableFailsCleanly) {
 
 TEST(Migration, Version8FileIsUpgradedWithItsDurationsNotEstimated) {
   // A version 8 file as this hila's writer would have made it: regrasp_edges without duration
-  // (version 4's table) and a stored digest for every table, of that content. The 8 -> 9 step
-  // gives every edge the column, 0 (not estimated), the migration the digests.
+  // (version 4's table), handover_candidates without bodies (version 3's) and a stored digest for
+  // every table, of that content. The 8 -> 9 step gives every edge the column, 0 (not estimated),
+  // the 9 -> 10 step every candidate its bodies, 0, the migration the digests.
   const std::string dir = temp_dir("db_migration_v8");
   Sample sample = make_sample();
   const std::string path = dir + "/v8.db";
   write_sample(path, sample);  // its estimated durations go with the column
-  execute_script(path, regrasp_edges_before_v9_sql());
+  execute_script(path, regrasp_edges_before_v9_sql() + handover_candidates_before_v10_sql());
   reseal(path, 8);  // the digests a version 8 writer stored for this content
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), got one "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), got one "
        "written by schema version 8 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -1390,14 +1422,15 @@ TEST(Migration, Version8FileIsUpgradedWithItsDurationsNotEstimated) {
   }
   ASSERT_GT(estimated, 0u) << "the sample has durations, so the migration must not keep them";
   clear_durations(sample);
+  clear_bodies(sample);
   const std::string written = dir + "/written.db";
   write_sample(written, sample);
 
-  migrate_in_place(path);  // 8 -> 9
+  migrate_in_place(path);  // 8 -> 9 -> 10
 
   // Built by this hila: opens with the default options, every stored digest checked.
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   std::size_t edges = 0;
   for (std::size_t k = 0; k < sample.parts.size(); ++k) {
     const auto got = db.regrasp_edges(static_cast<std::int64_t>(k + 1));
@@ -1418,13 +1451,14 @@ TEST(Migration, Version8FileIsUpgradedWithItsDurationsNotEstimated) {
   EXPECT_EQ(edges, 8u);
   EXPECT_EQ(content_digest(path), content_digest(written));
   EXPECT_NE(content_digest(path), digest_v8);
-  // The stored digests are the writer's; against the version 8 file's, only regrasp_edges' (its
-  // column) and meta's (schema_version) changed.
+  // The stored digests are the writer's; against the version 8 file's, only regrasp_edges' and
+  // handover_candidates' (their columns) and meta's (schema_version) changed.
   const auto digests = stored_digests(path);
   EXPECT_EQ(digests, stored_digests(written));
   ASSERT_EQ(digests.size(), digests_v8.size());
   for (const auto& [key, digest] : digests) {
-    if (key == "digest.regrasp_edges" || key == "digest.meta") {
+    if (key == "digest.regrasp_edges" || key == "digest.handover_candidates" ||
+        key == "digest.meta") {
       EXPECT_NE(digest, digests_v8.at(key)) << key;
     } else {
       EXPECT_EQ(digest, digests_v8.at(key)) << key;
@@ -1466,6 +1500,139 @@ TEST(Migration, Version8FileThatAlreadyHasTheNewColumnFailsCleanly) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
 }
 
+TEST(Migration, Version9FileIsUpgradedWithItsCandidatesTakingNoBody) {
+  // A version 9 file as this hila's writer would have made it: handover_candidates without bodies
+  // (version 3's table, which shared_grasps, direct_grasps, table_regrasps, suction_deliveries and
+  // regrasp_nodes refer to) and a stored digest for every table, of that content. The 9 -> 10 step
+  // gives every candidate the column, 0 (no body: not computed), the migration the digests.
+  const std::string dir = temp_dir("db_migration_v9");
+  Sample sample = make_sample();
+  const std::string path = dir + "/v9.db";
+  write_sample(path, sample);  // its masks go with the column
+  execute_script(path, handover_candidates_before_v10_sql());
+  reseal(path, 9);  // the digests a version 9 writer stored for this content
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 10), got one "
+       "written by schema version 9 (an older hila); rebuild with: hila build "
+       "meshes/cabinet/product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  ASSERT_EQ(handover_candidates_sql(path).size(), 2u);
+  EXPECT_EQ(handover_candidates_sql(path)[0], handover_candidates_v3_sql())
+      << "declared as versions 3 to 9 declared it";
+  const auto declared_v9 = all_declared_sql(path);
+  const std::string digest_v9 = content_digest(path);
+  const auto digests_v9 = stored_digests(path);
+  // What this hila writes for the same records: no candidate takes a body.
+  std::size_t with_bodies = 0;
+  for (const auto& p : sample.parts) {
+    for (const auto& c : p.handover_candidates) with_bodies += c.bodies != 0 ? 1 : 0;
+  }
+  ASSERT_GT(with_bodies, 0u) << "the sample has masks, so the migration must not keep them";
+  clear_bodies(sample);
+  const std::string written = dir + "/written.db";
+  write_sample(written, sample);
+
+  migrate_in_place(path);  // 9 -> 10
+
+  // Built by this hila: opens with the default options, every stored digest and reference checked.
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 10);
+  EXPECT_EQ(db.meta().human_bodies, "1.75 male; 1.55 female") << "meta kept as it was";
+  std::size_t candidates = 0;
+  std::size_t referring = 0;
+  for (std::size_t k = 0; k < sample.parts.size(); ++k) {
+    const auto got = db.handover_candidates(static_cast<std::int64_t>(k + 1));
+    const auto& want = sample.parts[k].handover_candidates;
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      SCOPED_TRACE(want[i].id);
+      ++candidates;
+      EXPECT_EQ(got[i].bodies, 0u) << "the step: no body";
+      EXPECT_EQ(got[i].id, want[i].id) << "the rest of the row is kept";
+      EXPECT_EQ(got[i].status, want[i].status);
+      EXPECT_EQ(got[i].rank, want[i].rank);
+      EXPECT_EQ(got[i].distance, want[i].distance);
+      EXPECT_EQ(got[i].second_quality, want[i].second_quality);
+      EXPECT_EQ(got[i].human_joints, want[i].human_joints);
+      EXPECT_EQ(got[i].second_joints, want[i].second_joints);
+      referring += db.shared_grasps(got[i].id).size() + db.direct_grasps(got[i].id).size() +
+                   db.table_regrasps(got[i].id).size() + db.suction_deliveries(got[i].id).size();
+    }
+  }
+  EXPECT_EQ(candidates, 9u);
+  std::size_t written_referring = 0;
+  for (const auto& p : sample.parts) {
+    written_referring += p.shared_grasps.size() + p.direct_grasps.size() + p.table_regrasps.size() +
+                         p.suction_deliveries.size();
+  }
+  EXPECT_GT(referring, 0u);
+  EXPECT_EQ(referring, written_referring) << "the rows referring to candidates still find theirs";
+  EXPECT_EQ(content_digest(path), content_digest(written));
+  EXPECT_NE(content_digest(path), digest_v9);
+  // The stored digests are the writer's; against the version 9 file's, only handover_candidates'
+  // (its column) and meta's (schema_version) changed.
+  const auto digests = stored_digests(path);
+  EXPECT_EQ(digests, stored_digests(written));
+  ASSERT_EQ(digests.size(), digests_v9.size());
+  for (const auto& [key, digest] : digests) {
+    if (key == "digest.handover_candidates" || key == "digest.meta") {
+      EXPECT_NE(digest, digests_v9.at(key)) << key;
+    } else {
+      EXPECT_EQ(digest, digests_v9.at(key)) << key;
+    }
+  }
+  // The table (and its index) declared as a fresh file declares them, nothing left over, and
+  // every other table as it was: the tables referring to handover_candidates still name it.
+  EXPECT_EQ(handover_candidates_sql(path), handover_candidates_sql(written));
+  EXPECT_EQ(handover_candidates_sql(path).size(), 2u);
+  const auto declared = all_declared_sql(path);
+  EXPECT_EQ(declared, all_declared_sql(written));
+  ASSERT_EQ(declared.size(), declared_v9.size());
+  for (const auto& [name, sql] : declared) {
+    if (name == "handover_candidates") continue;
+    EXPECT_EQ(sql, declared_v9.at(name)) << name;
+  }
+  EXPECT_NE(declared.at("shared_grasps").find("REFERENCES handover_candidates(id)"),
+            std::string::npos);
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"v9.db", "written.db"}));
+
+  // The migrated table takes a mask like a fresh one, its CHECK refuses one beyond 32 bits, and
+  // the foreign keys referring to it hold against it (candidate 2 has shared grasps).
+  execute_script(path, "UPDATE handover_candidates SET bodies = 3 WHERE id = 2");
+  expect_input_error([&] { Database::open(path); },
+                     {path + ": handover_candidates: expected the content digest stored when it "
+                             "was written"});
+  reseal(path);
+  EXPECT_EQ(Database::open(path).handover_candidates(1)[1].bodies, 3u);
+  expect_input_error(
+      [&] {
+        execute_script(path, "UPDATE handover_candidates SET bodies = 4294967296 WHERE id = 2");
+      },
+      {"CHECK constraint failed"});
+  expect_input_error([&] { execute_script(path, "DELETE FROM handover_candidates WHERE id = 2"); },
+                     {"FOREIGN KEY constraint failed"});
+
+  const std::string after = read_file(path);
+  migrate_in_place(path);
+  EXPECT_EQ(read_file(path), after) << "migrating a current file is a no-op";
+}
+
+TEST(Migration, Version9FileThatAlreadyHasTheNewColumnFailsCleanly) {
+  // Version 10 content with the version number set back: the 9 -> 10 step's ADD COLUMN fails and
+  // the file is left as it was (its masks are not replaced by 0).
+  const std::string dir = temp_dir("db_migration_v9_clash");
+  const std::string path = dir + "/p.db";
+  write_sample(path, make_sample());
+  execute_script(path, "UPDATE meta SET value = '9' WHERE key = 'schema_version'");
+  const std::string before = read_file(path);
+  expect_input_error([&] { migrate_in_place(path); },
+                     {path + ": migration 9 -> 10", "duplicate column name: bodies"});
+  EXPECT_EQ(read_file(path), before);
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"p.db"});
+}
+
 TEST(Migration, Version2StepKeepsAnExistingHumanBodiesKey) {
   // A hand-made version 2 file that already has the key: the step does not overwrite it.
   const std::string dir = temp_dir("db_migration_v2_bodies");
@@ -1498,7 +1665,7 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
 
   // Made from the sample, which this hila wrote: it opens with the default options.
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   const Sample sample = make_sample();
   ASSERT_EQ(db.parts().size(), sample.parts.size());
   EXPECT_EQ(db.parts()[0].name, sample.parts[0].part.name);
@@ -1520,12 +1687,14 @@ TEST(Migration, SyntheticStepThenTheRealOneUpgradeAVersion0Database) {
 TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   const std::string dir = temp_dir("db_migration_order");
   const std::string path = write_v0(dir);
-  // Step 9 -> 10 needs the table step 0 -> 1 creates, the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
-  // 4 -> 5, 5 -> 6 and 7 -> 8 create and the column 8 -> 9 adds; listed first to prove ordering.
+  // Step 10 -> 11 needs the table step 0 -> 1 creates, the ones steps 1 -> 2, 2 -> 3, 3 -> 4,
+  // 4 -> 5, 5 -> 6 and 7 -> 8 create and the columns 8 -> 9 and 9 -> 10 add; listed first to prove
+  // ordering.
   std::vector<MigrationStep> steps = {
-      {9,
-       "INSERT INTO notes (text) VALUES ('from step 9');"
+      {10,
+       "INSERT INTO notes (text) VALUES ('from step 10');"
        "INSERT INTO notes (text) SELECT duration FROM regrasp_edges;"
+       "INSERT INTO notes (text) SELECT bodies FROM handover_candidates;"
        "INSERT INTO notes (text) SELECT arm FROM comfort_maps;"
        "INSERT INTO notes (text) SELECT arm FROM ergonomics;"
        "INSERT INTO notes (text) SELECT arm FROM roadmaps;"
@@ -1533,6 +1702,7 @@ TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
        "INSERT INTO notes (text) SELECT arm FROM table_regrasps;"
        "INSERT INTO notes (text) SELECT arm FROM suction_deliveries;"}};
   steps.push_back(migration_steps().at(1));
+  steps.push_back(migration_steps().at(8));
   steps.push_back(migration_steps().at(7));
   steps.push_back(migration_steps().at(6));
   steps.push_back(migration_steps().at(5));
@@ -1543,13 +1713,13 @@ TEST(Migration, StepsRunInVersionOrderWhateverTheListOrder) {
   steps.push_back({0,
                    "CREATE TABLE notes (text TEXT NOT NULL);"
                    "ALTER TABLE robot_grasps ADD COLUMN theta_c_deg REAL NOT NULL DEFAULT 90.0;"});
-  EXPECT_TRUE(can_migrate(steps, 0, 10));
-  migrate_with_steps(path, steps, 10);
-  // The file is now version 10: this hila (9) calls it newer.
-  expect_input_error([&] { Database::open(path); }, {"written by schema version 10"});
-  // Migrating to 10 again is a no-op (already there).
+  EXPECT_TRUE(can_migrate(steps, 0, 11));
+  migrate_with_steps(path, steps, 11);
+  // The file is now version 11: this hila (10) calls it newer.
+  expect_input_error([&] { Database::open(path); }, {"written by schema version 11"});
+  // Migrating to 11 again is a no-op (already there).
   const std::string after = read_file(path);
-  migrate_with_steps(path, steps, 10);
+  migrate_with_steps(path, steps, 11);
   EXPECT_EQ(read_file(path), after);
 }
 
@@ -1593,12 +1763,18 @@ TEST(Migration, MissingStepIsRefusedWithoutTouchingTheFile) {
                    migration_steps().at(3), migration_steps().at(4), migration_steps().at(5)},
                   1, 8))
       << "1 -> 2 -> 3 -> 4 -> 5 -> 6 -> 7 does not reach 8";
-  EXPECT_FALSE(can_migrate(
-      {migration_steps().at(0), migration_steps().at(1), migration_steps().at(2),
-       migration_steps().at(3), migration_steps().at(4), migration_steps().at(5),
-       migration_steps().at(6)},
-      1, 9))
+  EXPECT_FALSE(
+      can_migrate({migration_steps().at(0), migration_steps().at(1), migration_steps().at(2),
+                   migration_steps().at(3), migration_steps().at(4), migration_steps().at(5),
+                   migration_steps().at(6)},
+                  1, 9))
       << "1 -> 2 -> ... -> 8 does not reach 9";
+  EXPECT_FALSE(
+      can_migrate({migration_steps().at(0), migration_steps().at(1), migration_steps().at(2),
+                   migration_steps().at(3), migration_steps().at(4), migration_steps().at(5),
+                   migration_steps().at(6), migration_steps().at(7)},
+                  1, 10))
+      << "1 -> 2 -> ... -> 9 does not reach 10";
   // The real steps start at version 1: there is nothing to migrate from 0.
   expect_input_error(
       [&] { migrate_in_place(path); },
@@ -1643,9 +1819,9 @@ TEST(Migration, NewerDatabaseIsRefused) {
   const std::string dir = temp_dir("db_migration_newer");
   const std::string path = dir + "/p.db";
   write_sample(path, make_sample());
-  execute_script(path, "UPDATE meta SET value = '10' WHERE key = 'schema_version'");
+  execute_script(path, "UPDATE meta SET value = '11' WHERE key = 'schema_version'");
   expect_input_error([&] { migrate_in_place(path); },
-                     {path, "written by schema version 10 (a newer hila)", "upgrade hila"});
+                     {path, "written by schema version 11 (a newer hila)", "upgrade hila"});
 }
 
 TEST(Migration, ForeignFilesAreRefused) {

@@ -123,7 +123,7 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
   const std::string path = write_small(temp_dir("db_open_older"));
   detail::execute_script(path, "UPDATE meta SET value = '0' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "this hila reads (schema version 9)",
+                     {path + ": meta.schema_version", "this hila reads (schema version 10)",
                       "written by schema version 0 (an older hila)",
                       "rebuild with: hila build meshes/cabinet/product.yaml -o " + path});
   // There is no step from version 0, so the message must not offer one.
@@ -138,7 +138,10 @@ TEST(OpenChecks, OlderSchemaVersionWithoutAMigrationPath) {
 // (regrasp_edges first: it refers to the others); suction_deliveries, table_regrasps and
 // direct_grasps go before handover_candidates, which they refer to. Version 8 also added
 // table_regrasps.repick_arm (kDropVersion8Columns, for a file that keeps the table), version 9
-// regrasp_edges.duration (kDropVersion9Columns, likewise: the table as versions 4 to 8 had it).
+// regrasp_edges.duration (kDropVersion9Columns, likewise: the table as versions 4 to 8 had it),
+// version 10 handover_candidates.bodies (kDropVersion10Columns: the table as versions 3 to 9 had
+// it).
+const std::string kDropVersion10Columns = handover_candidates_before_v10_sql();
 const std::string kDropVersion9Columns = regrasp_edges_before_v9_sql();
 const char* const kDropVersion8Tables = "DROP TABLE suction_deliveries;";
 const char* const kDropVersion8Columns = "ALTER TABLE table_regrasps DROP COLUMN repick_arm;";
@@ -159,7 +162,7 @@ TEST(OpenChecks, Version1OffersMigration) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
        "got one written by schema version 1 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -177,7 +180,7 @@ TEST(OpenChecks, Version2OffersMigration) {
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
        "got one written by schema version 2 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -188,13 +191,13 @@ TEST(OpenChecks, Version2OffersMigration) {
 TEST(OpenChecks, Version3OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v3"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, std::string(kDropVersion8Tables) + kDropVersion6Tables +
+  detail::execute_script(path, kDropVersion10Columns + kDropVersion8Tables + kDropVersion6Tables +
                                    kDropVersion5Tables + kDropVersion4Tables +
                                    "UPDATE meta SET value = '3' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
        "got one written by schema version 3 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -207,13 +210,13 @@ TEST(OpenChecks, Version3OffersMigration) {
 TEST(OpenChecks, Version4OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v4"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, kDropVersion9Columns + kDropVersion8Tables + kDropVersion6Tables +
-                                   kDropVersion5Tables +
+  detail::execute_script(path, kDropVersion10Columns + kDropVersion9Columns + kDropVersion8Tables +
+                                   kDropVersion6Tables + kDropVersion5Tables +
                                    "UPDATE meta SET value = '4' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
        "got one written by schema version 4 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -226,12 +229,13 @@ TEST(OpenChecks, Version4OffersMigration) {
 TEST(OpenChecks, Version5OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v5"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, kDropVersion9Columns + kDropVersion8Tables + kDropVersion6Tables +
+  detail::execute_script(path, kDropVersion10Columns + kDropVersion9Columns + kDropVersion8Tables +
+                                   kDropVersion6Tables +
                                    "UPDATE meta SET value = '5' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
        "got one written by schema version 5 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -244,14 +248,14 @@ TEST(OpenChecks, Version5OffersMigration) {
 TEST(OpenChecks, Version7OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v7"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, kDropVersion9Columns + kDropVersion8Tables +
+  detail::execute_script(path, kDropVersion10Columns + kDropVersion9Columns + kDropVersion8Tables +
                                    kDropVersion8Columns +
                                    "DELETE FROM meta WHERE key = 'digest.suction_deliveries';"
                                    "UPDATE meta SET value = '7' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
        "got one written by schema version 7 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -261,7 +265,7 @@ TEST(OpenChecks, Version7OffersMigration) {
   EXPECT_EQ(digest_v7.size(), 64u);
   EXPECT_NE(digest_v7, digest_current);
   // Migrated, it opens with every check (its digests rewritten), each regrasp taken again by the
-  // arm that set it down, no edge's duration estimated.
+  // arm that set it down, no edge's duration estimated, no candidate's bodies.
   migrate_in_place(path);
   const Database db = Database::open(path);
   std::size_t regrasps = 0;
@@ -274,17 +278,18 @@ TEST(OpenChecks, Version7OffersMigration) {
   EXPECT_EQ(regrasps, 5u);
   ASSERT_EQ(db.regrasp_edges(1).size(), 6u);
   for (const auto& e : db.regrasp_edges(1)) EXPECT_EQ(e.duration, 0.0) << e.id;
+  for (const auto& c : db.handover_candidates(1)) EXPECT_EQ(c.bodies, 0u) << c.id;
 }
 
 TEST(OpenChecks, Version8OffersMigration) {
   const std::string path = write_small(temp_dir("db_open_v8"));
   const std::string digest_current = content_digest(path);
-  detail::execute_script(path, kDropVersion9Columns +
+  detail::execute_script(path, kDropVersion10Columns + kDropVersion9Columns +
                                    "UPDATE meta SET value = '8' WHERE key = 'schema_version'");
   expect_input_error(
       [&] { Database::open(path); },
       {path +
-       ": meta.schema_version: expected a database this hila reads (schema version 9), "
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
        "got one written by schema version 8 (an older hila); rebuild with: hila build "
        "meshes/cabinet/product.yaml -o " +
        path + " (or migrate it in place with hila::db::migrate_in_place)"});
@@ -292,10 +297,11 @@ TEST(OpenChecks, Version8OffersMigration) {
   const std::string digest_v8 = content_digest(path);
   EXPECT_EQ(digest_v8.size(), 64u);
   EXPECT_NE(digest_v8, digest_current);
-  // Migrated, it opens with every check (its digests rewritten), no edge's duration estimated.
+  // Migrated, it opens with every check (its digests rewritten), no edge's duration estimated, no
+  // candidate's bodies.
   migrate_in_place(path);
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
   std::size_t edges = 0;
   for (const std::int64_t part : {1, 2}) {
     for (const auto& e : db.regrasp_edges(part)) {
@@ -304,20 +310,57 @@ TEST(OpenChecks, Version8OffersMigration) {
     }
   }
   EXPECT_EQ(edges, 8u);
-  // The migration's digests differ from the writer's only where the durations do: the same sample
-  // with none estimated has the same content.
+  // The migration's digests differ from the writer's only where the durations and masks do: the
+  // same sample with none estimated and none taking a body has the same content.
   const std::string dir = temp_dir("db_open_v8_written");
   Sample sample = make_sample();
   clear_durations(sample);
+  clear_bodies(sample);
+  write_sample(dir + "/p.db", sample);
+  EXPECT_EQ(content_digest(path), content_digest(dir + "/p.db"));
+}
+
+TEST(OpenChecks, Version9OffersMigration) {
+  const std::string path = write_small(temp_dir("db_open_v9"));
+  const std::string digest_current = content_digest(path);
+  detail::execute_script(
+      path, kDropVersion10Columns + "UPDATE meta SET value = '9' WHERE key = 'schema_version'");
+  expect_input_error(
+      [&] { Database::open(path); },
+      {path +
+       ": meta.schema_version: expected a database this hila reads (schema version 10), "
+       "got one written by schema version 9 (an older hila); rebuild with: hila build "
+       "meshes/cabinet/product.yaml -o " +
+       path + " (or migrate it in place with hila::db::migrate_in_place)"});
+  // The digest still reads it (a version 9 file has no handover_candidates.bodies), and differs.
+  const std::string digest_v9 = content_digest(path);
+  EXPECT_EQ(digest_v9.size(), 64u);
+  EXPECT_NE(digest_v9, digest_current);
+  // Migrated, it opens with every check (its digests rewritten), no candidate taking a body.
+  migrate_in_place(path);
+  const Database db = Database::open(path);
+  EXPECT_EQ(db.meta().schema_version, 10);
+  std::size_t candidates = 0;
+  for (const std::int64_t part : {1, 2}) {
+    for (const auto& c : db.handover_candidates(part)) {
+      ++candidates;
+      EXPECT_EQ(c.bodies, 0u) << c.id;
+    }
+  }
+  EXPECT_EQ(candidates, 9u);
+  // The migration's digests differ from the writer's only where the masks do.
+  const std::string dir = temp_dir("db_open_v9_written");
+  Sample sample = make_sample();
+  clear_bodies(sample);
   write_sample(dir + "/p.db", sample);
   EXPECT_EQ(content_digest(path), content_digest(dir + "/p.db"));
 }
 
 TEST(OpenChecks, NewerSchemaVersion) {
   const std::string path = write_small(temp_dir("db_open_newer"));
-  detail::execute_script(path, "UPDATE meta SET value = '10' WHERE key = 'schema_version'");
+  detail::execute_script(path, "UPDATE meta SET value = '11' WHERE key = 'schema_version'");
   expect_input_error([&] { Database::open(path); },
-                     {path + ": meta.schema_version", "written by schema version 10 (a newer hila)",
+                     {path + ": meta.schema_version", "written by schema version 11 (a newer hila)",
                       "upgrade hila, or rebuild with: hila build"});
 }
 

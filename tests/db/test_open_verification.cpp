@@ -500,7 +500,7 @@ TEST(OpenVerification, WrongStorageClassesAndColumns) {
           {path + ": meta.value (key 'product_name'): expected a TEXT (the column is TEXT NOT "
                   "NULL), got a BLOB of 1 byte"});
   refused("ALTER TABLE robot_grasps ADD COLUMN note TEXT",
-          {path + ": robot_grasps: expected the 26 columns of schema version 9, got 27 columns "
+          {path + ": robot_grasps: expected the 26 columns of schema version 10, got 27 columns "
                   "(column 27 is 'note', expected none)"});
 }
 
@@ -629,19 +629,20 @@ TEST(OpenVerification, Version6FileIsMigratedWithItsDigests) {
   edit(path,
        "DROP TABLE suction_deliveries;"
        "ALTER TABLE table_regrasps DROP COLUMN repick_arm;" +
-           regrasp_edges_before_v9_sql() +
+           regrasp_edges_before_v9_sql() + handover_candidates_before_v10_sql() +
            "DELETE FROM meta WHERE key GLOB 'digest.*';"
            "UPDATE meta SET value = '6' WHERE key = 'schema_version'");
   // This hila's writer for the same records: a version 6 regrasp is taken again by its own arm,
-  // and no edge's duration is estimated.
+  // no edge's duration is estimated and no candidate takes a body.
   for (auto& r : sample.parts[0].table_regrasps) r.repick_arm = r.arm;
   clear_durations(sample);
+  clear_bodies(sample);
   const std::string written = dir + "/written.db";
   write_sample(written, sample);
   expect_input_error([&] { Database::open(path); },
                      {path +
                       ": meta.schema_version: expected a database this hila reads (schema "
-                      "version 9), got one written by schema version 6 (an older hila); " +
+                      "version 10), got one written by schema version 6 (an older hila); " +
                       rebuild(path) + " (or migrate it in place with hila::db::migrate_in_place)"});
   migrate_in_place(path);
   EXPECT_NO_THROW(Database::open(path)) << "built by this hila: opens with the default options";

@@ -192,7 +192,7 @@ class RoadmapRoundTrip : public ::testing::Test {
 };
 
 TEST_F(RoadmapRoundTrip, SchemaVersion) {
-  EXPECT_EQ(Database::open(path_).meta().schema_version, 9);
+  EXPECT_EQ(Database::open(path_).meta().schema_version, 10);
 }
 
 TEST_F(RoadmapRoundTrip, RoadmapsBitForBitInIdOrder) {
@@ -354,18 +354,20 @@ TEST_F(RoadmapRoundTrip, RegraspEdgeDurationChecksInTheFile) {
   for (const std::string sql : {
            "UPDATE regrasp_edges SET duration = -1.0 WHERE id = 1",
            "UPDATE regrasp_edges SET duration = -1e-300 WHERE id = 2",
-           "UPDATE regrasp_edges SET duration = 2.5 WHERE id = 4",  // not connected
+           "UPDATE regrasp_edges SET duration = 2.5 WHERE id = 4",     // not connected
            "UPDATE regrasp_edges SET duration = 1e-300 WHERE id = 5",  // a handover
            "UPDATE regrasp_edges SET duration = NULL WHERE id = 1",
        }) {
     SCOPED_TRACE(sql);
-    expect_input_error([&] { detail::execute_script(path_, sql); },
-                       {std::string(sql.find("NULL") == std::string::npos
-                                        ? "CHECK constraint failed"
-                                        : "NOT NULL constraint failed")});
+    expect_input_error(
+        [&] { detail::execute_script(path_, sql); },
+        {std::string(sql.find("NULL") == std::string::npos ? "CHECK constraint failed"
+                                                           : "NOT NULL constraint failed")});
   }
-  EXPECT_NO_THROW(detail::execute_script(path_, "UPDATE regrasp_edges SET duration = 0 WHERE id = 1"));
-  EXPECT_NO_THROW(detail::execute_script(path_, "UPDATE regrasp_edges SET duration = 7 WHERE id = 3"));
+  EXPECT_NO_THROW(
+      detail::execute_script(path_, "UPDATE regrasp_edges SET duration = 0 WHERE id = 1"));
+  EXPECT_NO_THROW(
+      detail::execute_script(path_, "UPDATE regrasp_edges SET duration = 7 WHERE id = 3"));
 }
 
 TEST_F(RoadmapRoundTrip, RegraspEdgePathColumnsInTheFile) {
@@ -993,9 +995,10 @@ TEST(RoadmapReader, DamagedRowsAreDatabaseErrors) {
           {"regrasp_edges.path_dof (id 4)", "expected 0 when path_waypoints is 0", "got 6"});
   // The duration (schema version 9). +infinity passes the file's CHECK (duration >= 0).
   damaged("infinite duration", "UPDATE regrasp_edges SET duration = 9e999 WHERE id = 2",
-          {path + ": regrasp_edges.duration (id 2): expected a time in seconds, finite and >= 0, "
-                  "got inf; rebuild with: hila build meshes/cabinet/product.yaml -o " +
-               path});
+          {path +
+           ": regrasp_edges.duration (id 2): expected a time in seconds, finite and >= 0, "
+           "got inf; rebuild with: hila build meshes/cabinet/product.yaml -o " +
+           path});
   damaged("duration that is not a number",
           "UPDATE regrasp_edges SET duration = 'slow' WHERE id = 1",
           {path + ": regrasp_edges.duration (id 1): expected a REAL (the column is REAL NOT "
@@ -1018,9 +1021,10 @@ TEST(RoadmapReader, BadDurationsPastTheFilesChecksAreDatabaseErrors) {
     expect_input_error([&] { Database::open(path); }, fragments);
   };
   damaged("negative duration", "UPDATE regrasp_edges SET duration = -2.5 WHERE id = 3",
-          {path + ": regrasp_edges.duration (id 3): expected a time in seconds, finite and >= 0, "
-                  "got -2.5; rebuild with: hila build meshes/cabinet/product.yaml -o " +
-               path});
+          {path +
+           ": regrasp_edges.duration (id 3): expected a time in seconds, finite and >= 0, "
+           "got -2.5; rebuild with: hila build meshes/cabinet/product.yaml -o " +
+           path});
   damaged("the least negative duration",
           "UPDATE regrasp_edges SET duration = -4.9406564584124654e-324 WHERE id = 1",
           {path + ": regrasp_edges.duration (id 1): expected a time in seconds, finite and >= 0, "

@@ -34,9 +34,9 @@ std::vector<std::string> create_statements(const std::string& sql) {
 
 }  // namespace
 
-TEST(Schema, VersionIsNineWithStepsFromOneToEight) {
-  EXPECT_EQ(current_schema_version(), 9);
-  ASSERT_EQ(migration_steps().size(), 8u);
+TEST(Schema, VersionIsTenWithStepsFromOneToNine) {
+  EXPECT_EQ(current_schema_version(), 10);
+  ASSERT_EQ(migration_steps().size(), 9u);
   EXPECT_EQ(migration_steps()[0].from_version, 1);
   EXPECT_EQ(migration_steps()[1].from_version, 2);
   EXPECT_EQ(migration_steps()[2].from_version, 3);
@@ -45,6 +45,7 @@ TEST(Schema, VersionIsNineWithStepsFromOneToEight) {
   EXPECT_EQ(migration_steps()[5].from_version, 6);
   EXPECT_EQ(migration_steps()[6].from_version, 7);
   EXPECT_EQ(migration_steps()[7].from_version, 8);
+  EXPECT_EQ(migration_steps()[8].from_version, 9);
   EXPECT_TRUE(can_migrate(migration_steps(), 1, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 2, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 3, current_schema_version()));
@@ -53,6 +54,7 @@ TEST(Schema, VersionIsNineWithStepsFromOneToEight) {
   EXPECT_TRUE(can_migrate(migration_steps(), 6, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 7, current_schema_version()));
   EXPECT_TRUE(can_migrate(migration_steps(), 8, current_schema_version()));
+  EXPECT_TRUE(can_migrate(migration_steps(), 9, current_schema_version()));
   EXPECT_FALSE(can_migrate(migration_steps(), 0, current_schema_version()));
   // The steps create the tables exactly as a fresh database has them.
   EXPECT_NE(migration_steps()[0].sql.find("CREATE TABLE comfort_maps ("), std::string::npos);
@@ -64,8 +66,25 @@ TEST(Schema, VersionIsNineWithStepsFromOneToEight) {
     EXPECT_NE(migration_steps()[1].sql.find("CREATE TABLE " + table + " ("), std::string::npos)
         << table;
   }
+  // 2 -> 3 as a fresh database has them, but for version 10's handover_candidates.bodies.
+  std::string handover_candidates_v3;
   for (const auto& statement : created) {
+    if (statement.rfind("CREATE TABLE handover_candidates (", 0) == 0) {
+      handover_candidates_v3 = statement;
+      EXPECT_EQ(statement.find("bodies"), std::string::npos) << statement;
+      EXPECT_EQ(schema_sql().find(statement), std::string::npos) << "version 10 changed the table";
+      continue;
+    }
     EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  {
+    // Version 10's table is version 3's with the column after second_joints, before the CHECK.
+    std::string with_bodies = handover_candidates_v3;
+    const std::string last_column = "  second_joints BLOB NOT NULL,\n";
+    ASSERT_NE(with_bodies.find(last_column), std::string::npos);
+    with_bodies.insert(with_bodies.find(last_column) + last_column.size(),
+                       "  bodies INTEGER NOT NULL CHECK (bodies >= 0 AND bodies < 4294967296),\n");
+    EXPECT_NE(schema_sql().find(with_bodies), std::string::npos) << with_bodies;
   }
   EXPECT_NE(migration_steps()[1].sql.find(
                 "INSERT OR IGNORE INTO meta (key, value) VALUES ('human_bodies', '');"),
@@ -189,7 +208,8 @@ TEST(Schema, VersionIsNineWithStepsFromOneToEight) {
   }
   const std::size_t added =
       step_v9.find("ALTER TABLE regrasp_edges ADD COLUMN duration REAL NOT NULL DEFAULT 0.0;");
-  const std::size_t moved_v9 = step_v9.find("ALTER TABLE regrasp_edges RENAME TO regrasp_edges_v8;");
+  const std::size_t moved_v9 =
+      step_v9.find("ALTER TABLE regrasp_edges RENAME TO regrasp_edges_v8;");
   const std::size_t copied_v9 = step_v9.find("INSERT INTO regrasp_edges (");
   const std::size_t dropped_v9 = step_v9.find("DROP TABLE regrasp_edges_v8;");
   ASSERT_NE(added, std::string::npos) << step_v9;
@@ -212,6 +232,56 @@ TEST(Schema, VersionIsNineWithStepsFromOneToEight) {
   EXPECT_EQ(step_v9.find("INSERT", copied_v9 + 1), std::string::npos) << "one INSERT";
   EXPECT_EQ(step_v9.find("INSERT"), copied_v9);
   EXPECT_EQ(step_v9.find("digest"), std::string::npos)
+      << "the migration, not the step, writes the digests";
+  // 9 -> 10: handover_candidates rebuilt with bodies (and its index again), as a fresh database
+  // has them, and nothing else: the column added (failing on a table that has it), the old table
+  // out of the way without touching the references to it, the new one created, the rows copied,
+  // the old table dropped.
+  const std::string& step_v10 = migration_steps()[8].sql;
+  const auto created_v10 = create_statements(step_v10);
+  ASSERT_EQ(created_v10.size(), 2u) << "1 table, 1 index";
+  EXPECT_EQ(created_v10[0].rfind("CREATE TABLE handover_candidates (", 0), 0u) << created_v10[0];
+  EXPECT_NE(created_v10[0].find(
+                "  bodies INTEGER NOT NULL CHECK (bodies >= 0 AND bodies < 4294967296),\n"),
+            std::string::npos);
+  EXPECT_EQ(created_v10[1],
+            "CREATE INDEX handover_candidates_part_id ON handover_candidates(part_id);");
+  for (const auto& statement : created_v10) {
+    EXPECT_NE(schema_sql().find(statement), std::string::npos) << statement;
+  }
+  const std::size_t added_v10 = step_v10.find(
+      "ALTER TABLE handover_candidates ADD COLUMN bodies INTEGER NOT NULL DEFAULT 0;");
+  const std::size_t legacy_on = step_v10.find("PRAGMA legacy_alter_table = ON;");
+  const std::size_t moved_v10 =
+      step_v10.find("ALTER TABLE handover_candidates RENAME TO handover_candidates_v9;");
+  const std::size_t legacy_off = step_v10.find("PRAGMA legacy_alter_table = OFF;");
+  const std::size_t copied_v10 = step_v10.find("INSERT INTO handover_candidates (");
+  const std::size_t dropped_v10 = step_v10.find("DROP TABLE handover_candidates_v9;");
+  ASSERT_NE(added_v10, std::string::npos) << step_v10;
+  ASSERT_NE(legacy_on, std::string::npos) << step_v10;
+  ASSERT_NE(moved_v10, std::string::npos) << step_v10;
+  ASSERT_NE(legacy_off, std::string::npos) << step_v10;
+  ASSERT_NE(copied_v10, std::string::npos) << step_v10;
+  ASSERT_NE(dropped_v10, std::string::npos) << step_v10;
+  EXPECT_EQ(added_v10, 0u) << "first, so that a table with the column fails before anything moves";
+  EXPECT_LT(added_v10, step_v10.find("DROP INDEX handover_candidates_part_id;"));
+  EXPECT_LT(step_v10.find("DROP INDEX handover_candidates_part_id;"), legacy_on);
+  EXPECT_LT(legacy_on, moved_v10);
+  EXPECT_LT(moved_v10, legacy_off);
+  EXPECT_LT(legacy_off, step_v10.find("CREATE TABLE handover_candidates ("));
+  EXPECT_LT(step_v10.find("CREATE TABLE handover_candidates ("), copied_v10);
+  EXPECT_LT(copied_v10, dropped_v10);
+  const std::string columns =
+      "id, part_id, sample, board_x, board_y, board_z, board_qw, board_qx, board_qy, board_qz, "
+      "distance, quality, status, rank, human_arm, human_grasp_id, human_quality, second_arm, "
+      "second_grasp_id, second_quality, human_joints, second_joints, bodies";
+  EXPECT_NE(step_v10.find("INSERT INTO handover_candidates (" + columns + ")\n  SELECT " + columns +
+                          " FROM handover_candidates_v9 ORDER BY id;"),
+            std::string::npos)
+      << step_v10;
+  EXPECT_EQ(step_v10.find("INSERT", copied_v10 + 1), std::string::npos) << "one INSERT";
+  EXPECT_EQ(step_v10.find("INSERT"), copied_v10);
+  EXPECT_EQ(step_v10.find("digest"), std::string::npos)
       << "the migration, not the step, writes the digests";
 }
 
@@ -318,6 +388,7 @@ TEST(Schema, HandoverAndErgonomicsColumnsAreDeclared) {
            "second_quality REAL NOT NULL",
            "human_joints BLOB NOT NULL",
            "second_joints BLOB NOT NULL",
+           "bodies INTEGER NOT NULL CHECK (bodies >= 0 AND bodies < 4294967296)",
            "candidate_id INTEGER NOT NULL REFERENCES handover_candidates(id)",
            "robot_grasp_id INTEGER NOT NULL REFERENCES robot_grasps(id)",
            "robot_handover_id INTEGER NOT NULL REFERENCES robot_handovers(id)",
@@ -332,6 +403,14 @@ TEST(Schema, HandoverAndErgonomicsColumnsAreDeclared) {
        }) {
     EXPECT_NE(sql.find(column), std::string::npos) << column;
   }
+  // The column specs the checks at open use: bodies last, an INTEGER, after second_joints, as the
+  // writer and reader name them.
+  const auto& columns = schema_columns("handover_candidates");
+  ASSERT_EQ(columns.size(), 23u);
+  EXPECT_EQ(columns[21].name, "second_joints");
+  EXPECT_EQ(columns[22].name, "bodies");
+  EXPECT_EQ(columns[22].storage_class, SQLITE_INTEGER);
+  EXPECT_FALSE(columns[22].nullable);
 }
 
 TEST(Schema, RoadmapAndRegraspColumnsAreDeclared) {

@@ -64,7 +64,7 @@ TEST(SuctionDeliveries, EveryFieldRoundTripsPerCandidateInIdOrder) {
   const Sample sample = make_sample();
   write_sample(path, sample);
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
 
   const auto& written = sample.parts[0].suction_deliveries;
   ASSERT_EQ(written.size(), 5u);

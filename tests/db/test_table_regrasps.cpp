@@ -89,7 +89,7 @@ TEST(TableRegrasps, EveryFieldRoundTripsPerCandidateInIdOrder) {
   const Sample sample = make_sample();
   write_sample(path, sample);
   const Database db = Database::open(path);
-  EXPECT_EQ(db.meta().schema_version, 9);
+  EXPECT_EQ(db.meta().schema_version, 10);
 
   const auto& written = sample.parts[0].table_regrasps;
   ASSERT_EQ(written.size(), 5u);

@@ -6,17 +6,18 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <cmath>
-#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "hila/db/database.hpp"
 #include "hila/db/migration.hpp"
@@ -81,8 +82,8 @@ std::pair<int, int> expect_stored_durations(const nlohmann::json& graph, const s
   for (auto it = std::sregex_iterator(text.begin(), text.end(), timed);
        it != std::sregex_iterator(); ++it) {
     ++mentions;
-    EXPECT_TRUE(shown.count((*it)[1].str())) << "'" << (*it)[1].str() << "' is no edge of part "
-                                             << part_id << "'s regrasp_edges";
+    EXPECT_TRUE(shown.count((*it)[1].str()))
+        << "'" << (*it)[1].str() << "' is no edge of part " << part_id << "'s regrasp_edges";
   }
   return {blocks, mentions};
 }
@@ -290,8 +291,8 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
     const CommandRun graph_text = run("inspect " + out + " graph --part " + board + " --goals 99");
     ASSERT_EQ(graph_text.status, 0) << graph_text.out;
     int estimated = 0;
-    const auto [blocks, mentions] = expect_stored_durations(
-        gr, graph_text.out, database, database.part(board).id, estimated);
+    const auto [blocks, mentions] =
+        expect_stored_durations(gr, graph_text.out, database, database.part(board).id, estimated);
     EXPECT_GT(blocks, 0) << board;
     EXPECT_GT(mentions, 0) << board << "\n" << graph_text.out;
     EXPECT_GT(estimated, 0) << board;
@@ -493,10 +494,11 @@ TEST(Cli, InspectGraphShowsEachStoredEdgesCostAndEstimatedTime) {
     SCOPED_TRACE(part.name);
     const CommandRun graph = run("inspect " + db_path + " graph --part " + part.name + " --json");
     ASSERT_EQ(graph.status, 0) << graph.out;
-    const CommandRun text = run("inspect " + db_path + " graph --part " + part.name + " --goals 99");
+    const CommandRun text =
+        run("inspect " + db_path + " graph --part " + part.name + " --goals 99");
     ASSERT_EQ(text.status, 0) << text.out;
-    const auto [b, m] = expect_stored_durations(nlohmann::json::parse(json_part(graph.out)), text.out,
-                                                database, part.id, estimated);
+    const auto [b, m] = expect_stored_durations(nlohmann::json::parse(json_part(graph.out)),
+                                                text.out, database, part.id, estimated);
     boards += b > 0 ? 1 : 0;
     blocks += b;
     mentions += m;
@@ -507,7 +509,8 @@ TEST(Cli, InspectGraphShowsEachStoredEdgesCostAndEstimatedTime) {
   EXPECT_LT(estimated, blocks) << "handover edges have no path, so no time";
 
   // A file migrated from schema 8 (made from this one: regrasp_edges as versions 4 to 8 declared
-  // it, the 3 -> 4 step's text, then migrated), whose durations were never estimated: the text
+  // it, the 3 -> 4 step's text, handover_candidates without its schema 10 column, then migrated),
+  // whose durations were never estimated: the text
   // shows the cost without a time, the JSON 0.
   const std::string& step_v4 = db::detail::migration_steps().at(2).sql;
   const std::string to_v8 =
@@ -516,6 +519,7 @@ TEST(Cli, InspectGraphShowsEachStoredEdgesCostAndEstimatedTime) {
       "INSERT INTO regrasp_edges SELECT id, part_id, kind, arm, from_node, to_node, filter_id, "
       "connected, cost, path_nodes, via, path_dof, path_waypoints, path FROM regrasp_edges_v9;"
       "DROP TABLE regrasp_edges_v9;"
+      "ALTER TABLE handover_candidates DROP COLUMN bodies;"  // schema 10's, as in schema 8 to 9
       "UPDATE meta SET value = '8' WHERE key = 'schema_version';";
   sqlite3* handle = nullptr;
   ASSERT_EQ(sqlite3_open(db_path.c_str(), &handle), SQLITE_OK);
@@ -543,6 +547,118 @@ TEST(Cli, InspectGraphShowsEachStoredEdgesCostAndEstimatedTime) {
   EXPECT_FALSE(std::regex_search(old_text.out, std::regex(R"(rad \d+\.\d s )"))) << old_text.out;
   EXPECT_TRUE(std::regex_search(old_text.out, std::regex(R"(\d+\.\d\d rad (roadmap|bridge))")))
       << old_text.out;
+}
+
+namespace {
+
+// A one-board database written through hila::db: meta.human_bodies `human_bodies`, the board's
+// stage and its candidates with these masks (handover_candidates.bodies), goals of ranks 0, 1, ...
+// in order, and one uncomfortable candidate (mask `other`) that `inspect handover` does not list.
+std::string write_goals_with_bodies(const std::string& path, const std::string& human_bodies,
+                                    const std::vector<std::uint32_t>& goal_bodies,
+                                    std::uint32_t other) {
+  db::DatabaseWriter writer(path);
+  db::Meta meta;
+  meta.product_name = "one board";
+  meta.cell_hash = std::string(64, 'c');
+  meta.product_hash = std::string(64, 'a');
+  meta.settings_hash = std::string(64, '5');
+  meta.cell_file = "cell.yaml";
+  meta.product_file = "product.yaml";
+  meta.human_bodies = human_bodies;
+  writer.write_meta(meta);
+  db::PartRecord part;
+  part.name = "board";
+  part.mass = 1.0;
+  const std::int64_t id = writer.add_part(part);
+  db::HandoverStageRecord stage;
+  stage.part_id = id;
+  stage.candidates = static_cast<int>(goal_bodies.size()) + 1;
+  stage.comfortable = static_cast<int>(goal_bodies.size());
+  stage.goals = static_cast<int>(goal_bodies.size());
+  writer.add_handover_stage(stage);
+  std::vector<db::HandoverCandidateRecord> candidates;
+  db::HandoverCandidateRecord uncomfortable;
+  uncomfortable.status = "uncomfortable";
+  uncomfortable.bodies = other;
+  candidates.push_back(uncomfortable);
+  for (std::size_t i = 0; i < goal_bodies.size(); ++i) {
+    db::HandoverCandidateRecord goal;
+    goal.sample = static_cast<int>(i + 1);
+    goal.board.translation() = Eigen::Vector3d(0.5, 0.1 * static_cast<double>(i), 1.0);
+    goal.distance = 0.125 * static_cast<double>(i + 1);
+    goal.quality = 0.5;
+    goal.status = "goal";
+    goal.rank = static_cast<int>(i);
+    goal.human_arm = "right";
+    goal.human_grasp_id = 1;
+    goal.human_quality = 0.5;
+    goal.bodies = goal_bodies[i];
+    candidates.push_back(goal);
+  }
+  writer.add_handover_candidates(id, candidates);
+  writer.commit();
+  return path;
+}
+
+}  // namespace
+
+// `inspect handover` says which bodies of the build's worker set (meta.human_bodies) take each
+// goal comfortably (handover_candidates.bodies, schema 10): their labels in --json ("bodies", an
+// empty list for none and without a body set) and after each goal's line in the text ("bodies:
+// 1.5 female, 1.82 male", "bodies: none"), nothing of it without a body set.
+TEST(Cli, InspectHandoverNamesTheBodiesOfTheWorkerSetEachGoalSuits) {
+  const std::string dir = test::temp_dir("cli_handover_bodies");
+  const std::string with_set =
+      write_goals_with_bodies(dir + "/set.hila", "1.5 female; 1.82 male", {3, 0, 2, 1}, 3);
+  const CommandRun json = run("inspect " + with_set + " handover --part board --json");
+  ASSERT_EQ(json.status, 0) << json.out;
+  const auto j = nlohmann::json::parse(json_part(json.out));
+  EXPECT_EQ(j["human_bodies"], "1.5 female; 1.82 male");
+  ASSERT_EQ(j["ranked_goals"].size(), 4u) << "the goals only";
+  using Labels = std::vector<std::string>;
+  EXPECT_EQ(j["ranked_goals"][0]["bodies"].get<Labels>(), (Labels{"1.5 female", "1.82 male"}));
+  EXPECT_TRUE(j["ranked_goals"][1]["bodies"].is_array());
+  EXPECT_EQ(j["ranked_goals"][1]["bodies"].get<Labels>(), Labels{});
+  EXPECT_EQ(j["ranked_goals"][2]["bodies"].get<Labels>(), Labels{"1.82 male"});
+  EXPECT_EQ(j["ranked_goals"][3]["bodies"].get<Labels>(), Labels{"1.5 female"});
+  const CommandRun text = run("inspect " + with_set + " handover --part board");
+  ASSERT_EQ(text.status, 0) << text.out;
+  EXPECT_NE(text.out.find("  worker set: 1.5 female; 1.82 male\n"), std::string::npos) << text.out;
+  // Each goal's line, by rank, ends with its bodies.
+  const std::vector<std::string> expected = {"bodies: 1.5 female, 1.82 male", "bodies: none",
+                                             "bodies: 1.82 male", "bodies: 1.5 female"};
+  std::map<int, std::string> lines;
+  std::istringstream in(text.out);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (std::regex_match(line, m, std::regex(R"(\s+(\d+)\s+\d+\.\d{3}\s+.*)"))) {
+      lines[std::stoi(m[1].str())] = line;
+    }
+  }
+  ASSERT_EQ(lines.size(), expected.size()) << text.out;
+  for (int rank = 0; rank < static_cast<int>(expected.size()); ++rank) {
+    const std::string& line = lines.at(rank);
+    const std::string& tail = expected[static_cast<std::size_t>(rank)];
+    EXPECT_TRUE(line.size() >= tail.size() &&
+                line.compare(line.size() - tail.size(), tail.size(), tail) == 0)
+        << "rank " << rank << ": " << line;
+  }
+
+  // Without a body set: an empty list per goal, and the text says nothing of bodies.
+  const std::string without_set = write_goals_with_bodies(dir + "/none.hila", "", {0, 0}, 0);
+  const CommandRun none_json = run("inspect " + without_set + " handover --part board --json");
+  ASSERT_EQ(none_json.status, 0) << none_json.out;
+  const auto n = nlohmann::json::parse(json_part(none_json.out));
+  ASSERT_EQ(n["ranked_goals"].size(), 2u);
+  for (const auto& goal : n["ranked_goals"]) {
+    ASSERT_TRUE(goal["bodies"].is_array()) << goal.dump();
+    EXPECT_TRUE(goal["bodies"].empty()) << goal.dump();
+  }
+  const CommandRun none_text = run("inspect " + without_set + " handover --part board");
+  ASSERT_EQ(none_text.status, 0) << none_text.out;
+  EXPECT_EQ(none_text.out.find("bodies"), std::string::npos) << none_text.out;
+  EXPECT_EQ(none_text.out.find("worker set"), std::string::npos) << none_text.out;
 }
 
 // `inspect digest` answers only for a database the loader opens: one another hila built (its

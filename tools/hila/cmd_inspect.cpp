@@ -4,6 +4,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "cmd_inspect_graph.hpp"
 #include "commands.hpp"
@@ -142,6 +144,8 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
   }
   std::map<std::int64_t, double> theta_c;
   for (const auto& g : database.robot_grasps(part.id)) theta_c[g.id] = g.theta_c_deg;
+  // The build's worker set, in the order the goals' masks number its bodies.
+  const std::vector<std::string> body_labels = db::human_body_labels(database.meta().human_bodies);
   nlohmann::json goals = nlohmann::json::array();
   for (const auto& c : database.handover_goals(part.id)) {
     nlohmann::json shared = nlohmann::json::array();
@@ -189,6 +193,12 @@ nlohmann::json handover_json(const db::Database& database, const std::string& pa
       on_cup.push_back({{"id", d.id}, {"arm", d.arm}, {"suction_grasp", d.suction_grasp_id}});
     }
     g["suction_deliveries"] = on_cup;
+    // The bodies of the worker set that take this goal comfortably (bit i: body i).
+    nlohmann::json bodies = nlohmann::json::array();
+    for (std::size_t i = 0; i < body_labels.size() && i < 32; ++i) {
+      if ((c.bodies >> i) & 1u) bodies.push_back(body_labels[i]);
+    }
+    g["bodies"] = bodies;
     if (!c.second_arm.empty()) {
       g["second_arm"] = c.second_arm;
       g["second_grasp"] = c.second_grasp_id;
@@ -295,6 +305,10 @@ int run_inspect(const InspectOptions& opt) {
     if (!j["failure"].get<std::string>().empty()) {
       std::cout << "  no goal: " << j["failure"].get<std::string>() << "\n";
     }
+    const bool with_body_set = !db::human_body_labels(database.meta().human_bodies).empty();
+    if (with_body_set) {
+      std::cout << "  worker set: " << database.meta().human_bodies << "\n";
+    }
     std::cout << "  rank  distance m  Q      human hand (grasp)   shared grasps (theta_c deg) at "
                  "rr poses\n";
     int shown = 0;
@@ -337,10 +351,18 @@ int run_inspect(const InspectOptions& opt) {
                   d["arm"].get<std::string>() + " slip " + slip.str();
       }
       if (!direct.empty()) shared += (shared.empty() ? "" : "; ") + std::string("direct ") + direct;
+      // With a worker set, the bodies that take the goal comfortably ("none" for none of them).
+      std::string bodies;
+      if (with_body_set) {
+        for (const auto& b : g["bodies"]) {
+          bodies += (bodies.empty() ? "" : ", ") + b.get<std::string>();
+        }
+        bodies = "  bodies: " + (bodies.empty() ? std::string("none") : bodies);
+      }
       std::cout << std::setw(6) << g["rank"].get<int>() << std::setw(12) << std::fixed
                 << std::setprecision(3) << g["distance"].get<double>() << "  " << std::setw(5)
                 << std::setprecision(3) << g["quality"].get<double>() << "  " << std::left
-                << std::setw(20) << hand << std::right << " " << shared << "\n";
+                << std::setw(20) << hand << std::right << " " << shared << bodies << "\n";
     }
     return 0;
   }

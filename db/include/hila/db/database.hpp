@@ -18,6 +18,11 @@ int current_schema_version();
 // Database::open expects there by default (OpenOptions::expected_hila_version).
 std::string hila_version();
 
+// The bodies of a meta.human_bodies value in stored order: its items joined by "; ", e.g.
+// "1.5 female; 1.82 male" -> {"1.5 female", "1.82 male"} ("" -> none; empty items are skipped).
+// Bit i of HandoverCandidateRecord::bodies stands for item i.
+std::vector<std::string> human_body_labels(const std::string& human_bodies);
+
 // SHA-256 of bytes / of a file, lower-case hex. Throws core::InputError for an unreadable file.
 std::string sha256_hex(const std::string& bytes);
 std::string sha256_file(const std::string& path);
@@ -202,7 +207,8 @@ class Database {
   std::vector<SharedGraspRecord> shared_grasps(std::int64_t candidate_id) const;    // id order
   std::vector<DirectGraspRecord> direct_grasps(std::int64_t candidate_id) const;    // id order
   std::vector<TableRegraspRecord> table_regrasps(std::int64_t candidate_id) const;  // id order
-  std::vector<SuctionDeliveryRecord> suction_deliveries(std::int64_t candidate_id) const;  // id order
+  std::vector<SuctionDeliveryRecord> suction_deliveries(
+      std::int64_t candidate_id) const;                                  // id order
   std::vector<ErgonomicsRecord> ergonomics(std::int64_t part_id) const;  // id (write) order
 
   // Roadmaps and the regrasp graph (schema version 4). The arm's roadmap, or nullptr when the

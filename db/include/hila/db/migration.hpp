@@ -16,7 +16,8 @@ struct MigrationStep {
 // ergonomics tables and meta.human_bodies, 3 -> 4 the roadmap and regrasp-graph tables, 4 -> 5
 // direct_grasps, 5 -> 6 table_regrasps, 6 -> 7 the per-table content digests in meta, which the
 // migration itself writes after its last step, 7 -> 8 suction_deliveries and
-// table_regrasps.repick_arm, 8 -> 9 regrasp_edges.duration).
+// table_regrasps.repick_arm, 8 -> 9 regrasp_edges.duration, 9 -> 10
+// handover_candidates.bodies).
 const std::vector<MigrationStep>& migration_steps();
 
 // True if `steps` hold one step for every version from `from_version` up to `to_version` - 1.
