@@ -216,7 +216,8 @@ struct Result {
   std::map<std::string, int> outcomes;  // every attempt's outcome in full, with its count
   std::vector<std::string> invalidity;  // solved but rejected by the re-check
   int checked_samples = 0;
-  int motions_planned = 0;  // BoardPlan::motions_planned
+  int motions_planned = 0;        // BoardPlan::motions_planned
+  int human_postures_solved = 0;  // BoardPlan::human_postures_solved
   bool invalid() const { return solved && !invalidity.empty(); }
 };
 
@@ -279,6 +280,7 @@ Result run(online::BoardPlanner& planner, const online::PlannerModel& model,
   r.times = plan.times;
   r.attempts = static_cast<int>(plan.attempts.size());
   r.motions_planned = plan.motions_planned;
+  r.human_postures_solved = plan.human_postures_solved;
   for (const auto& a : plan.attempts) ++r.outcomes[a.outcome];
   if (!r.solved) {
     r.why_failed = why_failed(plan);
@@ -389,6 +391,7 @@ nlohmann::json result_json(const Result& r) {
     j["invalidity"] = r.invalidity;
     j["checked_samples"] = r.checked_samples;
     j["motions_planned"] = r.motions_planned;
+    j["human_postures_solved"] = r.human_postures_solved;
   }
   return j;
 }

@@ -308,6 +308,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       r.joints = goal.human_joints;
       r.second_joints = goal.second_joints;
     } else {  // the human arms' IK: no comfort maps needed
+      ++result.human_postures_solved;
       r = WorkerComfort::goal_reach(model_.cell(), goal, records->human_grasps, scene.human_stance,
                                     body);
       if (built_stance) r.quality = goal.quality;  // the stored Q is this human's
@@ -335,65 +336,84 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   }
   // Goals a person would choose first: of the comfortable ones, then of those the worker reaches
   // only uncomfortably, those whose receiving posture is natural (the part's centre between hip
-  // and shoulder height first: no inverse kinematics for the others).
+  // and shoulder height first: no inverse kinematics for the others); then the upright ones with
+  // a higher RULA (the elbow low and the part in front of the chest wherever a goal allows it).
+  // The scan is lazy: the first natural goal is tried before the others are looked for (most
+  // boards are planned there), then the scan goes on where it stopped; the order of the goals
+  // tried is the same either way.
   std::set<std::int64_t> natural, placed_first;  // natural ones; all put first (upright too)
-  if (settings_.natural_posture_first && (body != nullptr || natural_check_works_)) {
-    // Natural (upright, RULA within natural_max_rula), then upright with a higher RULA: the
-    // elbow below the shoulder and the part in front of the chest wherever a goal allows it.
-    std::vector<const db::HandoverCandidateRecord*> first, upright;
-    const Eigen::Vector3d centre = records->part.mass_properties.com;
-    const core::HumanBody* checked_body = body;  // the cell's human: nullptr
-    const core::HeightBand band =
-        core::natural_height_band(model_.cell(), checked_body, scene.human_stance);
-    // Only the first goal_limit goals are tried: once that many are natural, the rest are not
-    // looked at (the same goals, in the same order).
-    for (const auto* list : {&goals, &below_comfort}) {
-      for (const auto* goal : *list) {
-        if (first.size() >= goal_limit) break;
+  const bool natural_first =
+      settings_.natural_posture_first && (body != nullptr || natural_check_works_);
+  std::vector<const db::HandoverCandidateRecord*> natural_found, upright;
+  const Eigen::Vector3d centre = records->part.mass_properties.com;
+  const core::HeightBand band = core::natural_height_band(model_.cell(), body, scene.human_stance);
+  std::size_t scan_list = 0, scan_at = 0;  // where the natural scan goes on
+  // Scans on until `want` natural goals are found or every goal is looked at.
+  auto scan_natural = [&](std::size_t want) {
+    const std::vector<const db::HandoverCandidateRecord*>* lists[2] = {&goals, &below_comfort};
+    for (; scan_list < 2; ++scan_list, scan_at = 0) {
+      const auto& list = *lists[scan_list];
+      for (; scan_at < list.size(); ++scan_at) {
+        if (natural_found.size() >= want) return;
+        const auto* goal = list[scan_at];
         const double z = (goal->board * centre).z();
         if (!band.contains(z)) continue;
         const auto& r = reach(*goal, false);
         if (!r.reachable) continue;
         std::vector<std::pair<std::string, Eigen::VectorXd>> held{{goal->human_arm, r.joints}};
         if (!goal->second_arm.empty()) held.emplace_back(goal->second_arm, r.second_joints);
-        const PostureCheck check =
-            check_receiving_posture(model_.cell(), checked_body, scene.human_stance, held,
-                                    goal->board * centre, part->mass);
+        const PostureCheck check = check_receiving_posture(model_.cell(), body, scene.human_stance,
+                                                           held, goal->board * centre, part->mass);
         if (!check.upright()) continue;
-        if (list == &below_comfort) worker_quality[goal->id] = r.quality;
+        if (scan_list == 1) worker_quality[goal->id] = r.quality;
         if (!check.natural(settings_.natural_max_rula)) {
           upright.push_back(goal);
           continue;
         }
         natural.insert(goal->id);
-        first.push_back(goal);
+        natural_found.push_back(goal);
       }
     }
-    result.goals_natural = static_cast<int>(first.size());
-    first.insert(first.end(), upright.begin(), upright.end());
-    for (const auto* goal : first) placed_first.insert(goal->id);
-    for (const auto* goal : goals) {
-      if (placed_first.count(goal->id) == 0) first.push_back(goal);
+  };
+  // The goals to try, in order (goals): the natural scan finished (only the first goal_limit
+  // goals are tried: once that many are natural, the rest are not looked at), the natural and
+  // upright ones first, then the comfort tiers in Eq. 8 order up to goal_limit.
+  auto order_goals = [&] {
+    if (natural_first) {
+      scan_natural(goal_limit);
+      std::vector<const db::HandoverCandidateRecord*> first = natural_found;
+      result.goals_natural = static_cast<int>(first.size());
+      first.insert(first.end(), upright.begin(), upright.end());
+      for (const auto* goal : first) placed_first.insert(goal->id);
+      for (const auto* goal : goals) {
+        if (placed_first.count(goal->id) == 0) first.push_back(goal);
+      }
+      goals = std::move(first);
     }
-    goals = std::move(first);
-  }
-  for (const auto* goal : below_comfort) {
-    if (goals.size() >= goal_limit) break;
-    if (placed_first.count(goal->id) > 0) continue;  // already first
-    const auto& r = reach(*goal);
-    if (r.reachable) {
-      goals.push_back(goal);
-      worker_quality[goal->id] = r.quality;
-    } else {
-      best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal->id]);
+    for (const auto* goal : below_comfort) {
+      if (goals.size() >= goal_limit) break;
+      if (placed_first.count(goal->id) > 0) continue;  // already first
+      const auto& r = reach(*goal);
+      if (r.reachable) {
+        goals.push_back(goal);
+        worker_quality[goal->id] = r.quality;
+      } else {
+        best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal->id]);
+      }
     }
-  }
-  goals.resize(std::min(goals.size(), goal_limit));
-  {
+    goals.resize(std::min(goals.size(), goal_limit));
     const std::set<const db::HandoverCandidateRecord*> uncomfortable(below_comfort.begin(),
                                                                      below_comfort.end());
     for (const auto* goal : goals) result.goals_uncomfortable += uncomfortable.count(goal) > 0;
+  };
+  // The first natural goal, tried alone before the rest are ordered (nullptr: none, or the
+  // goals are ordered at once).
+  const db::HandoverCandidateRecord* tried_early = nullptr;
+  if (natural_first && goal_limit > 0 && settings_.way_order != WayOrder::kCheapestFirst) {
+    scan_natural(1);
+    if (!natural_found.empty()) tried_early = natural_found.front();
   }
+  if (tried_early == nullptr) order_goals();
   // Where the scene's human can take none of the goals: says where they stand and how they face.
   auto human_out_of_reach = [&]() {
     const core::Pose& stance = scene.human_stance;
@@ -409,7 +429,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
               "the database for this stance";
     return finish(BoardPlanStatus::kHumanOutOfReach, reason.str());
   };
-  if (goals.empty() && !records->goals.empty()) return human_out_of_reach();
+  if (tried_early == nullptr && goals.empty() && !records->goals.empty()) {
+    return human_out_of_reach();
+  }
   bool any_connected_offline = false;
   // What both ways fill in once a chain of a goal is planned.
   auto planned = [&](const db::HandoverCandidateRecord& goal, std::int64_t robot_grasp_id,
@@ -619,10 +641,14 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
   auto by_estimate = [](const Way& a, const Way& b) {
     return std::make_pair(a.unconnected, a.seconds) < std::make_pair(b.unconnected, b.seconds);
   };
-  // Every goal under the round's budgets; true when one is planned (result filled in).
-  auto try_goals = [&](const std::string& round) {
+  // Every goal of `list` under the round's budgets but `skip`; true when one is planned (result
+  // filled in).
+  auto try_goals = [&](const std::string& round,
+                       const std::vector<const db::HandoverCandidateRecord*>& list,
+                       const db::HandoverCandidateRecord* skip = nullptr) {
     std::vector<Way> across;  // kCheapestFirst: every goal's ways
-    for (const auto* goal_record : goals) {
+    for (const auto* goal_record : list) {
+      if (goal_record == skip) continue;
       const auto& goal = *goal_record;
       // A goal the maps call comfortable may still be out of reach (a map bin holds the best of
       // the samples near it): confirmed before it is planned.
@@ -665,7 +691,14 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     }
     return finish(BoardPlanStatus::kSolved, "");
   };
-  if (try_goals("")) return solved();
+  if (tried_early != nullptr) {
+    if (try_goals("", {tried_early})) {
+      result.goals_natural = static_cast<int>(natural_found.size());
+      return solved();
+    }
+    order_goals();
+  }
+  if (try_goals("", goals, tried_early)) return solved();
   // Every goal failed within the cheap budgets and time is left: once more with bridges as
   // large as the baselines' from-scratch budget, where the roadmap is cut.
   if (settings_.motion.planner == MotionPlannerKind::kRoadmap &&
@@ -673,7 +706,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       std::chrono::steady_clock::now() < deadline) {
     run.escalate(settings_.motion.escalated_bridge_checks,
                  settings_.motion.escalated_repair_checks);
-    if (try_goals("(larger bridges) ")) {
+    if (try_goals("(larger bridges) ", goals)) {
       result.larger_bridges = true;
       return solved();
     }

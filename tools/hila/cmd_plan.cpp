@@ -190,7 +190,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
                       {"rejected_motions", plan.rejected_motions},
                       {"goals_out_of_reach", plan.goals_out_of_reach},
                       {"goals_uncomfortable", plan.goals_uncomfortable},
-                      {"goals_natural", plan.goals_natural}};
+                      {"goals_natural", plan.goals_natural},
+                      {"human_postures_solved", plan.human_postures_solved}};
   if (plan.solved()) {
     // The way: who picks and how, the exchanges (from the cup to the other arm's gripper), who
     // delivers.

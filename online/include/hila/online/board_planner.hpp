@@ -186,6 +186,9 @@ struct BoardPlan {
   // Goals whose receiving posture is natural (BoardPlanSettings::natural_posture_first), among
   // those checked, and whether the chosen goal's is.
   int goals_natural = 0;
+  // Goals whose receiving posture was solved by the human arms' inverse kinematics (the reach
+  // check and the natural posture's, each goal once): a work measure of the worker's checks.
+  int human_postures_solved = 0;
   bool natural_posture = false;
   // The human's receiving posture at the goal: each hand's arm and its joints (rad), from the
   // human arm's inverse kinematics for the scene's stance (the build's own where it stands as
