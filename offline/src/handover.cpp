@@ -358,14 +358,29 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   };
 
   // --- Eq. 1 candidates and S ----------------------------------------------------------------
+  // The cell human's Eq. 1 candidates and the robot-robot search draw from `rng`; each body of a
+  // worker set and each natural band from a stream of its own, so that adding a worker or a band
+  // changes none of the other draws.
   std::mt19937_64 rng(settings.seed);
+  auto stream = [&](std::uint64_t k) {
+    std::seed_seq seq{static_cast<std::uint32_t>(settings.seed),
+                      static_cast<std::uint32_t>(settings.seed >> 32),
+                      static_cast<std::uint32_t>(k)};
+    return std::mt19937_64(seq);
+  };
+  // Per worker (index body + 1); body_rng[0] unused (the cell human draws from rng).
+  std::vector<std::mt19937_64> body_rng, band_rng;
+  for (int w = 0; w <= comfort.body_count(); ++w) {
+    body_rng.push_back(stream(2 * static_cast<std::uint64_t>(w) + 1));
+    band_rng.push_back(stream(2 * static_cast<std::uint64_t>(w) + 2));
+  }
   const double max_rotation = core::deg_to_rad(settings.max_rotation_deg);
   std::vector<HumanChoice> choices;
   double best_q = 0.0;
   // S's threshold: comfort_threshold, lowered towards comfort_floor for a part with no goal.
   double threshold = settings.comfort_threshold;
   // Eq. 1: within max_rotation of the target's orientation and max_offset of its position.
-  auto draw_eq1 = [&] {
+  auto draw_eq1 = [&](std::mt19937_64& rng) {
     core::Pose pose = core::Pose::Identity();
     pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
     pose.translation() = target.translation() + random_in_ball(settings.max_offset, rng);
@@ -376,8 +391,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // (kept kBandMargin inside its ends): the target lowered or raised to where the worker holds
   // it in front of the chest.
   const Eigen::Vector3d target_centre = target * grasps.com;
-  auto draw_in_band = [&](const core::HeightBand& band) {
-    return [&, band] {
+  // `w`: the worker whose band it is (index body + 1), whose band stream it draws from.
+  auto draw_in_band = [&](const core::HeightBand& band, int w) {
+    return [&, band, w](std::mt19937_64& /*worker's*/) {
+      std::mt19937_64& rng = band_rng[static_cast<std::size_t>(w)];
       core::Pose pose = core::Pose::Identity();
       pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
       Eigen::Vector3d centre = target_centre + random_in_ball(settings.max_offset, rng);
@@ -391,12 +408,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // `body` (-1: the cell's human, else a body of the set).
   std::vector<int> drawn_for;  // Eq. 1 and band candidates per worker (index body + 1)
   auto sample_candidates = [&](int until, const auto& draw, int body) {
+    // The worker's own stream (the cell human's: `rng`); a band's draw brings its own.
+    std::mt19937_64& from = body < 0 ? rng : body_rng[static_cast<std::size_t>(body + 1)];
     choosing_for = body;
     drawn_for.resize(static_cast<std::size_t>(comfort.body_count() + 1), 0);
     const int before = static_cast<int>(result.candidates.size());
     while (static_cast<int>(result.candidates.size()) < until && stage.draws < settings.max_draws) {
       ++stage.draws;
-      const core::Pose pose = draw();
+      const core::Pose pose = draw(from);
       screen_data.set_body_pose(screen_board, pose);
       if (core::in_collision(screen, screen_data, {screen_board})) continue;
       db::HandoverCandidateRecord c;
@@ -501,7 +520,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     const core::HeightBand band = core::natural_height_band(
         cell, w == 0 ? nullptr : &comfort.body(w - 1), cell.spec().human_stance);
     if (settings.natural_candidates > 0 && !band.contains(target_centre.z())) {
-      sample_candidates(stage.candidates + settings.natural_candidates, draw_in_band(band), w - 1);
+      sample_candidates(stage.candidates + settings.natural_candidates, draw_in_band(band, w),
+                        w - 1);
     }
   }
   // Nothing to search for: no candidate, or none the human takes even at the comfort floor.

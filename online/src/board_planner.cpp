@@ -375,33 +375,39 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       }
     }
   };
-  // The goals to try, in order (goals): the natural scan finished (only the first goal_limit
-  // goals are tried: once that many are natural, the rest are not looked at), the natural and
-  // upright ones first, then the comfort tiers in Eq. 8 order up to goal_limit.
+  // The goals to try, in order (goals): the natural ones found (the scan stops at goal_limit of
+  // them) and up to goal_limit upright ones, then the first goal_limit of the comfort tiers in
+  // Eq. 8 order that are not among them: where every natural and upright goal fails, the goals
+  // the Eq. 8 order alone would try.
   auto order_goals = [&] {
+    std::vector<const db::HandoverCandidateRecord*> first;
     if (natural_first) {
       scan_natural(goal_limit);
-      std::vector<const db::HandoverCandidateRecord*> first = natural_found;
+      first = natural_found;
       result.goals_natural = static_cast<int>(first.size());
-      first.insert(first.end(), upright.begin(), upright.end());
+      first.insert(
+          first.end(), upright.begin(),
+          upright.begin() + static_cast<std::ptrdiff_t>(std::min(upright.size(), goal_limit)));
       for (const auto* goal : first) placed_first.insert(goal->id);
-      for (const auto* goal : goals) {
-        if (placed_first.count(goal->id) == 0) first.push_back(goal);
-      }
-      goals = std::move(first);
+    }
+    std::vector<const db::HandoverCandidateRecord*> rest;
+    for (const auto* goal : goals) {
+      if (rest.size() >= goal_limit) break;
+      if (placed_first.count(goal->id) == 0) rest.push_back(goal);
     }
     for (const auto* goal : below_comfort) {
-      if (goals.size() >= goal_limit) break;
+      if (rest.size() >= goal_limit) break;
       if (placed_first.count(goal->id) > 0) continue;  // already first
       const auto& r = reach(*goal);
       if (r.reachable) {
-        goals.push_back(goal);
+        rest.push_back(goal);
         worker_quality[goal->id] = r.quality;
       } else {
         best_out_of_reach = std::max(best_out_of_reach, worker_quality[goal->id]);
       }
     }
-    goals.resize(std::min(goals.size(), goal_limit));
+    first.insert(first.end(), rest.begin(), rest.end());
+    goals = std::move(first);
     const std::set<const db::HandoverCandidateRecord*> uncomfortable(below_comfort.begin(),
                                                                      below_comfort.end());
     for (const auto* goal : goals) result.goals_uncomfortable += uncomfortable.count(goal) > 0;

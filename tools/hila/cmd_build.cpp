@@ -32,6 +32,7 @@ struct BuildOptions {
   int jobs = 1;
   long comfort_samples = core::ComfortMapSettings{}.samples;
   int handover_candidates = offline::HandoverSettings{}.candidates;
+  int natural_candidates = offline::HandoverSettings{}.natural_candidates;
   double comfort_threshold = offline::HandoverSettings{}.comfort_threshold;
   double comfort_floor = offline::HandoverSettings{}.comfort_floor;
   std::string bodies;
@@ -95,6 +96,7 @@ int run_build(const BuildOptions& opt) {
   settings.jobs = opt.jobs;
   settings.comfort.samples = opt.comfort_samples;
   settings.handover.candidates = opt.handover_candidates;
+  settings.handover.natural_candidates = opt.natural_candidates;
   settings.handover.comfort_threshold = opt.comfort_threshold;
   settings.handover.comfort_floor = opt.comfort_floor;
   settings.roadmap.nodes = opt.roadmap_nodes;
@@ -239,6 +241,12 @@ void add_build_command(CLI::App& app, Action& action) {
                    "Eq. 1 candidate poses per board")
       ->capture_default_str()
       ->check(int_in(1, kMaxCandidatesOrNodes));
+  build
+      ->add_option("--natural-candidates", opt->natural_candidates,
+                   "candidates with the part's centre between a worker's hip and shoulder height, "
+                   "per worker whose band the part's fitted centre lies outside of (0: none)")
+      ->capture_default_str()
+      ->check(int_in(0, kMaxCandidatesOrNodes));
   build
       ->add_option("--comfort-threshold", opt->comfort_threshold,
                    "least human comfort Q of a handover goal (S)")

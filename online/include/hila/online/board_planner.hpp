@@ -33,7 +33,9 @@ const char* to_string(WayOrder order);
 struct BoardPlanSettings {
   double approach = 0.05;  // m: straight approach and retreat along the cup's / gripper's axis
   double lift = 0.15;      // m: straight up from the table after the suction pick
-  int goals = 10;          // goals tried in Eq. 8 order
+  // Goals tried in Eq. 8 order; with natural_posture_first, up to as many natural and as many
+  // upright ones before them.
+  int goals = 10;
   WayOrder way_order = WayOrder::kEstimatedTime;  // within each goal
   int exchange_bridges = 2;   // receiving-arm IK branches at the exchange given a bridge
   double speed_scale = 0.5;   // of the arms' velocity and acceleration limits
