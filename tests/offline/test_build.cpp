@@ -95,6 +95,7 @@ TEST(Build, HandoverStagesGoalsAndErgonomicsAreStoredForEveryBoard) {
   const auto database = db::Database::open(dir + "/c.hila");
   EXPECT_EQ(database.meta().human_bodies, "1.6 female; 1.8 male");
   int with_goals = 0;
+  int goals_for_body[2] = {0, 0};  // goals each body of the set takes comfortably
   for (std::size_t i = 0; i < database.parts().size(); ++i) {
     const auto& part = database.parts()[i];
     const db::HandoverStageRecord* stage = database.handover_stage(part.id);
@@ -102,8 +103,7 @@ TEST(Build, HandoverStagesGoalsAndErgonomicsAreStoredForEveryBoard) {
     EXPECT_EQ(stage->finished_parts.size(), i) << part.name;  // the boards before it
     // The cell human's 60 and each body's 30, and any natural band's or thin board's more.
     EXPECT_GE(stage->candidates, 60 + 2 * 30);
-    // A candidate is comfortable for one worker at least: the cell's human's are among them.
-    EXPECT_GE(stage->comfortable, stage->comfortable_default_body);
+    EXPECT_LE(stage->comfortable, stage->candidates);
     const auto candidates = database.handover_candidates(part.id);
     EXPECT_EQ(static_cast<int>(candidates.size()), stage->candidates);
     const auto goals = database.handover_goals(part.id);
@@ -112,6 +112,9 @@ TEST(Build, HandoverStagesGoalsAndErgonomicsAreStoredForEveryBoard) {
     EXPECT_EQ(summary.parts[i].handover_failure, stage->failure);
     for (std::size_t r = 0; r < goals.size(); ++r) {
       EXPECT_EQ(goals[r].rank, static_cast<int>(r));
+      EXPECT_LT(goals[r].bodies, 4U);  // bits of the two bodies only
+      for (int b = 0; b < 2; ++b)
+        goals_for_body[b] += static_cast<int>((goals[r].bodies >> b) & 1U);
       const auto id = goals[r].id;
       EXPECT_TRUE(!database.shared_grasps(id).empty() || !database.direct_grasps(id).empty() ||
                   !database.table_regrasps(id).empty() || !database.suction_deliveries(id).empty())
@@ -123,6 +126,8 @@ TEST(Build, HandoverStagesGoalsAndErgonomicsAreStoredForEveryBoard) {
     EXPECT_EQ(ergonomics.back().method, "alone");
   }
   EXPECT_GT(with_goals, 0);
+  EXPECT_GT(goals_for_body[0], 0);
+  EXPECT_GT(goals_for_body[1], 0);
   EXPECT_EQ(static_cast<int>(summary.failed_parts().size()), 7 - with_goals);
 }
 
