@@ -380,10 +380,10 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // S's threshold: comfort_threshold, lowered towards comfort_floor for a part with no goal.
   double threshold = settings.comfort_threshold;
   // Eq. 1: within max_rotation of the target's orientation and max_offset of its position.
-  auto draw_eq1 = [&](std::mt19937_64& rng) {
+  auto draw_eq1 = [&](std::mt19937_64& from) {
     core::Pose pose = core::Pose::Identity();
-    pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
-    pose.translation() = target.translation() + random_in_ball(settings.max_offset, rng);
+    pose.linear() = target.linear() * random_rotation_within(max_rotation, from);
+    pose.translation() = target.translation() + random_in_ball(settings.max_offset, from);
     return pose;
   };
   // A natural band's: the orientation and the horizontal position of the part's centre as
@@ -394,12 +394,12 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // `w`: the worker whose band it is (index body + 1), whose band stream it draws from.
   auto draw_in_band = [&](const core::HeightBand& band, int w) {
     return [&, band, w](std::mt19937_64& /*worker's*/) {
-      std::mt19937_64& rng = band_rng[static_cast<std::size_t>(w)];
+      std::mt19937_64& from = band_rng[static_cast<std::size_t>(w)];
       core::Pose pose = core::Pose::Identity();
-      pose.linear() = target.linear() * random_rotation_within(max_rotation, rng);
-      Eigen::Vector3d centre = target_centre + random_in_ball(settings.max_offset, rng);
+      pose.linear() = target.linear() * random_rotation_within(max_rotation, from);
+      Eigen::Vector3d centre = target_centre + random_in_ball(settings.max_offset, from);
       centre.z() = band.hip_z + kBandMargin +
-                   uniform01(rng) * std::max(0.0, band.shoulder_z - band.hip_z - 2 * kBandMargin);
+                   uniform01(from) * std::max(0.0, band.shoulder_z - band.hip_z - 2 * kBandMargin);
       pose.translation() = centre - pose.linear() * grasps.com;
       return pose;
     };

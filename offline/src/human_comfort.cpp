@@ -1,6 +1,5 @@
 #include "hila/offline/human_comfort.hpp"
 
-#include <algorithm>
 #include <sstream>
 
 #include "hila/core/comfort.hpp"
@@ -53,12 +52,6 @@ double HumanComfort::body_quality(int body, int arm, const core::Pose& hand) con
   const auto a = static_cast<std::size_t>(arm);
   const Body& b = bodies_[static_cast<std::size_t>(body)];
   return maps_[a].lookup(b.body->to_cell_arm(arm, b.world_to_base[a] * hand));
-}
-
-double HumanComfort::best_quality(int arm, const core::Pose& hand) const {
-  double best = quality(arm, hand);
-  for (int b = 0; b < body_count(); ++b) best = std::max(best, body_quality(b, arm, hand));
-  return best;
 }
 
 std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,

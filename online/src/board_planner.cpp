@@ -346,7 +346,9 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       settings_.natural_posture_first && (body != nullptr || natural_check_works_);
   std::vector<const db::HandoverCandidateRecord*> natural_found, upright;
   const Eigen::Vector3d centre = records->part.mass_properties.com;
-  const core::HeightBand band = core::natural_height_band(model_.cell(), body, scene.human_stance);
+  const core::HeightBand band =
+      natural_first ? core::natural_height_band(model_.cell(), body, scene.human_stance)
+                    : core::HeightBand{};
   std::size_t scan_list = 0, scan_at = 0;  // where the natural scan goes on
   // Scans on until `want` natural goals are found or every goal is looked at.
   auto scan_natural = [&](std::size_t want) {

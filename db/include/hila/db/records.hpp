@@ -102,12 +102,14 @@ struct HandoverStageRecord {
   std::vector<std::string> finished_parts;  // in assembly order
   int draws = 0;                            // poses drawn to obtain the candidates
   int candidates = 0;   // poses satisfying Eq. 1 (rotation < 45 deg, offset < 0.5 m, no collision)
-  int comfortable = 0;  // |S|: best human grasp above the comfort threshold (every body of the set)
-  int comfortable_default_body = 0;  // |S| for the cell's own human alone
-  int goals = 0;                     // |𝕊|: members of S with a shared or direct grasp
-  int robot_handovers = 0;           // feasible robot-robot handover poses
-  bool two_hands = false;            // no one-hand human grasp holds the board
-  std::string failure;               // empty when goals > 0, else why there is none
+  int comfortable = 0;  // |S|: above the comfort threshold for the worker each was drawn for
+  // Candidates the cell's own human takes above the threshold (at the grasps chosen for the
+  // worker each was drawn for): without a body set, |S| before the human's IK confirmed any.
+  int comfortable_default_body = 0;
+  int goals = 0;            // |𝕊|: members of S with a shared or direct grasp
+  int robot_handovers = 0;  // feasible robot-robot handover poses
+  bool two_hands = false;   // no one-hand human grasp holds the board
+  std::string failure;      // empty when goals > 0, else why there is none
 };
 
 // A robot-robot handover pose: the right arm holds the board by suction at its centre of mass.

@@ -55,7 +55,7 @@ struct PartBuildSummary {
   int handover_draws = 0;
   int handover_candidates = 0;
   int comfortable = 0;               // |S|
-  int comfortable_default_body = 0;  // |S| for the cell's human alone
+  int comfortable_default_body = 0;  // HandoverStageRecord::comfortable_default_body
   int goals = 0;                     // |𝕊|
   // With a body set: goals each body of the set takes comfortably (its bit of
   // HandoverCandidateRecord::bodies), in the set's order.

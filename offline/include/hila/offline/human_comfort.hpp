@@ -39,9 +39,6 @@ class HumanComfort {
   double quality(int arm, const core::Pose& hand) const;
   // Q of body `body` of the set.
   double body_quality(int body, int arm, const core::Pose& hand) const;
-  // The best Q over the worker set: the cell's human and every body of the set (a goal any of
-  // them takes comfortably is a goal, and records which of them do).
-  double best_quality(int arm, const core::Pose& hand) const;
   const core::HumanBody& body(int b) const { return *bodies_[static_cast<std::size_t>(b)].body; }
 
  private:
