@@ -326,6 +326,7 @@ const std::vector<Eigen::VectorXd>& Run::executed_path(const Stage& st, std::siz
     }
     times_.validation += waited;
     times_.motions -= waited;
+    p.read_as_hint = true;
     if (!p.finished->path.empty()) return p.finished->path;
     break;  // a discarded job never finished: as found
   }
@@ -436,6 +437,9 @@ bool Run::settle(std::span<const Stage* const> chain) {
     queue_->wait_all(jobs);
   }
   bool all_passed = true;
+  // The first stage whose rejected step was read as a hint (replaced by another path, or the
+  // stage planned again).
+  const Stage* hint_replaced = nullptr;
   for (Stage* st : waiting) {
     for (PendingCheck& p : st->pending) {
       PlanStep& s = st->steps[p.step];
@@ -449,6 +453,7 @@ bool Run::settle(std::span<const Stage* const> chain) {
       TimedPath timed = finished.timed;
       const std::string e =
           recover(p.frame, p.request, *p.planner, *p.arm, s.name, p.found, path, timed, s);
+      if (p.read_as_hint && hint_replaced == nullptr) hint_replaced = st;
       if (!e.empty()) {
         st->failure = e;
         st->rejected_late = true;
@@ -460,6 +465,23 @@ bool Run::settle(std::span<const Stage* const> chain) {
       s.via = p.found.via;
     }
     abandon(*st);  // after a step it could not recover, the rest are not wanted either
+  }
+  if (hint_replaced != nullptr) {
+    // The stages after it were planned with the rejected path as a hint: planned again.
+    const auto at = std::find(chain.begin(), chain.end(), hint_replaced);
+    const std::span<const Stage* const> later =
+        at == chain.end() ? chain.last(0)
+                          : chain.subspan(static_cast<std::size_t>(at - chain.begin()) + 1);
+    auto mark = [&](Stage& st) {
+      if (std::find(later.begin(), later.end(), &st) != later.end()) st.rejected_late = true;
+    };
+    if (tool_) mark(*tool_);
+    if (tool_down_) mark(*tool_down_);
+    if (tool_return_) mark(*tool_return_);
+    each_memo([&](auto& stages) {
+      for (auto& entry : stages) mark(entry.second);
+    });
+    all_passed = false;
   }
   return all_passed;
 }

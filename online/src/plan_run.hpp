@@ -78,6 +78,10 @@ struct PendingCheck {
   const core::Arm* arm = nullptr;
   MotionResult found;  // the planner's path, before smoothing
   std::shared_ptr<const FinishedPath> finished;
+  // A later step was planned with this one's path as a hint (Run::executed_path): where the
+  // validator then rejects it, the stages planned after it are planned again in order, with the
+  // path that replaces it, as they would have been without the overlap.
+  mutable bool read_as_hint = false;
 };
 
 // A stage of the chain (e.g. the suction pick for one cup): its timed steps (from 0) and where
