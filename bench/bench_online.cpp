@@ -67,7 +67,9 @@ constexpr const char* kUsage =
     "  --variants    also hila with other settings, interleaved; each a '+'-joined list of:\n"
     "                fixed (each goal's ways in the order direct, regrasp, suction, exchange),\n"
     "                cheapest (every goal's ways by estimated robot time alone), eq8 (goals in\n"
-    "                Eq. 8 order, natural receiving postures not first): fixed+eq8 is 0.14.0's\n"
+    "                Eq. 8 order, natural receiving postures not first), inplace (a goal whose\n"
+    "                exchanges the build found blocked tried in its place, not after the\n"
+    "                others): fixed+eq8 is 0.14.0's\n"
     "  --json        also write every problem's figures to FILE\n";
 
 constexpr const char* kBuildHint =
@@ -91,6 +93,7 @@ struct Options {
     std::string name;
     online::WayOrder way_order = online::WayOrder::kEstimatedTime;
     bool natural_posture_first = true;
+    bool blocked_exchanges_last = true;
   };
   std::vector<Variant> variants;  // extra hila variants
   std::string json;
@@ -179,9 +182,13 @@ Options parse(int argc, char** argv) {
               v.way_order = online::WayOrder::kCheapestFirst;
             } else if (part == "eq8") {
               v.natural_posture_first = false;
+            } else if (part == "inplace") {
+              v.blocked_exchanges_last = false;
             } else {
-              usage_error("--variants: expected fixed, cheapest or eq8 joined by '+', got '" +
-                          name + "'");
+              usage_error(
+                  "--variants: expected fixed, cheapest, eq8 or inplace joined by '+', "
+                  "got '" +
+                  name + "'");
             }
           }
           opt.variants.push_back(v);
@@ -456,6 +463,7 @@ int main(int argc, char** argv) {
     s.motion.held_resolution = opt.held_resolution;
     s.way_order = v.way_order;
     s.natural_posture_first = v.natural_posture_first;
+    s.blocked_exchanges_last = v.blocked_exchanges_last;
     settings.push_back(s);
     planners.push_back(std::make_unique<online::BoardPlanner>(*model, s));
     names.push_back("hila (" + v.name + ")");

@@ -309,7 +309,9 @@ std::string settings_hash(const BuildSettings& s) {
   const auto& g = s.regrasp;
   text << "regrasp " << g.goals << ' ' << g.served_goals << ' ' << g.attach_neighbours << ' '
        << g.bridge.max_checks << ' ' << g.transfer_bridges << ' ' << g.bridge_alternatives << ' '
-       << g.alternative_checks << ' ' << g.timing_speed_scale << ' ' << g.timing_step << '\n';
+       << g.alternative_checks << ' ' << g.timing_speed_scale << ' ' << g.timing_step << ' '
+       << g.served_natural << ' ' << g.considered_natural << ' ' << g.online_held_resolution
+       << '\n';
   return db::sha256_hex(text.str());
 }
 
@@ -521,6 +523,8 @@ BuildSummary build_database(const std::string& product_path, const std::string& 
     s.goals_considered = g.goals_considered;
     s.goals_served = g.goals_served;
     s.first_served_rank = g.first_served_rank;
+    s.exchanges_examined = g.exchanges_examined;
+    s.exchanges_connected = g.exchanges_connected;
     // A board without goals already says why; the regrasp failure adds only a new reason.
     if (s.handover_failure.empty()) s.regrasp_failure = g.failure;
     s.regrasp_seconds = g.seconds;

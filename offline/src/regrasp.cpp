@@ -5,10 +5,12 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <tuple>
 
 #include "hila/core/bridge.hpp"
 #include "hila/core/error.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/core/pre_grasp.hpp"
 #include "hila/core/roadmap_graph.hpp"
 #include "hila/core/slip_projection.hpp"
@@ -307,13 +309,6 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     return finish(handover.stage.failure.empty() ? "the board has no handover goal"
                                                  : handover.stage.failure);
   }
-  std::vector<std::size_t> shared;
-  for (const int c : goals) {
-    for (std::size_t s = 0; s < handover.shared.size(); ++s) {
-      if (handover.shared[s].candidate_id == c) shared.push_back(s);
-    }
-  }
-
   // The board's stage: its chains must not carry it (or the arm) through the parts already
   // assembled or those still in the stack, or the online planner would find every stored
   // transfer blocked in the nominal sequence and fall back to bridges.
@@ -386,11 +381,10 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     if (e.path.size() >= 2) {
       const core::ArmSpec& spec = arm == settings.suction_arm ? suction.workspace.arm().spec
                                                               : receiving.workspace.arm().spec;
-      e.duration = core::time_parameterize_through(e.path, spec.max_velocity,
-                                                   spec.max_acceleration,
-                                                   settings.timing_speed_scale,
-                                                   settings.timing_step)
-                       .time.back();
+      e.duration =
+          core::time_parameterize_through(e.path, spec.max_velocity, spec.max_acceleration,
+                                          settings.timing_speed_scale, settings.timing_step)
+              .time.back();
     }
     result.edges.push_back(e);
     result.bridges += c.connected && c.via == "bridge" ? 1 : 0;
@@ -453,6 +447,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     rr_nodes[r] = node;
     const Pick& pick = pick_for(rr.suction_grasp_id);
     Connection transfer;
+    bool open_online = false;  // connected only at the online planner's resolution
     if (pick.node >= 0 && pick.lift.size() > 0) {
       const auto& grasp = grasps.suction[static_cast<std::size_t>(rr.suction_grasp_id)];
       const core::Pose board_in_tcp = cup_in_tcp * grasp.cup.inverse();
@@ -479,6 +474,25 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
         std::swap(ends.front(), ends[chosen]);
         result.nodes[static_cast<std::size_t>(node)].solutions = ends;
       }
+      // Not connected at the validator's resolution: the online planner searches at its own,
+      // coarser one and its validator mends what it finds, so the same search may connect
+      // there. Only a transfer blocked at both is stored (as blocked).
+      if (!transfer.connected && settings.online_held_resolution > suction.held_resolution) {
+        const double fine = suction.held_resolution;
+        suction.held_resolution = settings.online_held_resolution;
+        const Endpoint coarse_lift = endpoint(suction, no_slip_limit, pick.lift, k);
+        for (std::size_t b = 0; b < ends.size() && !open_online; ++b) {
+          open_online = roadmap_path(suction, no_slip_limit, edges, coarse_lift,
+                                     endpoint(suction, no_slip_limit, ends[b], k), search)
+                            .connected;
+        }
+        for (std::size_t b = 0;
+             b < ends.size() && !open_online && static_cast<int>(b) < settings.transfer_bridges;
+             ++b) {
+          open_online = bridge_path(suction, no_slip_limit, pick.lift, ends[b], bridge()).connected;
+        }
+        suction.held_resolution = fine;
+      }
       suction.workspace.release();
       if (transfer.connected) {  // the path starts at the pick, below the lift
         transfer.path.insert(transfer.path.begin(),
@@ -486,7 +500,7 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
         transfer.cost = path_length(transfer.path);
       }
     }
-    if (pick.node >= 0) {
+    if (pick.node >= 0 && !open_online) {
       add_edge("transfer", settings.suction_arm, pick.node, node, pick.filter, transfer);
     }
     rr_transfer[r] = pick.node >= 0 && pick.transit && transfer.connected;
@@ -604,15 +618,21 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   // Goals in Eq. 8 order; each goal's shared grasps until one connects the whole chain. Filters
   // are made when a grasp is first needed, and the search stops after `served_goals` goals:
   // the online planner tries the goals in the same order.
-  std::size_t next_shared = 0;
-  for (const int c : goals) {
-    if (result.goals_served >= settings.served_goals) break;
+  std::map<int, std::vector<std::size_t>> shared_of;  // candidate -> its shared grasps
+  for (std::size_t i = 0; i < handover.shared.size(); ++i) {
+    shared_of[handover.shared[i].candidate_id].push_back(i);
+  }
+  std::set<int> considered;
+  // One goal's shared grasps until one connects the whole chain; true when one does.
+  auto serve = [&](int c) {
+    considered.insert(c);
     ++result.goals_considered;
     bool served = false;
-    for (; next_shared < shared.size() && handover.shared[shared[next_shared]].candidate_id == c;
-         ++next_shared) {
-      if (served) continue;  // the goal's remaining grasps are not needed
-      const auto& s = handover.shared[shared[next_shared]];
+    const auto grasps_of = shared_of.find(c);
+    if (grasps_of == shared_of.end()) return false;
+    for (const std::size_t g : grasps_of->second) {
+      if (served) break;  // the goal's remaining grasps are not needed
+      const auto& s = handover.shared[g];
       ++result.shared_grasps;
       std::vector<int> starts;  // receiving-arm nodes at the exchange reached from home
       for (const auto& end : rr_left_for(s)) {
@@ -701,11 +721,16 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
       result.transfers_connected += transfer.connected ? 1 : 0;
       served = transfer.connected;
     }
-    if (!served) continue;
+    if (!served) return false;
     ++result.goals_served;
     if (result.first_served_rank < 0) {
       result.first_served_rank = handover.candidates[static_cast<std::size_t>(c)].rank;
     }
+    return true;
+  };
+  for (const int c : goals) {
+    if (result.goals_served >= settings.served_goals) break;
+    serve(c);
   }
   // Suction deliveries of the first goals: the suction arm's pick (its node, transit and the
   // cup's filter) and its transfer, the board on the cup, to the goal's robot-human pose, as for
@@ -737,11 +762,46 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     suction.workspace.release();
     if (ends.empty()) ends.push_back(d.joints_rh);
     if (transfer.connected) std::swap(ends.front(), ends[chosen]);
-    const int node = add_node("human_handover", settings.suction_arm, "suction",
-                              d.suction_grasp_id, -1, d.candidate_id, candidate.board, ends);
+    const int node = add_node("human_handover", settings.suction_arm, "suction", d.suction_grasp_id,
+                              -1, d.candidate_id, candidate.board, ends);
     add_edge("transfer", settings.suction_arm, pick.node, node, pick.filter, transfer);
     ++result.suction_transfers;
     result.suction_transfers_connected += transfer.connected ? 1 : 0;
+  }
+  // The goals the cell's human takes with the part's centre between hip and shoulder height
+  // (core::natural_height_band), in Eq. 8 order, until `served_natural` more are served: the
+  // online planner tries natural receiving postures first (docs/online.md), and without a
+  // stored chain it plans theirs from scratch. After the deliveries, so the bridges' seeds above
+  // stay as they were.
+  if (settings.served_natural > 0) {
+    const core::HeightBand band =
+        core::natural_height_band(cell, nullptr, cell.spec().human_stance);
+    std::vector<int> in_band;
+    for (std::size_t c = 0; c < handover.candidates.size(); ++c) {
+      const auto& candidate = handover.candidates[c];
+      if (candidate.rank >= 0 && considered.count(static_cast<int>(c)) == 0 &&
+          band.contains((candidate.board * grasps.com).z())) {
+        in_band.push_back(static_cast<int>(c));
+      }
+    }
+    std::sort(in_band.begin(), in_band.end(), [&](int a, int b) {
+      return handover.candidates[static_cast<std::size_t>(a)].rank <
+             handover.candidates[static_cast<std::size_t>(b)].rank;
+    });
+    int natural_served = 0, natural_considered = 0;
+    for (const int c : in_band) {
+      if (natural_served >= settings.served_natural ||
+          natural_considered >= settings.considered_natural) {
+        break;
+      }
+      ++natural_considered;
+      natural_served += serve(c) ? 1 : 0;
+    }
+  }
+  // The robot-robot poses whose suction-arm transfer was examined on the way.
+  for (const auto& [r, connected] : rr_transfer) {
+    ++result.exchanges_examined;
+    result.exchanges_connected += connected ? 1 : 0;
   }
   // Goals reached by a direct pick, a regrasp on the table or on the suction cup have no
   // exchange chain here: the online planner plans them through the picking arm's roadmap (the

@@ -576,6 +576,8 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     const db::SuctionDeliveryRecord* suction = nullptr;
     const db::SharedGraspRecord* shared = nullptr;
     bool unconnected = false;  // an exchange the offline regrasp graph did not connect
+    // An exchange whose suction-arm transfer to the robot-robot pose the build found blocked.
+    bool blocked = false;
     double seconds = 0.0;
   };
   auto ways_of = [&](const db::HandoverCandidateRecord& goal, std::vector<Way>& ways) {
@@ -613,6 +615,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
         ways.push_back({.goal = &goal,
                         .shared = &g,
                         .unconnected = !connected,
+                        .blocked = !connected && run.exchange_blocked_offline(g),
                         .seconds = run.estimate(goal, g)});
       }
       std::stable_partition(ways.begin() + static_cast<std::ptrdiff_t>(first), ways.end(),
@@ -647,14 +650,25 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     return false;
   };
   auto by_estimate = [](const Way& a, const Way& b) {
-    return std::make_pair(a.unconnected, a.seconds) < std::make_pair(b.unconnected, b.seconds);
+    return std::make_tuple(a.blocked, a.unconnected, a.seconds) <
+           std::make_tuple(b.blocked, b.unconnected, b.seconds);
+  };
+  // A goal whose every way is an exchange the build found blocked (none direct, by a regrasp or
+  // on the cup): tried after the goals of the list that have an open way
+  // (BoardPlanSettings::blocked_exchanges_last).
+  const bool blocked_last =
+      settings_.blocked_exchanges_last && settings_.way_order != WayOrder::kFixed;
+  auto all_blocked = [](const std::vector<Way>& ways) {
+    return !ways.empty() &&
+           std::all_of(ways.begin(), ways.end(), [](const Way& w) { return w.blocked; });
   };
   // Every goal of `list` under the round's budgets but `skip`; true when one is planned (result
   // filled in).
   auto try_goals = [&](const std::string& round,
                        const std::vector<const db::HandoverCandidateRecord*>& list,
                        const db::HandoverCandidateRecord* skip = nullptr) {
-    std::vector<Way> across;  // kCheapestFirst: every goal's ways
+    std::vector<Way> across;                      // kCheapestFirst: every goal's ways
+    std::vector<std::vector<Way>> blocked_goals;  // all_blocked, in list order
     for (const auto* goal_record : list) {
       if (goal_record == skip) continue;
       const auto& goal = *goal_record;
@@ -673,6 +687,14 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
       if (settings_.way_order == WayOrder::kEstimatedTime) {
         std::stable_sort(ways.begin(), ways.end(), by_estimate);
       }
+      if (blocked_last && all_blocked(ways)) {
+        blocked_goals.push_back(std::move(ways));
+        continue;
+      }
+      if (try_ways(round, ways)) return true;
+      if (std::chrono::steady_clock::now() >= deadline) return false;
+    }
+    for (const auto& ways : blocked_goals) {
       if (try_ways(round, ways)) return true;
       if (std::chrono::steady_clock::now() >= deadline) return false;
     }
@@ -699,6 +721,14 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     }
     return finish(BoardPlanStatus::kSolved, "");
   };
+  if (tried_early != nullptr && blocked_last) {  // tried with the others, after the open ones
+    std::vector<Way> ways;
+    ways_of(*tried_early, ways);
+    if (all_blocked(ways)) {
+      tried_early = nullptr;
+      order_goals();
+    }
+  }
   if (tried_early != nullptr) {
     if (try_goals("", {tried_early})) {
       result.goals_natural = static_cast<int>(natural_found.size());

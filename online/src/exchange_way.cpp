@@ -31,6 +31,14 @@ bool Run::connected_offline(const db::HandoverCandidateRecord& goal,
              {shared.robot_handover_id, shared.robot_grasp_id, goal.id}) > 0;
 }
 
+bool Run::exchange_blocked_offline(const db::SharedGraspRecord& shared) {
+  const auto rr = handovers_.find(shared.robot_handover_id);
+  if (rr == handovers_.end()) return false;
+  const EstimateIndex& index = estimate_index();
+  return index.exchange_examined.count(rr->first) > 0 &&
+         index.to_exchange.count({rr->first, rr->second.suction_grasp_id}) == 0;
+}
+
 bool Run::receive_failed_at_same_pose(const db::SharedGraspRecord& shared) const {
   const auto rr = handovers_.find(shared.robot_handover_id);
   if (rr == handovers_.end()) return false;

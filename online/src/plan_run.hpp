@@ -15,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -22,10 +23,10 @@
 #include <utility>
 #include <vector>
 
+#include "hila/core/time_parameterization.hpp"
 #include "hila/online/arm_motion.hpp"
 #include "hila/online/board_planner.hpp"
 #include "hila/online/planner_model.hpp"
-#include "hila/core/time_parameterization.hpp"
 #include "hila/online/validation_queue.hpp"
 #include "hila/online/validator.hpp"
 #include "hila/online/world.hpp"
@@ -33,8 +34,8 @@
 namespace hila::online::detail {
 
 using core::resample_path;
-using core::TimedPath;
 using core::time_parameterize_through;
+using core::TimedPath;
 
 // IK solutions of `arm` for a TCP pose in the world, nearest `seed` first (`preferred`, when
 // given and among them, first of all).
@@ -159,6 +160,9 @@ class Run {
   // Whether the offline regrasp graph connected this goal with this shared grasp.
   bool connected_offline(const db::HandoverCandidateRecord& goal,
                          const db::SharedGraspRecord& shared);
+  // Whether the build examined the suction arm's transfer from the pick to this shared grasp's
+  // robot-robot pose and found none: blocked at the board's nominal stage.
+  bool exchange_blocked_offline(const db::SharedGraspRecord& shared);
 
   // Whether the receiving arm's reach of the exchange failed with this shared grasp's robot grasp
   // at its board pose, under another robot-robot pose of the same board pose (another suction
@@ -319,6 +323,9 @@ class Run {
     // (arm, suction grasp, goal): the suction delivery's transfer from the pick.
     std::map<std::tuple<std::string, std::int64_t, std::int64_t>, const db::RegraspEdgeRecord*>
         on_cup;
+    // Robot handovers whose suction-arm transfer from the pick the build stored, connected or
+    // not (a goal it examined used them).
+    std::set<std::int64_t> exchange_examined;
   };
   const EstimateIndex& estimate_index();
   // The suction arm from home to the tool's place in the scene and back: taking the tool or

@@ -19,8 +19,8 @@ constexpr double kNoEstimate = std::numeric_limits<double>::infinity();
 double Run::straight_seconds(const core::Arm& arm, const Eigen::VectorXd& from,
                              const Eigen::VectorXd& to) const {
   if (from.size() != to.size() || from.size() == 0) return kNoEstimate;  // a malformed record
-  return core::rest_to_rest_duration({from, to}, arm.spec.max_velocity,
-                                     arm.spec.max_acceleration, settings_.speed_scale);
+  return core::rest_to_rest_duration({from, to}, arm.spec.max_velocity, arm.spec.max_acceleration,
+                                     settings_.speed_scale);
 }
 
 double Run::stored_seconds(const core::Arm& arm, const db::RegraspEdgeRecord* edge,
@@ -40,10 +40,14 @@ const Run::EstimateIndex& Run::estimate_index() {
     }
   }
   for (const auto& e : edges_) {
-    if (!e.connected || e.path.size() < 2) continue;
     const auto* from = node(e.from_node);
     const auto* to = node(e.to_node);
     if (from == nullptr || to == nullptr) continue;
+    if (e.kind == "transfer" && e.arm == suction_.spec.name && from->kind == "pick" &&
+        to->kind == "robot_handover") {
+      index.exchange_examined.insert(to->robot_handover_id);
+    }
+    if (!e.connected || e.path.size() < 2) continue;
     if (e.kind == "transit" && from->kind == "home" && to->kind == "robot_handover") {
       index.way_in.try_emplace({to->robot_handover_id, to->grasp_id}, &e);
     } else if (e.kind == "transfer" && from->kind == "pick" && to->kind == "robot_handover") {
@@ -125,8 +129,7 @@ double Run::estimate(const db::HandoverCandidateRecord& goal,
   return t + straight_seconds(*arm, delivery.joints_rh, arm->spec.home);
 }
 
-double Run::estimate(const db::HandoverCandidateRecord& goal,
-                     const db::SharedGraspRecord& shared) {
+double Run::estimate(const db::HandoverCandidateRecord& goal, const db::SharedGraspRecord& shared) {
   const auto rr_it = handovers_.find(shared.robot_handover_id);
   if (rr_it == handovers_.end()) return kNoEstimate;
   const db::RobotHandoverRecord& rr = rr_it->second;
@@ -155,10 +158,10 @@ double Run::estimate(const db::HandoverCandidateRecord& goal,
   return t +
          stored_seconds(receiving_, stored(index.way_in, at),
                         straight_seconds(receiving_, start_joints(receiving_), shared.joints_rr)) +
-         stored_seconds(receiving_,
-                        stored(index.to_human,
-                               std::make_tuple(rr.id, shared.robot_grasp_id, goal.id)),
-                        straight_seconds(receiving_, shared.joints_rr, shared.joints_rh)) +
+         stored_seconds(
+             receiving_,
+             stored(index.to_human, std::make_tuple(rr.id, shared.robot_grasp_id, goal.id)),
+             straight_seconds(receiving_, shared.joints_rr, shared.joints_rh)) +
          straight_seconds(receiving_, shared.joints_rh, receiving_.spec.home);
 }
 

@@ -3,10 +3,12 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <tuple>
 
 #include "hila/core/collision.hpp"
+#include "hila/core/human_model.hpp"
 #include "hila/core/product.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
@@ -175,6 +177,13 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
 
   std::vector<std::string> connected_boards, unconnected_boards;
   int alternatives = 0;
+  // The cell human's hip and shoulder heights at the stance, from the anthropometric ratios
+  // (not core::natural_height_band, which the build uses).
+  const core::HumanDimensions dims = core::human_dimensions(core::HumanBodySpec{});
+  const core::Pose stance = ref.cell->spec().human_stance;
+  const double hip_z = (stance * Eigen::Vector3d(0, 0, dims.hip_height)).z();
+  const double shoulder_z = (stance * Eigen::Vector3d(0, 0, dims.shoulder_height)).z();
+  int band_goals_examined = 0;  // boards whose first in-band goal is not among the Eq. 8 served
   for (const auto& part : database.parts()) {
     SCOPED_TRACE(part.name);
     const auto robot = database.robot_grasps(part.id);
@@ -214,6 +223,37 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
         const core::Pose cup = tcp * cup_in_tcp;
         EXPECT_TRUE(cup.isApprox(part.initial * suction_by_id.at(n.grasp_id)->cup, 1e-6))
             << "pick node " << n.id;
+      }
+    }
+
+    // The first goal in Eq. 8 order whose part centre lies between the cell human's hip and
+    // shoulder height is examined by the build (RegraspSettings::served_natural): a chain to
+    // it, or the suction arm at each of its robot-robot poses.
+    {
+      std::set<std::int64_t> suction_at, human_at;
+      for (const auto& n : nodes) {
+        if (n.kind == "robot_handover" && n.arm == "right") suction_at.insert(n.robot_handover_id);
+        if (n.kind == "human_handover") human_at.insert(n.candidate_id);
+      }
+      std::vector<db::HandoverCandidateRecord> goals;
+      for (const auto& [id, c] : candidate_by_id) {
+        if (c.status == "goal") goals.push_back(c);
+      }
+      std::sort(goals.begin(), goals.end(),
+                [](const auto& a, const auto& b) { return a.rank < b.rank; });
+      for (const auto& goal : goals) {
+        const double z = (goal.board * com).z();
+        if (z < hip_z || z > shoulder_z) continue;
+        bool examined = human_at.count(goal.id) > 0;
+        bool every_pose = true, any_pose = false;
+        for (const auto& s : database.shared_grasps(goal.id)) {
+          any_pose = true;
+          every_pose = every_pose && suction_at.count(s.robot_handover_id) > 0;
+        }
+        examined = examined || (any_pose && every_pose);
+        EXPECT_TRUE(examined) << "first in-band goal, rank " << goal.rank;
+        band_goals_examined += goal.rank >= 3 ? 1 : 0;
+        break;
       }
     }
 
@@ -352,4 +392,6 @@ TEST(Regrasp, CabinetGraphReverifiedAndEveryGoalChainChecked) {
   // have alternatives.
   EXPECT_GT(alternatives, 0);
   EXPECT_TRUE(summary.failed_parts().empty());
+  // back_upper's and top's first in-band goals lie beyond the three goals served in Eq. 8 order.
+  EXPECT_GE(band_goals_examined, 2);
 }

@@ -139,6 +139,41 @@ int expect_failed_receives_tried_last(const online::PlannerModel& model, const s
   return came_back;
 }
 
+// Whether the build found every way of a goal blocked: no direct, regrasp or suction way, and
+// each shared grasp's robot-robot pose has a stored suction-arm transfer from its cup's pick,
+// none connected (read from the regrasp graph's records, not through the planner's index).
+bool all_exchanges_blocked(const online::BoardRecords& records,
+                           const db::HandoverCandidateRecord& goal) {
+  const auto has = [&](const auto& ways) {
+    const auto it = ways.find(goal.id);
+    return it != ways.end() && !it->second.empty();
+  };
+  if (has(records.direct_grasps) || has(records.table_regrasps) ||
+      has(records.suction_deliveries)) {
+    return false;
+  }
+  const auto shared = records.shared_grasps.find(goal.id);
+  if (shared == records.shared_grasps.end() || shared->second.empty()) return false;
+  for (const auto& s : shared->second) {
+    const auto& rr = records.robot_handovers.at(s.robot_handover_id);
+    int stored = 0, connected = 0;
+    for (const auto& e : records.regrasp_edges) {
+      const auto from = records.node_by_id.find(e.from_node);
+      const auto to = records.node_by_id.find(e.to_node);
+      if (e.kind != "transfer" || from == records.node_by_id.end() ||
+          to == records.node_by_id.end() || from->second->kind != "pick" ||
+          from->second->grasp_kind != "suction" || to->second->kind != "robot_handover" ||
+          to->second->robot_handover_id != rr.id) {
+        continue;
+      }
+      ++stored;
+      connected += e.connected && from->second->grasp_id == rr.suction_grasp_id ? 1 : 0;
+    }
+    if (stored == 0 || connected > 0) return false;
+  }
+  return true;
+}
+
 // The same steps, point for point: the same names, smoothing, times and joints.
 void expect_same_steps(const online::BoardPlan& a, const online::BoardPlan& b) {
   ASSERT_EQ(a.steps.size(), b.steps.size());
@@ -577,6 +612,11 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
   const core::Cell& cell = model().cell();
   const online::BoardPlanSettings settings;
   ASSERT_TRUE(settings.natural_posture_first);
+  ASSERT_TRUE(settings.blocked_exchanges_last);
+  online::BoardPlanSettings in_place_settings;
+  in_place_settings.blocked_exchanges_last = false;
+  online::BoardPlanner in_place_planner(model(), in_place_settings);
+  int blocked_boards = 0;  // boards whose first natural goal the build found blocked
   const core::HumanDimensions dims = core::human_dimensions(core::HumanBodySpec{});
   int reordered = 0, natural_boards = 0;
   int lazy_stops = 0;  // boards planned at the first of several natural goals
@@ -629,7 +669,18 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
       }
     }
     ASSERT_FALSE(plan.attempts.empty());
-    if (!natural.empty() && plan.solved() && plan.candidate_id == natural.front()) {
+    if (natural.empty()) {
+      EXPECT_FALSE(plan.natural_posture);
+      EXPECT_EQ(plan.goals_natural, 0);
+      continue;
+    }
+    ++natural_boards;
+    const auto goal_of = [&](std::int64_t id) -> const db::HandoverCandidateRecord& {
+      return *std::find_if(records->goals.begin(), records->goals.end(),
+                           [&](const auto& g) { return g.id == id; });
+    };
+    const bool first_blocked = all_exchanges_blocked(*records, goal_of(natural.front()));
+    if (!first_blocked && plan.solved() && plan.candidate_id == natural.front()) {
       // Planned at the first natural goal: the search stopped there (lazy), its postures solved
       // only up to that goal.
       EXPECT_EQ(plan.goals_natural, 1);
@@ -640,11 +691,23 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
       EXPECT_EQ(plan.goals_natural,
                 std::min(static_cast<int>(natural.size()), online::BoardPlanSettings{}.goals));
     }
-    if (natural.empty()) {
-      EXPECT_FALSE(plan.natural_posture);
-      continue;
+    // Natural goals whose every exchange the build found blocked come after the open ones.
+    const auto first_natural_eq8 = natural.front();
+    const auto open_end = std::stable_partition(natural.begin(), natural.end(), [&](auto id) {
+      return !all_exchanges_blocked(*records, goal_of(id));
+    });
+    const auto open_natural = static_cast<std::size_t>(open_end - natural.begin());
+    if (first_blocked) {
+      // In its place, the blocked goal is the first tried, and fails.
+      ++blocked_boards;
+      const online::BoardPlan in_place =
+          in_place_planner.plan(scene_of(part.name), part.name, in_seconds(120.0));
+      ASSERT_FALSE(in_place.attempts.empty());
+      EXPECT_EQ(in_place.attempts.front().candidate_id, first_natural_eq8);
+      EXPECT_NE(in_place.attempts.front().outcome, "planned");
+      EXPECT_NE(plan.attempts.front().candidate_id, first_natural_eq8);
+      EXPECT_LT(plan.attempts.size(), in_place.attempts.size());
     }
-    ++natural_boards;
     EXPECT_EQ(plan.attempts.front().candidate_id, natural.front());
     // The goals tried go through the natural ones in Eq. 8 order before any other.
     std::vector<std::int64_t> tried;  // distinct, in the order first tried (a second round
@@ -654,8 +717,16 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
         tried.push_back(a.candidate_id);
       }
     }
-    for (std::size_t i = 0; i < tried.size() && i < natural.size(); ++i) {
+    for (std::size_t i = 0; i < tried.size() && i < open_natural; ++i) {
       EXPECT_EQ(tried[i], natural[i]) << "goal tried " << i;
+    }
+    // Once a blocked goal is tried, every goal after it is blocked too (within a round).
+    bool blocked_seen = false;
+    for (const auto& a : plan.attempts) {
+      if (a.larger_bridges) break;
+      const bool blocked = all_exchanges_blocked(*records, goal_of(a.candidate_id));
+      EXPECT_TRUE(blocked || !blocked_seen) << "goal " << a.candidate_id << " after a blocked one";
+      blocked_seen = blocked_seen || blocked;
     }
     if (plan.solved()) {
       EXPECT_EQ(plan.natural_posture,
@@ -664,6 +735,7 @@ TEST_F(BoardPlanner, TheFirstGoalTriedIsTheFirstNaturalOneInEq8Order) {
     reordered += natural.front() != records->goals.front().id ? 1 : 0;
   }
   EXPECT_GT(natural_boards, 0);
-  EXPECT_GT(reordered, 0);   // the tiers change a first goal on the cabinet
-  EXPECT_GT(lazy_stops, 0);  // the lazy search saved the other natural goals' postures
+  EXPECT_GT(reordered, 0);       // the tiers change a first goal on the cabinet
+  EXPECT_GT(lazy_stops, 0);      // the lazy search saved the other natural goals' postures
+  EXPECT_GT(blocked_boards, 0);  // back_upper's first natural goal: every exchange blocked
 }

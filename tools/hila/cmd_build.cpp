@@ -164,9 +164,12 @@ int run_build(const BuildOptions& opt) {
   }
   std::cout
       << "  regrasp graph (first goals' shared grasps; transfers = receiving arm, robot-robot "
-         "-> robot-human, within the grasp's filter):\n";
+         "-> robot-human, within the grasp's filter; exchanges = robot-robot poses the suction "
+         "arm's "
+         "transfer reaches, of those examined):\n";
   std::cout
-      << "  #  part           filters  nodes  edges  transfers  goals served  first  time s\n";
+      << "  #  part           filters  nodes  edges  transfers  goals served  first  exchanges  "
+         "time s\n";
   for (const auto& p : summary.parts) {
     std::cout << "  " << p.order << "  " << std::left << std::setw(14) << p.name << std::right
               << std::setw(8) << p.regrasp_filters << std::setw(7) << p.regrasp_nodes
@@ -179,7 +182,9 @@ int run_build(const BuildOptions& opt) {
     } else {
       std::cout << "-";
     }
-    std::cout << std::setw(8) << std::setprecision(2) << p.regrasp_seconds << "\n";
+    std::cout << std::setw(7) << p.exchanges_connected << "/" << std::left << std::setw(3)
+              << p.exchanges_examined << std::right << std::setw(8) << std::setprecision(2)
+              << p.regrasp_seconds << "\n";
   }
   if (const auto& relay = summary.tool_relay.handle) {
     const Eigen::Vector3d at = relay->translation();

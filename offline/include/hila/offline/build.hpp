@@ -77,6 +77,8 @@ struct PartBuildSummary {
   int goals_considered = 0;
   int goals_served = 0;  // goals whose whole chain connects in the roadmaps
   int first_served_rank = -1;
+  int exchanges_examined = 0;  // robot-robot poses whose suction-arm transfer was examined
+  int exchanges_connected = 0;
   std::string regrasp_failure;
   double regrasp_seconds = 0.0;
 };

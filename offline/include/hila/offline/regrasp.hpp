@@ -20,6 +20,11 @@ struct RegraspSettings {
   // Filters are made for the grasps met on the way.
   int goals = 10;
   int served_goals = 3;
+  // Then the goals the cell's human takes with the part's centre between hip and shoulder
+  // height (core::natural_height_band), in Eq. 8 order: up to `served_natural` more served, of
+  // at most `considered_natural` examined (each unserved one costs its grasps' chains).
+  int served_natural = 2;
+  int considered_natural = 4;
   int attach_neighbours = 10;  // roadmap nodes tried when connecting a configuration
   // The same for the receiving arm's pre-grasp at the exchange: beside the board it holds still,
   // most straight joins to the nearest nodes cross it.
@@ -48,6 +53,11 @@ struct RegraspSettings {
   // Motions holding the board (attachments, roadmap edges, bridges) are checked this finely
   // (rad; the build takes HandoverSettings::exchange_resolution, the online validator's).
   double held_resolution = 0.01;
+  // The online planner's own (MotionSettings::held_resolution): a suction-arm transfer to a
+  // robot-robot pose that does not connect at held_resolution is searched again at this one, and
+  // stored as blocked only where it fails there too (the online planner searches at this
+  // resolution and mends the path for its validator).
+  double online_held_resolution = 0.04;
   // Each stored path's estimated duration (RegraspEdgeRecord::duration) is its time at the arm's
   // velocity and acceleration limits times this, in pieces of at most `timing_step` rad: the
   // online planner's defaults (BoardPlanSettings::speed_scale and timing_step), so that a stored
@@ -82,6 +92,10 @@ struct RegraspResult {
   // from the lift to the robot-human pose, tried and connected.
   int suction_transfers = 0;
   int suction_transfers_connected = 0;
+  // Robot-robot poses whose suction-arm transfer was examined (those of the goals examined), and
+  // of those the ones it connected.
+  int exchanges_examined = 0;
+  int exchanges_connected = 0;
   int bridges = 0;           // edges connected by a bridge rather than the roadmap
   int alternatives = 0;      // of those, other bridges of a transfer (bridge_alternatives)
   int goals_considered = 0;  // goals examined (in Eq. 8 order)

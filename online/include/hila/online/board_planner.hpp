@@ -86,6 +86,11 @@ struct BoardPlanSettings {
   // RULA grand score a natural receiving posture keeps to: 3 and below is action level 1-2
   // ("acceptable", or "investigate further" at 3), what the issue asks of every handover.
   int natural_max_rula = 3;
+  // A goal whose every way is an exchange the build found blocked at the suction arm's transfer
+  // to the robot-robot pose (a stored transfer edge, not connected: docs/roadmap.md) is tried
+  // after the goals of its list that have an open way: most fail again, each at the cost of a
+  // bridge search (tens of ms). Not in the kFixed way order. false: in its place.
+  bool blocked_exchanges_last = true;
 };
 
 // One arm's timed motion within the plan, with what happens at its end.
