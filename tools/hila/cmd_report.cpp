@@ -1,5 +1,6 @@
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "cmd_report_html.hpp"
 #include "commands.hpp"
@@ -37,7 +38,8 @@ int run_report(ReportOptions opt) {
     if (!given.empty()) {
       throw core::InputError("command line", option,
                              std::string("no ") + option +
-                                 " with report ergonomics (the scene names the cell and product)",
+                                 " with report ergonomics (an option of report html; the "
+                                 "report reads the cell and product the scene names)",
                              "'" + given + "'");
     }
   }
