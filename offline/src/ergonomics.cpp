@@ -13,10 +13,9 @@ namespace hila::offline {
 namespace {
 
 // The configuration variable that bends the torso forward: the joint above the arms' base link.
-int torso_variable(const core::Cell& cell) {
-  if (cell.human_arms().empty()) return -1;
-  const auto& human = cell.human();
-  const int link = human.link_index(cell.human_arms().front().spec.base_link);
+int torso_variable(const core::RobotModel& human, const std::vector<core::HumanArm>& arms) {
+  if (arms.empty()) return -1;
+  const int link = human.link_index(arms.front().spec.base_link);
   const int joint = human.links()[static_cast<std::size_t>(link)].parent_joint;
   return joint < 0 ? -1 : human.joints()[static_cast<std::size_t>(joint)].variable;
 }
@@ -51,12 +50,18 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
                           const core::Pose& stance, const core::Pose& board,
                           const std::vector<db::HumanGraspRecord>& human_grasps,
                           const std::vector<int>& grasps, int only_arm,
-                          const ErgonomicsSettings& settings) {
+                          const ErgonomicsSettings& settings, const core::HumanBody* body) {
+  // A body that is the cell's human is searched as the cell's human: the same postures.
+  if (body != nullptr && body->same_as_cell()) body = nullptr;
   Posture posture;
-  const auto& human = cell.human();
-  const int torso = torso_variable(cell);
+  posture.stance = stance;
+  posture.board = board;
+  const core::RobotModel& human = body != nullptr ? body->model() : cell.human();
+  const std::vector<core::HumanArm>& human_arms =
+      body != nullptr ? body->arms() : cell.human_arms();
+  const int torso = torso_variable(human, human_arms);
   const double max_flexion = torso < 0 ? 0.0 : core::rad_to_deg(human.upper_limits()[torso]);
-  Eigen::VectorXd q = cell.human_neutral();
+  Eigen::VectorXd q = body != nullptr ? body->neutral() : cell.human_neutral();
   std::vector<core::Pose> links;
   core::ComfortSettings ik;
   ik.ik_attempts = settings.ik_attempts;
@@ -65,16 +70,19 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
     if (torso >= 0) q[torso] = core::deg_to_rad(flexion);
     human.link_poses(q, links);
     std::vector<Scored> scored;
-    for (int a = 0; a < static_cast<int>(cell.human_arms().size()); ++a) {
+    for (int a = 0; a < static_cast<int>(human_arms.size()); ++a) {
       if (only_arm >= 0 && a != only_arm) continue;
-      const auto& arm = cell.human_arms()[static_cast<std::size_t>(a)];
+      const auto& arm = human_arms[static_cast<std::size_t>(a)];
       const core::Pose base =
           stance * links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
       const core::Pose base_inv = base.inverse();
       for (const int g : grasps) {
         const core::Pose hand = base_inv * board * human_grasps[static_cast<std::size_t>(g)].hand;
-        scored.push_back({comfort.map(a).lookup(hand),
-                          (hand.translation() - arm.chain.first_joint_position()).norm(), a, g});
+        // The cell human's map serves a body at the hand's place scaled about its shoulder.
+        const double map_quality =
+            comfort.map(a).lookup(body != nullptr ? body->to_cell_arm(a, hand) : hand);
+        scored.push_back(
+            {map_quality, (hand.translation() - arm.chain.first_joint_position()).norm(), a, g});
       }
     }
     // Best by the map first; map misses (unsampled bins) by nearness to the shoulder.
@@ -86,7 +94,7 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
                                             static_cast<std::size_t>(settings.candidates_per_step));
     for (std::size_t i = 0; i < take; ++i) {
       const Scored& s = scored[i];
-      const auto& arm = cell.human_arms()[static_cast<std::size_t>(s.arm)];
+      const auto& arm = human_arms[static_cast<std::size_t>(s.arm)];
       const core::Pose base =
           stance * links[static_cast<std::size_t>(human.link_index(arm.spec.base_link))];
       const core::Pose hand =
@@ -108,11 +116,13 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
   }
   if (!posture.reachable) return posture;
   // Shoulder and elbow heights at the posture.
-  const auto& arm = cell.human_arms()[static_cast<std::size_t>(posture.arm)];
+  const auto& arm = human_arms[static_cast<std::size_t>(posture.arm)];
   const auto& vars = arm.chain.model_variables();
+  if (torso >= 0) q[torso] = core::deg_to_rad(posture.torso_flexion_deg);
   for (std::size_t i = 0; i < vars.size(); ++i) {
     q[vars[i]] = posture.arm_joints[static_cast<Eigen::Index>(i)];
   }
+  posture.q = q;
   human.link_poses(q, links);
   auto joint_position = [&](const std::string& name) -> Eigen::Vector3d {
     const auto& joint = human.joints()[static_cast<std::size_t>(human.joint_index(name))];
@@ -160,24 +170,24 @@ std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
     return r;
   };
   std::vector<db::ErgonomicsRecord> out;
-  const core::Pose stance = cell.spec().human_stance;
+  const core::Pose stance = in.stance.value_or(cell.spec().human_stance);
   if (in.has_goal) {
     const Posture p = receiving_posture(cell, comfort, stance, in.goal, grasps, {in.goal_grasp},
-                                        in.goal_arm, settings);
+                                        in.goal_arm, settings, in.body);
     out.push_back(record("hila", in.goal, p));
   }
   if (in.has_placement) {
     const core::Pose table = table_drop_pose(cell, in.table_placement, settings);
-    out.push_back(
-        record("table", table,
-               receiving_posture(cell, comfort, stance, table, grasps, usable, -1, settings)));
+    out.push_back(record(
+        "table", table,
+        receiving_posture(cell, comfort, stance, table, grasps, usable, -1, settings, in.body)));
   }
   // Alone, the human steps sideways to face the stack.
   core::Pose at_stack = stance;
   at_stack.translation().y() = in.initial.translation().y();
-  out.push_back(
-      record("alone", in.initial,
-             receiving_posture(cell, comfort, at_stack, in.initial, grasps, usable, -1, settings)));
+  out.push_back(record("alone", in.initial,
+                       receiving_posture(cell, comfort, at_stack, in.initial, grasps, usable, -1,
+                                         settings, in.body)));
   return out;
 }
 

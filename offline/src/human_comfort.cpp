@@ -1,5 +1,6 @@
 #include "hila/offline/human_comfort.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "hila/core/comfort.hpp"
@@ -54,6 +55,53 @@ double HumanComfort::body_quality(int body, int arm, const core::Pose& hand) con
   return maps_[a].lookup(b.body->to_cell_arm(arm, b.world_to_base[a] * hand));
 }
 
+namespace {
+
+// One body: STATURE (m) and SEX ("male" or "female"), from `item` as given (for messages).
+core::HumanBodySpec parse_body(const std::string& stature, const std::string& sex,
+                               const std::string& item, const std::string& file,
+                               const std::string& field, const std::string& form) {
+  core::HumanBodySpec body;
+  std::size_t used = 0;
+  try {
+    body.stature = std::stod(stature, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != stature.size()) {
+    throw core::InputError(file, field, form, "'" + item + "'");
+  }
+  if (!std::isfinite(body.stature) || body.stature < core::kMinStature ||
+      body.stature > core::kMaxStature) {
+    throw core::InputError(file, field,
+                           "a stature in metres within [" + core::format_number(core::kMinStature) +
+                               ", " + core::format_number(core::kMaxStature) + "] in '" + item +
+                               "'",
+                           core::format_number(body.stature) +
+                               (body.stature > 100.0 ? " (millimetres given as metres?)" : ""));
+  }
+  if (sex != "male" && sex != "female") {
+    throw core::InputError(file, field, "sex 'male' or 'female' in '" + item + "'",
+                           "'" + sex + "'");
+  }
+  body.sex = sex == "male" ? core::Sex::Male : core::Sex::Female;
+  return body;
+}
+
+// Each goal records the bodies that take it as bits of a 32-bit mask.
+void check_body_count(const std::vector<core::HumanBodySpec>& bodies, const std::string& file,
+                      const std::string& field) {
+  if (bodies.empty()) {
+    throw core::InputError(file, field, "at least one STATURE[:SEX] item", "nothing");
+  }
+  if (bodies.size() > kMaxHumanBodies) {
+    throw core::InputError(file, field, "at most " + std::to_string(kMaxHumanBodies) + " bodies",
+                           std::to_string(bodies.size()));
+  }
+}
+
+}  // namespace
+
 std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,
                                                     const std::string& field) {
   std::vector<core::HumanBodySpec> bodies;
@@ -61,35 +109,30 @@ std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,
   std::string item;
   while (std::getline(items, item, ',')) {
     const auto colon = item.find(':');
-    const std::string stature = item.substr(0, colon);
-    const std::string sex = colon == std::string::npos ? "male" : item.substr(colon + 1);
-    core::HumanBodySpec body;
-    std::size_t used = 0;
-    try {
-      body.stature = std::stod(stature, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != stature.size()) {
-      throw core::InputError("command line", field, "STATURE[:SEX] items such as 1.50:female",
-                             "'" + item + "'");
-    }
-    if (sex != "male" && sex != "female") {
-      throw core::InputError("command line", field, "sex 'male' or 'female'", "'" + sex + "'");
-    }
-    body.sex = sex == "male" ? core::Sex::Male : core::Sex::Female;
-    core::human_dimensions(body);  // validates the stature
-    bodies.push_back(body);
+    bodies.push_back(parse_body(item.substr(0, colon),
+                                colon == std::string::npos ? "male" : item.substr(colon + 1), item,
+                                "command line", field, "STATURE[:SEX] items such as 1.50:female"));
   }
-  if (bodies.empty()) {
-    throw core::InputError("command line", field, "at least one STATURE[:SEX] item", "nothing");
+  check_body_count(bodies, "command line", field);
+  return bodies;
+}
+
+std::vector<core::HumanBodySpec> parse_stored_human_bodies(const std::string& stored,
+                                                           const std::string& file) {
+  static const std::string kSeparator = "; ";
+  std::vector<core::HumanBodySpec> bodies;
+  std::size_t begin = 0;
+  while (begin < stored.size()) {
+    std::size_t end = stored.find(kSeparator, begin);
+    if (end == std::string::npos) end = stored.size();
+    const std::string item = stored.substr(begin, end - begin);
+    const auto space = item.find(' ');
+    bodies.push_back(parse_body(
+        item.substr(0, space), space == std::string::npos ? "" : item.substr(space + 1), item, file,
+        "meta.human_bodies", "'STATURE SEX' items joined by '; ' such as '1.5 female'"));
+    begin = end + kSeparator.size();
   }
-  // Each goal records the bodies that take it as bits of a 32-bit mask.
-  if (bodies.size() > kMaxHumanBodies) {
-    throw core::InputError("command line", field,
-                           "at most " + std::to_string(kMaxHumanBodies) + " bodies",
-                           std::to_string(bodies.size()));
-  }
+  check_body_count(bodies, file, "meta.human_bodies");
   return bodies;
 }
 

@@ -2,7 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <map>
 
+#include "hila/core/human_body.hpp"
 #include "hila/core/mesh_symmetry.hpp"
 #include "hila/core/product.hpp"
 #include "hila/offline/ergonomics.hpp"
@@ -187,4 +189,78 @@ TEST(Ergonomics, ReorientationIsModuloThePartsSymmetries) {
   ASSERT_EQ(plain.back().method, "alone");  // the board taken where it lies: only the turn left
   EXPECT_NEAR(plain.back().reorientation_deg, 180.0, 1e-6);
   EXPECT_NEAR(modulo.back().reorientation_deg, 0.0, 1e-6);
+}
+
+// A worker's own body (core::HumanBody): the posture at the table drop and at the stack is
+// searched on that body's model. Its whole configuration puts the body's hand on the grasp (the
+// body's forward kinematics from the stance), the reach is the body's shoulder to that hand, the
+// torso joint holds the flexion found; a short woman and a tall man take the same boards with
+// different postures, and the cell's own human as a body (same_as_cell) gets the cell human's.
+TEST(Ergonomics, EachBodyTakesTheBoardWithItsOwnArms) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  offline::ErgonomicsInputs in;
+  in.target = b.spec.target;
+  in.initial = b.spec.initial;
+  in.has_placement = true;
+  in.table_placement = b.analysis.placements.front().part_in_plane;
+  in.human_grasps = &b.grasps;
+  offline::ErgonomicsSettings settings;
+  settings.seed = 11;
+  std::vector<offline::Posture> cell_postures;
+  const auto cell_records =
+      offline::evaluate_ergonomics(*cell, comfort(), in, settings, &cell_postures);
+  std::map<std::string, std::vector<offline::Posture>> by_body;
+  for (const core::HumanBodySpec spec :
+       {core::HumanBodySpec{core::kFemaleStatureP5, core::Sex::Female},
+        core::HumanBodySpec{core::kTallStature, core::Sex::Male}}) {
+    const core::HumanBody body(*cell, spec);
+    SCOPED_TRACE(body.label());
+    in.body = &body;
+    std::vector<offline::Posture>& postures = by_body[body.label()];
+    const auto records = offline::evaluate_ergonomics(*cell, comfort(), in, settings, &postures);
+    ASSERT_EQ(records.size(), 2u);  // table and alone
+    const int torso =
+        body.model()
+            .joints()[static_cast<std::size_t>(body.model().joint_index("torso_flexion"))]
+            .variable;
+    for (std::size_t k = 0; k < records.size(); ++k) {
+      SCOPED_TRACE(records[k].method);
+      const offline::Posture& p = postures[k];
+      ASSERT_TRUE(p.reachable);
+      ASSERT_EQ(p.q.size(), body.model().num_variables());
+      EXPECT_NEAR(p.q[torso], core::deg_to_rad(p.torso_flexion_deg), 1e-12);
+      const auto& arm = body.arms()[static_cast<std::size_t>(p.arm)];
+      std::vector<core::Pose> links;
+      body.model().link_poses(p.q, links);
+      const core::Pose base =
+          p.stance * links[static_cast<std::size_t>(body.model().link_index(arm.spec.base_link))];
+      const Eigen::Vector3d hand = (base * arm.chain.fk(p.arm_joints)).translation();
+      const Eigen::Vector3d grasp =
+          (p.board * b.grasps[static_cast<std::size_t>(p.grasp)].hand).translation();
+      EXPECT_LT((hand - grasp).norm(), 1e-4);
+      EXPECT_NEAR(p.reach, (grasp - base * arm.chain.first_joint_position()).norm(), 1e-9);
+    }
+    // Alone, the body steps sideways to the stack; at the table it stands at the stance.
+    EXPECT_TRUE(postures[0].stance.isApprox(cell->spec().human_stance, 1e-12));
+    EXPECT_DOUBLE_EQ(postures[1].stance.translation().y(), b.spec.initial.translation().y());
+  }
+  // The two bodies' arms differ: so do their postures (reach and joints) at the same board.
+  const auto& small = by_body.at("1.5 female");
+  const auto& tall = by_body.at("1.95 male");
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_GT(std::abs(small[k].reach - tall[k].reach), 0.01) << k;
+  }
+  // The cell's own human as a body: the cell human's postures, exactly.
+  const core::HumanBody cell_body(*cell, core::HumanBodySpec{});
+  ASSERT_TRUE(cell_body.same_as_cell());
+  in.body = &cell_body;
+  std::vector<offline::Posture> same;
+  const auto same_records = offline::evaluate_ergonomics(*cell, comfort(), in, settings, &same);
+  ASSERT_EQ(same_records.size(), cell_records.size());
+  for (std::size_t k = 0; k < same.size(); ++k) {
+    EXPECT_EQ(same[k].arm_joints, cell_postures[k].arm_joints);
+    EXPECT_EQ(same_records[k].torso_flexion_deg, cell_records[k].torso_flexion_deg);
+    EXPECT_EQ(same_records[k].quality, cell_records[k].quality);
+  }
 }

@@ -98,7 +98,12 @@ TEST(HumanComfort, BodySetsParseAndRejectBadItems) {
   test::expect_input_error([] { offline::parse_human_bodies("1.7:robot", "--bodies"); },
                            {"--bodies", "sex", "robot"});
   test::expect_input_error([] { offline::parse_human_bodies("1722", "--bodies"); },
-                           {"stature", "1722"});
+                           {"command line: --bodies:", "stature", "[1.3, 2.2]", "'1722'",
+                            "got 1722 (millimetres given as metres?)"});
+  test::expect_input_error([] { offline::parse_human_bodies("1.5:female,1.29", "--workers"); },
+                           {"--workers", "stature", "'1.29'", "got 1.29"});
+  test::expect_input_error([] { offline::parse_human_bodies("1.5:female,,1.8", "--workers"); },
+                           {"--workers", "STATURE[:SEX]", "got ''"});
   test::expect_input_error([] { offline::parse_human_bodies("tall", "--bodies"); },
                            {"--bodies", "tall"});
   // A goal's bodies are bits of a 32-bit mask: 32 bodies, not 33.
@@ -107,4 +112,25 @@ TEST(HumanComfort, BodySetsParseAndRejectBadItems) {
   test::expect_input_error([&] { offline::parse_human_bodies(many, "--bodies"); },
                            {"--bodies", "at most 32 bodies", "33"});
   EXPECT_EQ(offline::parse_human_bodies(many.substr(4), "--bodies").size(), 32u);
+}
+
+// The stored form (meta.human_bodies) reads back as the set it was written from; an item that is
+// not "STATURE SEX" names the database and the field.
+TEST(HumanComfort, StoredBodySetsReadBack) {
+  const auto bodies = offline::parse_human_bodies("1.50:female,1.722,1.95:male", "--bodies");
+  const std::string stored = offline::format_human_bodies(bodies);
+  const auto back = offline::parse_stored_human_bodies(stored, "cab.hila");
+  ASSERT_EQ(back.size(), bodies.size());
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    EXPECT_EQ(back[i].stature, bodies[i].stature) << i;
+    EXPECT_EQ(back[i].sex, bodies[i].sex) << i;
+  }
+  EXPECT_EQ(offline::format_human_bodies(back), stored);
+  test::expect_input_error(
+      [] { offline::parse_stored_human_bodies("1.5 female; 1.8", "cab.hila"); },
+      {"cab.hila: meta.human_bodies:", "sex", "got ''"});
+  test::expect_input_error([] { offline::parse_stored_human_bodies("1.5:female", "cab.hila"); },
+                           {"cab.hila: meta.human_bodies:", "'1.5:female'"});
+  test::expect_input_error([] { offline::parse_stored_human_bodies("", "cab.hila"); },
+                           {"meta.human_bodies", "at least one"});
 }

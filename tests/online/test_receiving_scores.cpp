@@ -273,3 +273,68 @@ TEST(ReceivingScores, APostureCheckOfAWorkersBodyFollowsItsForwardKinematics) {
   EXPECT_GT(above, 20);
   EXPECT_GT(natural, 0);
 }
+
+// At a whole configuration: upright, the same scores and check as from the arms' joints; with the
+// torso bent forward 30 degrees, the trunk scores its 20-60 degree band (RULA 3, REBA 3), the
+// check reads the bend, the hip stays where it is and the shoulder comes down by the torso's
+// turn about the hip (forward kinematics of the torso's link); one hand's posture standing for
+// two hands carries half the load in RULA and the whole load in REBA.
+TEST(ReceivingScores, AWholeConfigurationIsScoredAsItIs) {
+  const auto cell = test::reference_cell();
+  const core::HumanBody body(*cell, {1.60, core::Sex::Female});
+  std::mt19937_64 rng(37);
+  const auto& arm = body.arms().front();
+  const core::Pose stance = cell->spec().human_stance;
+  const Eigen::Vector3d centre = stance * Eigen::Vector3d(0.4, 0.0, 1.1);
+  const int torso =
+      body.model()
+          .joints()[static_cast<std::size_t>(body.model().joint_index("torso_flexion"))]
+          .variable;
+  for (int trial = 0; trial < 20; ++trial) {
+    const std::vector<std::pair<std::string, Eigen::VectorXd>> arms{
+        {arm.spec.name, random_within(arm.chain, rng)}};
+    Eigen::VectorXd q = body.posture(arms);
+    const auto joints = online::receiving_scores(*cell, &body, arms, 3.0);
+    const auto whole = online::receiving_scores(*cell, &body, q, {arm.spec.name}, 3.0, false);
+    EXPECT_EQ(whole.rula().grand, joints.rula().grand);
+    EXPECT_EQ(whole.reba().reba, joints.reba().reba);
+    const auto upright = online::check_receiving_posture(*cell, &body, stance, arms, centre, 3.0);
+    const auto same = online::check_receiving_posture(*cell, &body, stance, q, {arm.spec.name},
+                                                      centre, 3.0, false);
+    EXPECT_EQ(same.shoulder_z, upright.shoulder_z);
+    EXPECT_EQ(same.elbow_below_shoulder, upright.elbow_below_shoulder);
+    EXPECT_EQ(same.rula_grand, upright.rula_grand);
+
+    q[torso] = core::deg_to_rad(30.0);
+    const auto bent = online::receiving_scores(*cell, &body, q, {arm.spec.name}, 3.0, true);
+    ASSERT_TRUE(bent.scored);
+    EXPECT_TRUE(bent.two_hands);
+    EXPECT_EQ(bent.hands[0].rula.trunk, 3);
+    EXPECT_EQ(bent.hands[0].reba.trunk, 3);
+    EXPECT_DOUBLE_EQ(bent.hands[0].rula_inputs.load_kg, 1.5);
+    EXPECT_DOUBLE_EQ(bent.hands[0].reba_inputs.load_kg, 3.0);
+    const auto check = online::check_receiving_posture(*cell, &body, stance, q, {arm.spec.name},
+                                                       centre, 3.0, true);
+    EXPECT_NEAR(check.trunk_flexion_deg, 30.0, 1e-9);
+    EXPECT_EQ(check.rula_grand, bent.rula().grand);
+    EXPECT_NEAR(check.hip_z, upright.hip_z, 1e-12);
+    // The shoulder in the torso's frame, turned 30 degrees forward about the hip (the torso
+    // link's y axis; forward flexion takes +x down).
+    const Eigen::Vector3d s = arm.chain.first_joint_position();
+    const double turned =
+        s.z() * std::cos(core::deg_to_rad(30.0)) - s.x() * std::sin(core::deg_to_rad(30.0));
+    EXPECT_NEAR(check.shoulder_z, check.hip_z + turned, 1e-9);
+  }
+  test::expect_input_error(
+      [&] {
+        online::receiving_scores(*cell, &body, Eigen::VectorXd::Zero(3), {arm.spec.name}, 1.0,
+                                 false);
+      },
+      {"human configuration", "finite values", "got 3"});
+  test::expect_input_error(
+      [&] {
+        online::check_receiving_posture(*cell, &body, stance, body.neutral(), {"middle"}, centre,
+                                        1.0, false);
+      },
+      {"'middle'", "left"});
+}

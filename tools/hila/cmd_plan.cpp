@@ -8,9 +8,10 @@
 #include "commands.hpp"
 #include "hila/core/error.hpp"
 #include "hila/online/board_planner.hpp"
-#include "hila/online/receiving_scores.hpp"
 #include "io_checks.hpp"
 #include "option_checks.hpp"
+#include "plan_sequence.hpp"
+#include "receiving_ergonomics.hpp"
 
 namespace hila::tools {
 
@@ -31,7 +32,7 @@ struct PlanOptions {
   std::string output;
   bool output_given = false;  // -o was on the command line (perhaps as '')
   bool json = false;
-  double deadline_s = 30.0;
+  double deadline_s = kDefaultBoardDeadlineSeconds;
   bool eq8_order = false;  // BoardPlanSettings::natural_posture_first off
 };
 
@@ -39,100 +40,6 @@ nlohmann::json pose_to_json(const core::Pose& pose) {
   const Eigen::Quaterniond q(pose.linear());
   const Eigen::Vector3d t = pose.translation();
   return {{"xyz", {t.x(), t.y(), t.z()}}, {"quat_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
-}
-
-// A hand's RULA and REBA with every sub-score, and the arm angles they were scored from.
-nlohmann::json hand_scores_json(const online::HandScores& h) {
-  const core::RulaScore& r = h.rula;
-  const core::RebaScore& b = h.reba;
-  return {{"side", h.arm},
-          {"angles_deg",
-           {{"trunk_flexion", h.rula_inputs.trunk_flexion_deg},
-            {"upper_arm", h.rula_inputs.upper_arm_flexion_deg},
-            {"upper_arm_abducted", h.rula_inputs.upper_arm_abducted},
-            {"lower_arm", h.rula_inputs.lower_arm_flexion_deg},
-            {"arm_across_midline_or_out_to_side", h.rula_inputs.arm_across_midline_or_out_to_side},
-            {"wrist", h.rula_inputs.wrist_flexion_deg},
-            {"wrist_deviated", h.rula_inputs.wrist_deviated},
-            {"wrist_twist_near_end", h.rula_inputs.wrist_twist_near_end}}},
-          {"rula",
-           {{"grand", r.grand},
-            {"action_level", core::rula_action_level(r.grand)},
-            {"action", core::rula_action(r.grand)},
-            {"load_kg", h.rula_inputs.load_kg},
-            {"upper_arm", r.upper_arm},
-            {"lower_arm", r.lower_arm},
-            {"wrist", r.wrist},
-            {"wrist_twist", r.wrist_twist},
-            {"posture_a", r.posture_a},
-            {"muscle_use", r.muscle_use},
-            {"force_load", r.force_load},
-            {"score_c", r.score_c},
-            {"neck", r.neck},
-            {"trunk", r.trunk},
-            {"legs", r.legs},
-            {"posture_b", r.posture_b},
-            {"score_d", r.score_d}}},
-          {"reba",
-           {{"score", b.reba},
-            {"risk", core::reba_risk_level(b.reba)},
-            {"load_kg", h.reba_inputs.load_kg},
-            {"neck", b.neck},
-            {"trunk", b.trunk},
-            {"legs", b.legs},
-            {"posture_a", b.posture_a},
-            {"load_force", b.load_force},
-            {"score_a", b.score_a},
-            {"upper_arm", b.upper_arm},
-            {"lower_arm", b.lower_arm},
-            {"wrist", b.wrist},
-            {"posture_b", b.posture_b},
-            {"coupling", b.coupling},
-            {"score_b", b.score_b},
-            {"score_c", b.score_c},
-            {"activity", b.activity}}}};
-}
-
-// The receiving posture's RULA and REBA (docs/online.md): the board's scores (the worse hand's)
-// and each hand's. Scored here, after planning; a human model the scores cannot read says why.
-nlohmann::json ergonomics_json(const core::Cell& cell, const online::BoardPlan& plan,
-                               double load_kg, const core::Pose& stance,
-                               const Eigen::Vector3d& centre_of_mass) {
-  online::ReceivingScores s;
-  try {
-    s = online::receiving_scores(cell, plan, load_kg);
-  } catch (const core::InputError& e) {
-    return {{"error", e.what()}};
-  }
-  if (!s.scored) return {{"error", "no receiving posture"}};
-  nlohmann::json hands = nlohmann::json::array();
-  for (const auto& h : s.hands) hands.push_back(hand_scores_json(h));
-  // Where the posture puts the worker (BoardPlanSettings::natural_posture_first).
-  std::vector<std::pair<std::string, Eigen::VectorXd>> arms{{plan.human_arm, plan.human_joints}};
-  if (!plan.second_human_arm.empty()) {
-    arms.emplace_back(plan.second_human_arm, plan.second_human_joints);
-  }
-  const online::PostureCheck c = online::check_receiving_posture(
-      cell, plan.worker.get(), stance, arms, plan.human_handover * centre_of_mass, load_kg);
-  return {{"load_kg", s.load_kg},
-          {"posture",
-           {{"trunk_flexion_deg", c.trunk_flexion_deg},
-            {"elbow_below_shoulder", c.elbow_below_shoulder},
-            {"part_centre_z", c.part_centre_z},
-            {"hip_z", c.hip_z},
-            {"shoulder_z", c.shoulder_z},
-            {"natural", c.natural(online::BoardPlanSettings{}.natural_max_rula)}}},
-          {"two_hands", s.two_hands},
-          {"rula",
-           {{"grand", s.rula().grand},
-            {"action_level", core::rula_action_level(s.rula().grand)},
-            {"action", core::rula_action(s.rula().grand)},
-            {"side", s.hands[static_cast<std::size_t>(s.worst_rula)].arm}}},
-          {"reba",
-           {{"score", s.reba().reba},
-            {"risk", core::reba_risk_level(s.reba().reba)},
-            {"side", s.hands[static_cast<std::size_t>(s.worst_reba)].arm}}},
-          {"hands", hands}};
 }
 
 // The worker a plan is for: the scene's `worker` (stature and sex) or the cell's own human.
@@ -240,7 +147,8 @@ nlohmann::json plan_json(const online::BoardPlan& plan, const core::Cell& cell, 
       posture[plan.second_human_arm] = joints(plan.second_human_joints);
     j["human_posture_rad"] = posture;
     j["natural_posture"] = plan.natural_posture;
-    j["ergonomics"] = ergonomics_json(cell, plan, load_kg, stance, centre_of_mass);
+    j["ergonomics"] = receiving_ergonomics_json(
+        plan_receiving_ergonomics(cell, plan, load_kg, stance, centre_of_mass));
     if (plan.mode == online::DeliveryMode::kExchange) {
       j["robot_handover"] = pose_to_json(plan.robot_handover);
     }
@@ -273,9 +181,7 @@ int run_plan(const PlanOptions& opt) {
   online::Scene scene = online::load_scene(opt.scene, model->cell(), model->product());
   std::vector<std::string> boards;
   if (opt.all) {
-    for (const auto& p : model->product().parts) {
-      if (!scene.is_finished(p.name)) boards.push_back(p.name);
-    }
+    boards = boards_to_plan(*model, scene);
   } else {
     model->product().part(opt.board);  // InputError naming the product file for an unknown board
     if (scene.is_finished(opt.board)) {
@@ -298,43 +204,31 @@ int run_plan(const PlanOptions& opt) {
     std::cout
         << "  board           theta_c   Q      goals  plan ms   path rad  motion s  validated\n";
   }
-  for (std::size_t k = 0; k < boards.size(); ++k) {
-    const std::string& board = boards[k];
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::microseconds(static_cast<long>(opt.deadline_s * 1e6));
-    // Where the suction arm cannot take the tool where it is, the plan begins with the other arm
-    // setting it down where it can (BoardPlan::tool_place).
-    const online::BoardPlan plan = planner.plan(scene, board, deadline);
-    const online::BoardRecords* records = model->board_records(board);
-    out["boards"].push_back(plan_json(
-        plan, model->cell(), model->product().part(board).mass, scene.human_stance,
-        records != nullptr ? records->part.mass_properties.com : Eigen::Vector3d::Zero()));
-    if (!opt.json) {
-      std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;
-      if (plan.solved()) {
-        std::cout << std::setprecision(0) << std::setw(8) << plan.theta_c_deg
-                  << std::setprecision(3) << std::setw(7) << plan.quality << std::setw(7)
-                  << plan.attempts.size() << std::setprecision(1) << std::setw(9)
-                  << 1e3 * plan.planning_seconds << std::setprecision(2) << std::setw(11)
-                  << plan.path_length << std::setw(10) << plan.duration << "  "
-                  << (plan.validated ? "yes" : "NO") << "\n";
-      } else {
-        std::cout << "  not planned (" << online::to_string(plan.status) << ", "
-                  << plan.attempts.size() << " attempts, " << std::setprecision(1)
-                  << 1e3 * plan.planning_seconds << " ms): " << plan.reason << "\n";
-      }
-    }
-    // A board the robot cannot handle is assembled by hand: the next boards' scenes have it
-    // finished, so one failure does not hide whether the rest can be planned.
-    if (!plan.solved()) ++failed;
-    scene = scene.with_finished(model->product(), board);
-    if (plan.solved()) {
-      scene.tool_in_hand = plan.tool_in_hand_after;
-      scene.tool_arm = plan.suction_arm;
-      if (plan.tool_place) scene.tool = *plan.tool_place;
-    }
-    for (const auto& arm : model->cell().arms()) scene.robot[arm.spec.name] = arm.spec.home;
-  }
+  plan_in_sequence(
+      *model, planner, scene, boards, opt.deadline_s,
+      [&](const online::BoardPlan& plan, const online::Scene& planned_in) {
+        const std::string& board = plan.board;
+        const online::BoardRecords* records = model->board_records(board);
+        out["boards"].push_back(plan_json(
+            plan, model->cell(), model->product().part(board).mass, planned_in.human_stance,
+            records != nullptr ? records->part.mass_properties.com : Eigen::Vector3d::Zero()));
+        if (!opt.json) {
+          std::cout << "  " << std::left << std::setw(15) << board << std::right << std::fixed;
+          if (plan.solved()) {
+            std::cout << std::setprecision(0) << std::setw(8) << plan.theta_c_deg
+                      << std::setprecision(3) << std::setw(7) << plan.quality << std::setw(7)
+                      << plan.attempts.size() << std::setprecision(1) << std::setw(9)
+                      << 1e3 * plan.planning_seconds << std::setprecision(2) << std::setw(11)
+                      << plan.path_length << std::setw(10) << plan.duration << "  "
+                      << (plan.validated ? "yes" : "NO") << "\n";
+          } else {
+            std::cout << "  not planned (" << online::to_string(plan.status) << ", "
+                      << plan.attempts.size() << " attempts, " << std::setprecision(1)
+                      << 1e3 * plan.planning_seconds << " ms): " << plan.reason << "\n";
+          }
+        }
+        if (!plan.solved()) ++failed;
+      });
   if (opt.output_given) write_file_atomically(opt.output, out.dump(1) + "\n");
   if (opt.json) std::cout << out.dump(1) << "\n";
   if (failed > 0) {

@@ -414,8 +414,8 @@ void check_part_meshes(const core::ProductSpec& product) {
       std::string what = e.what();
       const std::string prefix = e.file() + ": " + e.field() + ": ";
       if (what.rfind(prefix, 0) == 0) what = what.substr(prefix.size());
-      throw core::InputError(part.mesh_file + ": mesh of part '" + part.name +
-                             "' (" + product.file + "): " + what);
+      throw core::InputError(part.mesh_file + ": mesh of part '" + part.name + "' (" +
+                             product.file + "): " + what);
     }
   }
 }
@@ -440,6 +440,14 @@ std::string default_cell_path() {
 }
 std::string default_product_path() {
   return data_dir() + "/cabinet/product.yaml";
+}
+std::string default_scene_path(const std::string& product) {
+  // A name that is no plain folder name has no bundled folder.
+  if (product.empty() || product == "." || product == ".." ||
+      product.find('/') != std::string::npos) {
+    return "";
+  }
+  return data_dir() + "/" + product + "/scene.yaml";
 }
 
 }  // namespace hila::tools

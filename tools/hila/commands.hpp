@@ -28,5 +28,9 @@ std::string default_cell_path();
 // part and the product file. Quick (no sampling): the build and `product check` run it first.
 void check_part_meshes(const core::ProductSpec& product);
 std::string default_product_path();
+// The nominal scene bundled with hila for the product named `product` (the cabinet's:
+// meshes/cabinet/scene.yaml, beside its product file); a path that does not exist when hila has
+// none for it, "" for a name that is no plain folder name.
+std::string default_scene_path(const std::string& product);
 
 }  // namespace hila::tools

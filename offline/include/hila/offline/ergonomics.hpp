@@ -1,10 +1,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/db/records.hpp"
 #include "hila/offline/human_comfort.hpp"
 
@@ -24,7 +26,9 @@ struct ErgonomicsSettings {
 // How the human takes a board at `board` (world): the least torso flexion (in steps) at which
 // one of `grasps` (indices into `human_grasps`) is reachable by an arm, then the most
 // comfortable of the best map-scored grasps there by direct IK. `stance` is where the human
-// stands. With `only_arm` >= 0 just that arm is used.
+// stands. With `only_arm` >= 0 just that arm is used. `body`: the worker's body (its model, arms
+// and neutral posture; the cell human's comfort maps serve it through core::HumanBody::
+// to_cell_arm); nullptr, or a body that is the cell's human (same_as_cell), the cell's human.
 struct Posture {
   bool reachable = false;
   double torso_flexion_deg = 0.0;
@@ -34,13 +38,20 @@ struct Posture {
   int arm = -1;
   int grasp = -1;
   Eigen::VectorXd arm_joints;
+  // The whole configuration at the posture (the torso bent, the arm's joints, the rest neutral),
+  // of the model the posture was searched on (the body's, else the cell's human); where the
+  // human stood; where the board was (world). Empty q when not reachable.
+  Eigen::VectorXd q;
+  core::Pose stance = core::Pose::Identity();
+  core::Pose board = core::Pose::Identity();
 };
 
 Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
                           const core::Pose& stance, const core::Pose& board,
                           const std::vector<db::HumanGraspRecord>& human_grasps,
                           const std::vector<int>& grasps, int only_arm,
-                          const ErgonomicsSettings& settings);
+                          const ErgonomicsSettings& settings,
+                          const core::HumanBody* body = nullptr);
 
 struct ErgonomicsInputs {
   core::Pose target = core::Pose::Identity();   // world
@@ -59,12 +70,17 @@ struct ErgonomicsInputs {
   // least over them (a board handed over turned by a half turn it is symmetric under needs none).
   // Empty: the plain angle.
   std::vector<Eigen::Matrix3d> symmetries;
+  // Where the human stands (world): nullopt, the cell's stance.
+  std::optional<core::Pose> stance;
+  // The worker (receiving_posture's `body`): nullptr, the cell's human. Not owned.
+  const core::HumanBody* body = nullptr;
 };
 
 // The three ways of getting one board to the human (records in the order hila, table, alone;
 // "hila" only with a goal, "table" only with a placement):
 // hila's first goal with its human grasp; the board laid flat at the table spot; the human alone
-// stepping sideways to face the stack and taking the board from it. Board-specific inputs only;
+// stepping sideways to face the stack and taking the board from it, each for inputs.body at
+// inputs.stance. Board-specific inputs only;
 // part_id is left unset. With `postures`, also each record's posture (its arm's joints), in the
 // same order: what the database does not store, for `hila report ergonomics` to score.
 std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,

@@ -58,10 +58,16 @@ class HumanComfort {
 inline constexpr std::size_t kMaxHumanBodies = 32;
 
 // Parses a body set: "STATURE[:SEX]" items joined by commas, e.g. "1.50:female,1.722,1.90:male"
-// (sex defaults to male). Throws InputError naming `field`.
+// (sex defaults to male; stature in metres within [core::kMinStature, core::kMaxStature]).
+// Throws InputError naming the command line, `field` and the item.
 std::vector<core::HumanBodySpec> parse_human_bodies(const std::string& text,
                                                     const std::string& field);
 // "1.5 female; 1.722 male": the stored form.
 std::string format_human_bodies(const std::vector<core::HumanBodySpec>& bodies);
+// The stored form read back (meta.human_bodies of the database `file`). Throws InputError naming
+// `file` and meta.human_bodies for an item that is not "STATURE SEX" within the human model's
+// statures.
+std::vector<core::HumanBodySpec> parse_stored_human_bodies(const std::string& stored,
+                                                           const std::string& file);
 
 }  // namespace hila::offline

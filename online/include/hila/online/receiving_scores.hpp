@@ -42,6 +42,13 @@ struct ReceivingScores {
 ReceivingScores receiving_scores(const core::Cell& cell, const core::HumanBody* body,
                                  const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms,
                                  double load_kg);
+// The same at a whole configuration `q` of the human model (the body's, else the cell's human),
+// e.g. with the torso bent forward: the hands `arms` (human arm names) scored there. `two_hands`:
+// the load is shared by two hands even where `arms` names one (a part held with both hands whose
+// one hand's posture stands for both); with two arms it is shared anyway.
+ReceivingScores receiving_scores(const core::Cell& cell, const core::HumanBody* body,
+                                 const Eigen::VectorXd& q, const std::vector<std::string>& arms,
+                                 double load_kg, bool two_hands);
 
 // Where a receiving posture puts the worker (docs/online.md, "Goals a person would choose"):
 // the torso's forward bend, whether every receiving elbow is below its shoulder, and the part's
@@ -67,6 +74,12 @@ PostureCheck check_receiving_posture(
     const core::Cell& cell, const core::HumanBody* body, const core::Pose& stance,
     const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms,
     const Eigen::Vector3d& part_centre, double load_kg);
+// The same at a whole configuration `q` (receiving_scores above: `arms` by name, `two_hands`).
+PostureCheck check_receiving_posture(const core::Cell& cell, const core::HumanBody* body,
+                                     const core::Pose& stance, const Eigen::VectorXd& q,
+                                     const std::vector<std::string>& arms,
+                                     const Eigen::Vector3d& part_centre, double load_kg,
+                                     bool two_hands);
 
 // Scores the posture the planner hands the board over at: plan.human_joints on plan.human_arm
 // (and plan.second_human_joints on plan.second_human_arm), the rest of the human at
