@@ -108,7 +108,7 @@ TEST(HumanComfort, BodySetsParseAndRejectBadItems) {
                            {"--bodies", "tall"});
   // A goal's bodies are bits of a 32-bit mask: 32 bodies, not 33.
   std::string many;
-  for (int i = 0; i < 33; ++i) many += (i ? "," : "") + std::string("1.7");
+  for (int i = 0; i < 33; ++i) many += i == 0 ? "1.7" : ",1.7";
   test::expect_input_error([&] { offline::parse_human_bodies(many, "--bodies"); },
                            {"--bodies", "at most 32 bodies", "33"});
   EXPECT_EQ(offline::parse_human_bodies(many.substr(4), "--bodies").size(), 32u);
