@@ -335,6 +335,15 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     b.seed = settings.seed + 0x9E3779B97F4A7C15ULL * ++bridges;
     return b;
   };
+  // The suction transfer's search at the online planner's resolution draws from a sequence of
+  // its own too: the bridges stored stay those the search at held_resolution finds.
+  std::uint64_t coarse_seeds = 0;
+  auto coarse_bridge = [&] {
+    core::BridgeSettings b = settings.bridge;
+    b.resolution = suction_roadmap.resolution;
+    b.seed = settings.seed + 0x94D049BB133111EBULL * ++coarse_seeds;
+    return b;
+  };
   // Alternatives draw from a sequence of their own: the other bridges stay as they were.
   std::uint64_t alternative_seeds = 0;
   auto alternative_bridge = [&] {
@@ -486,10 +495,14 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
                                      endpoint(suction, no_slip_limit, ends[b], k), search)
                             .connected;
         }
-        for (std::size_t b = 0;
-             b < ends.size() && !open_online && static_cast<int>(b) < settings.transfer_bridges;
-             ++b) {
-          open_online = bridge_path(suction, no_slip_limit, pick.lift, ends[b], bridge()).connected;
+        // Bridges to every branch, a share of the samples drawn around the robot-robot end
+        // (where a transfer that does not attach is wedged), as the online planner's.
+        for (std::size_t b = 0; b < ends.size() && !open_online; ++b) {
+          core::BridgeSettings focused = coarse_bridge();
+          focused.focus = {ends[b]};
+          focused.focus_fraction = settings.coarse_focus;
+          focused.max_checks = settings.coarse_bridge_checks;
+          open_online = bridge_path(suction, no_slip_limit, pick.lift, ends[b], focused).connected;
         }
         suction.held_resolution = fine;
       }

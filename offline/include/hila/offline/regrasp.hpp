@@ -58,6 +58,13 @@ struct RegraspSettings {
   // stored as blocked only where it fails there too (the online planner searches at this
   // resolution and mends the path for its validator).
   double online_held_resolution = 0.04;
+  // That search's bridges draw this share of their samples around the robot-robot end (the
+  // online planner's MotionSettings::wedged_focus).
+  double coarse_focus = 0.6;
+  // and at most this many checks each: the online planner's budget for a bridge from a wedged
+  // end (MotionSettings::wedged_bridge_checks), so that what is stored as blocked is what the
+  // online planner would not find either.
+  long coarse_bridge_checks = 3000;
   // Each stored path's estimated duration (RegraspEdgeRecord::duration) is its time at the arm's
   // velocity and acceleration limits times this, in pieces of at most `timing_step` rad: the
   // online planner's defaults (BoardPlanSettings::speed_scale and timing_step), so that a stored
