@@ -721,13 +721,15 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     }
     return finish(BoardPlanStatus::kSolved, "");
   };
-  if (tried_early != nullptr && blocked_last) {  // tried with the others, after the open ones
+  // A blocked natural goal is tried after the open ones: the first open natural goal is tried
+  // early instead, the scan going on only as far as it.
+  for (std::size_t found = 1; tried_early != nullptr && blocked_last;) {
     std::vector<Way> ways;
     ways_of(*tried_early, ways);
-    if (all_blocked(ways)) {
-      tried_early = nullptr;
-      order_goals();
-    }
+    if (!all_blocked(ways)) break;
+    scan_natural(++found);
+    tried_early = natural_found.size() >= found ? natural_found[found - 1] : nullptr;
+    if (tried_early == nullptr) order_goals();
   }
   if (tried_early != nullptr) {
     if (try_goals("", {tried_early})) {
