@@ -328,29 +328,22 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
   core::GraphSearchWorkspace search;
   ExchangeCheck exchange(cell, part.mesh, finished, stacked, settings.suction_arm,
                          settings.receiving_arm);
-  std::uint64_t bridges = 0;
-  auto bridge = [&] {
+  // Each kind of bridge draws its seeds from a sequence of its own (a counter times its
+  // stride): the coarse searches of suction transfers and the alternatives leave the bridges
+  // stored for the chains as they would be without them.
+  auto seeded = [&](std::uint64_t& drawn, std::uint64_t stride) {
     core::BridgeSettings b = settings.bridge;
     b.resolution = receiving_roadmap.resolution;
-    b.seed = settings.seed + 0x9E3779B97F4A7C15ULL * ++bridges;
+    b.seed = settings.seed + stride * ++drawn;
     return b;
   };
-  // The suction transfer's search at the online planner's resolution draws from a sequence of
-  // its own too: the bridges stored stay those the search at held_resolution finds.
-  std::uint64_t coarse_seeds = 0;
-  auto coarse_bridge = [&] {
-    core::BridgeSettings b = settings.bridge;
-    b.resolution = suction_roadmap.resolution;
-    b.seed = settings.seed + 0x94D049BB133111EBULL * ++coarse_seeds;
-    return b;
-  };
-  // Alternatives draw from a sequence of their own: the other bridges stay as they were.
-  std::uint64_t alternative_seeds = 0;
+  std::uint64_t bridges = 0, coarse_seeds = 0, alternative_seeds = 0;
+  auto bridge = [&] { return seeded(bridges, 0x9E3779B97F4A7C15ULL); };
+  // The suction transfer's search at the online planner's resolution.
+  auto coarse_bridge = [&] { return seeded(coarse_seeds, 0x94D049BB133111EBULL); };
   auto alternative_bridge = [&] {
-    core::BridgeSettings b = settings.bridge;
-    b.resolution = receiving_roadmap.resolution;
+    core::BridgeSettings b = seeded(alternative_seeds, 0xD1B54A32D192ED03ULL);
     b.max_checks = settings.alternative_checks;
-    b.seed = settings.seed + 0xD1B54A32D192ED03ULL * ++alternative_seeds;
     return b;
   };
   const GraspSlip no_slip_limit;  // theta_c 90: any tilt

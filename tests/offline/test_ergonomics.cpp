@@ -54,6 +54,18 @@ Board shelf_board() {
   return b;
 }
 
+// The board at its target and in the stack, laid on its first stable placement, with its human
+// grasps: the inputs evaluate_ergonomics takes (the cell's human at the cell's stance).
+offline::ErgonomicsInputs inputs_of(const Board& b) {
+  offline::ErgonomicsInputs in;
+  in.target = b.spec.target;
+  in.initial = b.spec.initial;
+  in.has_placement = true;
+  in.table_placement = b.analysis.placements.front().part_in_plane;
+  in.human_grasps = &b.grasps;
+  return in;
+}
+
 // Shoulder of the human arm in the world, by the human model's own FK at the neutral posture
 // bent by `flexion_deg` (an independent path from the posture search's).
 Eigen::Vector3d shoulder_in_world(const core::Cell& cell, int arm, double flexion_deg) {
@@ -138,12 +150,7 @@ TEST(Ergonomics, TableDropPoseLiesFlatOnTheTableAtTheSpot) {
 TEST(Ergonomics, EvaluateReturnsEachRecordsPostureAndRepeatsItself) {
   const auto cell = test::reference_cell();
   const Board b = shelf_board();
-  offline::ErgonomicsInputs in;
-  in.target = b.spec.target;
-  in.initial = b.spec.initial;
-  in.has_placement = true;
-  in.table_placement = b.analysis.placements.front().part_in_plane;
-  in.human_grasps = &b.grasps;
+  offline::ErgonomicsInputs in = inputs_of(b);
   offline::ErgonomicsSettings settings;
   settings.seed = 11;
   std::vector<offline::Posture> postures{offline::Posture{}};  // cleared first
@@ -199,12 +206,7 @@ TEST(Ergonomics, ReorientationIsModuloThePartsSymmetries) {
 TEST(Ergonomics, EachBodyTakesTheBoardWithItsOwnArms) {
   const auto cell = test::reference_cell();
   const Board b = shelf_board();
-  offline::ErgonomicsInputs in;
-  in.target = b.spec.target;
-  in.initial = b.spec.initial;
-  in.has_placement = true;
-  in.table_placement = b.analysis.placements.front().part_in_plane;
-  in.human_grasps = &b.grasps;
+  offline::ErgonomicsInputs in = inputs_of(b);
   offline::ErgonomicsSettings settings;
   settings.seed = 11;
   std::vector<offline::Posture> cell_postures;
