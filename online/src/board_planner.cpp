@@ -580,6 +580,10 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
     bool blocked = false;
     double seconds = 0.0;
   };
+  // Exchanges the build found blocked go last (BoardPlanSettings::blocked_exchanges_last); off,
+  // no way is marked blocked and every order is as without the flag.
+  const bool blocked_last =
+      settings_.blocked_exchanges_last && settings_.way_order != WayOrder::kFixed;
   auto ways_of = [&](const db::HandoverCandidateRecord& goal, std::vector<Way>& ways) {
     if (const auto direct = records->direct_grasps.find(goal.id);
         direct != records->direct_grasps.end()) {
@@ -615,7 +619,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
         ways.push_back({.goal = &goal,
                         .shared = &g,
                         .unconnected = !connected,
-                        .blocked = !connected && run.exchange_blocked_offline(g),
+                        .blocked = blocked_last && !connected && run.exchange_blocked_offline(g),
                         .seconds = run.estimate(goal, g)});
       }
       std::stable_partition(ways.begin() + static_cast<std::ptrdiff_t>(first), ways.end(),
@@ -654,10 +658,7 @@ BoardPlan BoardPlanner::plan_here(const Scene& scene, const std::string& board,
            std::make_tuple(b.blocked, b.unconnected, b.seconds);
   };
   // A goal whose every way is an exchange the build found blocked (none direct, by a regrasp or
-  // on the cup): tried after the goals of the list that have an open way
-  // (BoardPlanSettings::blocked_exchanges_last).
-  const bool blocked_last =
-      settings_.blocked_exchanges_last && settings_.way_order != WayOrder::kFixed;
+  // on the cup): tried after the goals of the list that have an open way.
   auto all_blocked = [](const std::vector<Way>& ways) {
     return !ways.empty() &&
            std::all_of(ways.begin(), ways.end(), [](const Way& w) { return w.blocked; });
