@@ -72,18 +72,17 @@ std::string Run::chain(const db::HandoverCandidateRecord& goal, const db::Shared
   const Stage* stages[7] = {};
   const auto plan_stages = [&] {
     stages[0] = &tool();
-    if (stages[0]->ok()) {
+    // Nothing is planned for a grasp whose goal the receiving arm cannot reach (the present
+    // stage's own first check, made first): neither the exchange nor the suction arm's pick and
+    // transfer, which fail expensively where the scene moved the exchange out of reach.
+    if (stages[0]->ok() &&
+        (!settings_.reach_human_pose_first || reaches_human_pose(grasp, goal))) {
       // The transfer chooses the suction grasp (its stand-ins) and plans the pick it follows.
       const Stage& moved = transfer(rr);
       stages[1] = &pick(moved.cup);
       if (stages[1]->ok()) stages[2] = &moved;
     }
-    // The exchange and release are planned per grasp: not for one whose goal the receiving
-    // arm cannot reach (the present stage's own first check, made first).
-    if (stages[2] != nullptr && stages[2]->ok() &&
-        (!settings_.reach_human_pose_first || reaches_human_pose(grasp, goal))) {
-      stages[3] = &receive(rr, grasp);
-    }
+    if (stages[2] != nullptr && stages[2]->ok()) stages[3] = &receive(rr, grasp);
     if (stages[3] != nullptr && stages[3]->ok()) stages[4] = &release(rr, grasp);
     if (stages[4] != nullptr && stages[4]->ok()) stages[5] = &present(rr, grasp, goal);
     if (stages[5] != nullptr && stages[5]->ok()) stages[6] = &leave(rr, grasp, goal);

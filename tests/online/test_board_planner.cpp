@@ -527,6 +527,37 @@ TEST_F(BoardPlanner, ReachOfTheHumanPoseIsCheckedBeforeTheExchange) {
       fallback.motions_planned, late.motions_planned, unreachable);
 }
 
+// With only the crated first goal to try, every way ends at the reach check: the receiving arm
+// has no valid IK branch at its robot-human pose with any grasp. Checked first (the default),
+// nothing at all is planned for it: neither the exchange nor the suction arm's tool, pick and
+// transfer to the robot-robot pose, which are planned (and may fail expensively where the scene
+// moved) when the exchange's stages come first.
+TEST_F(BoardPlanner, NothingIsPlannedForAGoalTheReceivingArmCannotReach) {
+  const Blocked& blocked = crate_at_first_goal();
+  online::BoardPlanSettings first_only = eq8_order();
+  first_only.goals = 1;
+  const auto checked = online::BoardPlanner(model(), first_only)
+                           .plan(blocked.scene, "lateral_right", in_seconds(120.0));
+  online::BoardPlanSettings exchange_first = first_only;
+  exchange_first.reach_human_pose_first = false;
+  const auto late = online::BoardPlanner(model(), exchange_first)
+                        .plan(blocked.scene, "lateral_right", in_seconds(120.0));
+  print_plan(checked);
+  ASSERT_FALSE(checked.attempts.empty());
+  for (const auto& a : checked.attempts) {
+    EXPECT_EQ(a.candidate_id, checked.attempts.front().candidate_id);
+    EXPECT_NE(a.outcome.find("no valid IK at the robot-human pose"), std::string::npos)
+        << "the crate must leave every way of the first goal unreachable: " << a.outcome;
+  }
+  EXPECT_FALSE(checked.solved());
+  EXPECT_EQ(late.status, checked.status);
+  EXPECT_EQ(checked.motions_planned, 0);
+  EXPECT_GT(late.motions_planned, 0);
+  std::printf("the unreachable goal alone: %d motions planned with the reach checked first, %d "
+              "with the exchange first\n",
+              checked.motions_planned, late.motions_planned);
+}
+
 // A validator stricter than the planner (a held board kept 2 deg inside theta_c) rejects
 // transfers the planner has already planned past: with the validation overlapped, each is
 // caught when the goal settles, its fallbacks run and its stage is planned again in order.

@@ -59,10 +59,11 @@ struct BoardPlanSettings {
   // thread rather than queued with its validation (the plan is the same either way). false
   // queues every step's smoothing: slower, the work piling onto the thread already behind.
   bool smooth_here_when_behind = true;
-  // Before the exchange is planned for a goal and grasp, whether the receiving arm reaches the
-  // goal's robot-human pose with that grasp at all (the transfer to the human's own first
-  // check): the same plans, without planning exchanges for grasps the goal cannot use. false
-  // plans the exchange first.
+  // Before anything of an exchange way is planned for a goal and grasp (the suction arm's pick
+  // and transfer included), whether the receiving arm reaches the goal's robot-human pose with
+  // that grasp at all (the transfer to the human's own first check): the same choice of way,
+  // without planning picks, transfers and exchanges for grasps the goal cannot use. false plans
+  // the exchange's stages first.
   bool reach_human_pose_first = true;
   // The human who is there. The stored goals are evaluated again for the scene's human (comfort
   // Q of paper Eq. 4, by the database's comfort maps). Those with Q of at least this (or of at
