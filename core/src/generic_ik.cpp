@@ -23,18 +23,37 @@ Eigen::VectorXd random_configuration(const KinematicChain& chain, std::mt19937_6
   return q;
 }
 
+namespace {
+
+// One Levenberg-Marquardt step dq = J^T (J J^T + lambda I)^-1 e over the task's Rows rows, in
+// fixed-size matrices (no allocation in the IK loop).
+template <int Rows>
+void lm_step(const Jacobian& jac, const Eigen::Matrix<double, 6, 1>& e, double lambda,
+             Eigen::VectorXd& dq) {
+  const auto j = jac.topRows<Rows>();
+  Eigen::Matrix<double, Rows, Rows> jjt = j * j.transpose();
+  jjt.diagonal().array() += lambda;
+  const Eigen::Matrix<double, Rows, 1> y = jjt.ldlt().solve(e.head<Rows>());
+  dq.noalias() = j.transpose() * y;
+}
+
+}  // namespace
+
 GenericIkResult solve_ik(const KinematicChain& chain, const Pose& target,
                          const Eigen::VectorXd& seed, std::mt19937_64& rng,
                          const GenericIkSettings& settings) {
   GenericIkResult result;
   const int rows = settings.position_only ? 3 : 6;
-  Pose tip;
-  Jacobian jac;
+  const int n = chain.dof();
+  Pose tip, tip_new;
+  Jacobian jac(6, n), jac_new(6, n);
+  Eigen::VectorXd q(n), q_new(n), dq(n);
   double best_cost = std::numeric_limits<double>::infinity();
   for (int attempt = 0; attempt < settings.max_attempts; ++attempt) {
     ++result.attempts;
-    Eigen::VectorXd q = attempt == 0 ? seed : random_configuration(chain, rng);
-    q = q.cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
+    q = (attempt == 0 ? seed : random_configuration(chain, rng))
+            .cwiseMax(chain.lower_limits())
+            .cwiseMin(chain.upper_limits());
     double lambda = 1e-2;
     chain.fk_and_jacobian(q, tip, jac);
     Eigen::Matrix<double, 6, 1> e = pose_error(target, tip);
@@ -45,21 +64,20 @@ GenericIkResult solve_ik(const KinematicChain& chain, const Pose& target,
           (settings.position_only || e.tail<3>().norm() < settings.orientation_tolerance)) {
         break;
       }
-      const Eigen::MatrixXd j = jac.topRows(rows);
-      Eigen::MatrixXd jjt = j * j.transpose();
-      jjt.diagonal().array() += lambda + settings.damping * settings.damping;
-      const Eigen::VectorXd dq = j.transpose() * jjt.ldlt().solve(e.head(rows));
-      const Eigen::VectorXd q_new =
-          (q + dq).cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
-      Pose tip_new;
-      Jacobian jac_new;
+      const double added = lambda + settings.damping * settings.damping;
+      if (settings.position_only) {
+        lm_step<3>(jac, e, added, dq);
+      } else {
+        lm_step<6>(jac, e, added, dq);
+      }
+      q_new = (q + dq).cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
       chain.fk_and_jacobian(q_new, tip_new, jac_new);
       const Eigen::Matrix<double, 6, 1> e_new = pose_error(target, tip_new);
       const double cost_new = e_new.head(rows).squaredNorm();
       if (cost_new < cost) {
-        q = q_new;
+        q.swap(q_new);
         tip = tip_new;
-        jac = jac_new;
+        jac.swap(jac_new);
         e = e_new;
         cost = cost_new;
         lambda = std::max(lambda * 0.3, 1e-12);

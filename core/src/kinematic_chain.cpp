@@ -170,25 +170,26 @@ Pose KinematicChain::fk(const Eigen::VectorXd& q) const {
 void KinematicChain::fk_and_jacobian(const Eigen::VectorXd& q, Pose& tip, Jacobian& jac) const {
   assert(q.size() == dof());
   const int n = dof();
-  jac.resize(6, n);
-  Eigen::Matrix<double, 3, Eigen::Dynamic> axes(3, n);
-  Eigen::Matrix<double, 3, Eigen::Dynamic> origins(3, n);
+  jac.resize(6, n);  // no allocation when it already has n columns (an IK loop's)
+  // Each joint's axis goes to the angular rows and its origin, for now, to the linear rows: the
+  // linear column needs the tip, known only at the end of the walk.
   Eigen::Matrix3d r;
   Eigen::Vector3d p;
   walk_chain(fixed_rotation_, fixed_translation_, fixed_permutation_, joint_types_, q, r, p,
              [&](int i, const Eigen::Matrix3d& ri, const Eigen::Vector3d& pi) {
-               axes.col(i) = ri.col(2);
-               origins.col(i) = pi;
+               jac.block<3, 1>(3, i) = ri.col(2);
+               jac.block<3, 1>(0, i) = pi;
              });
   tip = Pose::Identity();
   tip.linear() = r;
   tip.translation() = p;
   for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d axis = jac.block<3, 1>(3, i);
     if (joint_types_[i] == JointType::Revolute) {
-      jac.block<3, 1>(0, i) = axes.col(i).cross(p - origins.col(i));
-      jac.block<3, 1>(3, i) = axes.col(i);
+      const Eigen::Vector3d origin = jac.block<3, 1>(0, i);
+      jac.block<3, 1>(0, i) = axis.cross(p - origin);
     } else {
-      jac.block<3, 1>(0, i) = axes.col(i);
+      jac.block<3, 1>(0, i) = axis;
       jac.block<3, 1>(3, i).setZero();
     }
   }
