@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -42,6 +43,61 @@ std::vector<std::string> split_events(const std::string& text) {
 // happens when its step has arrived (docs/online.md: a step's starting event comes first).
 bool starts_step(const std::string& event) {
   return event == "suction_off" || event == "gripper_open";
+}
+
+// The human who is there takes the board where the plan presents it: each receiving hand's
+// joints in the plan, within the arm's limits, put that hand by forward kinematics (from the
+// scene's stance: the worker's body, else the cell's human at its neutral posture) at the goal's
+// human grasp on the board at the robot-human pose.
+template <typename Problem>
+void check_human_takes_it(const online::PlannerModel& model, const online::Scene& scene,
+                          const online::BoardPlan& plan, const db::PartRecord& record,
+                          Problem&& problem) {
+  const core::Cell& cell = model.cell();
+  const db::Database& db = model.database();
+  std::optional<db::HandoverCandidateRecord> goal;
+  for (const auto& g : db.handover_goals(record.id)) {
+    if (g.id == plan.candidate_id) goal = g;
+  }
+  if (!goal) {
+    problem(plan.board, "the plan's goal is not in the database");
+    return;
+  }
+  std::map<std::int64_t, core::Pose> hand_in_part;
+  for (const auto& h : db.human_grasps(record.id)) hand_in_part[h.id] = h.hand;
+  const core::HumanBody* body = scene.worker.get();
+  std::vector<core::Pose> links;
+  cell.human().link_poses(cell.human_neutral(), links);
+  const std::vector<core::HumanArm>& arms = body != nullptr ? body->arms() : cell.human_arms();
+  const auto takes = [&](const std::string& arm_name, const Eigen::VectorXd& q,
+                         std::int64_t grasp_id, const std::string& plan_arm) {
+    const std::string where = plan.board + ": the human's " + arm_name + " hand";
+    const auto a = std::find_if(arms.begin(), arms.end(),
+                                [&](const core::HumanArm& h) { return h.spec.name == arm_name; });
+    const auto hand = hand_in_part.find(grasp_id);
+    if (a == arms.end() || hand == hand_in_part.end()) {
+      problem(where, "the goal names a human arm or grasp the model or database has not");
+      return;
+    }
+    if (plan_arm != arm_name || q.size() != a->chain.dof()) {
+      problem(where, "the plan's receiving posture is not the goal's arm or has " +
+                         std::to_string(q.size()) + " joints");
+      return;
+    }
+    if (!a->chain.within_limits(q, 1e-9)) problem(where, "its joints are outside their limits");
+    const core::Pose base =
+        body != nullptr
+            ? body->base_in_stance(static_cast<int>(a - arms.begin()))
+            : links[static_cast<std::size_t>(cell.human().link_index(a->spec.base_link))];
+    const std::string off = pose_error(scene.human_stance * base * a->chain.fk(q),
+                                       plan.human_handover * hand->second);
+    if (!off.empty()) problem(where, "is " + off + " its grasp on the presented board");
+  };
+  takes(goal->human_arm, plan.human_joints, goal->human_grasp_id, plan.human_arm);
+  if (!goal->second_arm.empty()) {
+    takes(goal->second_arm, plan.second_human_joints, goal->second_grasp_id,
+          plan.second_human_arm);
+  }
 }
 
 }  // namespace
@@ -390,6 +446,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
   if (!handed_over || on_cup || in_gripper) {
     problem(plan.board, "the board does not end with the human");
   }
+  if (record != nullptr) check_human_takes_it(model, scene, plan, *record, problem);
   return out;
 }
 
