@@ -32,6 +32,7 @@ ComfortResult best_comfort(const core::KinematicChain& arm, const core::Pose& ha
   ik.max_attempts = 1;  // restarts are ours, so that every solution is scored
   ik.position_tolerance = settings.tolerance;
   ik.orientation_tolerance = settings.tolerance;
+  ik.hold_joints_at_limits = settings.hold_joints_at_limits;
   int found_at = -1;
   for (int attempt = 0; attempt < settings.ik_attempts; ++attempt) {
     if (found_at >= 0 && settings.attempts_after_found >= 0 &&

@@ -1,7 +1,9 @@
 #include "hila/core/generic_ik.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace hila::core {
 
@@ -26,11 +28,15 @@ Eigen::VectorXd random_configuration(const KinematicChain& chain, std::mt19937_6
 namespace {
 
 // One Levenberg-Marquardt step dq = J^T (J J^T + lambda I)^-1 e over the task's Rows rows, in
-// fixed-size matrices (no allocation in the IK loop).
+// fixed-size matrices (no allocation in the IK loop); the columns of held joints are left out.
 template <int Rows>
 void lm_step(const Jacobian& jac, const Eigen::Matrix<double, 6, 1>& e, double lambda,
-             Eigen::VectorXd& dq) {
-  const auto j = jac.topRows<Rows>();
+             const std::vector<bool>& held, Jacobian& free_jac, Eigen::VectorXd& dq) {
+  free_jac = jac;
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    if (held[i]) free_jac.col(static_cast<Eigen::Index>(i)).setZero();
+  }
+  const auto j = free_jac.topRows<Rows>();
   Eigen::Matrix<double, Rows, Rows> jjt = j * j.transpose();
   jjt.diagonal().array() += lambda;
   const Eigen::Matrix<double, Rows, 1> y = jjt.ldlt().solve(e.head<Rows>());
@@ -47,7 +53,9 @@ GenericIkResult solve_ik(const KinematicChain& chain, const Pose& target,
   const int n = chain.dof();
   Pose tip, tip_new;
   Jacobian jac(6, n), jac_new(6, n);
+  Jacobian free_jac(6, n);
   Eigen::VectorXd q(n), q_new(n), dq(n);
+  std::vector<bool> held(static_cast<std::size_t>(n), false);
   double best_cost = std::numeric_limits<double>::infinity();
   for (int attempt = 0; attempt < settings.max_attempts; ++attempt) {
     ++result.attempts;
@@ -65,10 +73,25 @@ GenericIkResult solve_ik(const KinematicChain& chain, const Pose& target,
         break;
       }
       const double added = lambda + settings.damping * settings.damping;
-      if (settings.position_only) {
-        lm_step<3>(jac, e, added, dq);
-      } else {
-        lm_step<6>(jac, e, added, dq);
+      std::fill(held.begin(), held.end(), false);
+      // Without holding: one step. Holding: again while the step pushes a joint at a limit out.
+      for (int pass = 0; pass <= (settings.hold_joints_at_limits ? n : 0); ++pass) {
+        if (settings.position_only) {
+          lm_step<3>(jac, e, added, held, free_jac, dq);
+        } else {
+          lm_step<6>(jac, e, added, held, free_jac, dq);
+        }
+        bool more = false;
+        for (int i = 0; settings.hold_joints_at_limits && i < n; ++i) {
+          const auto k = static_cast<std::size_t>(i);
+          if (held[k]) continue;
+          if ((q[i] <= chain.lower_limits()[i] && dq[i] < 0.0) ||
+              (q[i] >= chain.upper_limits()[i] && dq[i] > 0.0)) {
+            held[k] = true;
+            more = true;
+          }
+        }
+        if (!more) break;
       }
       q_new = (q + dq).cwiseMax(chain.lower_limits()).cwiseMin(chain.upper_limits());
       chain.fk_and_jacobian(q_new, tip_new, jac_new);

@@ -23,6 +23,8 @@ struct ComfortSettings {
   // comfortable posture). A reach check with a good seed needs few.
   int attempts_after_found = -1;
   double tolerance = 1e-10;  // m and rad: the hand pose error a solution may leave
+  // GenericIkSettings::hold_joints_at_limits: steps solved over the joints not held at a limit.
+  bool hold_joints_at_limits = false;
   std::uint64_t seed = 1;
 };
 

@@ -16,6 +16,11 @@ struct GenericIkSettings {
   double orientation_tolerance = 1e-10;  // rad
   double damping = 1e-6;       // added to the LM lambda (keeps steps bounded near singularities)
   bool position_only = false;  // ignore orientation (reaching tasks)
+  // A joint at a limit whose step would push it past the limit is held there for that step, the
+  // step solved again over the others (an active set), instead of the step being clipped: the
+  // clipped step leaves the other joints' share unsolved, and the iterate crawls along the limit
+  // for tens of iterations. false: clipped steps only.
+  bool hold_joints_at_limits = false;
 };
 
 struct GenericIkResult {
