@@ -89,14 +89,13 @@ void check_human_takes_it(const online::PlannerModel& model, const online::Scene
         body != nullptr
             ? body->base_in_stance(static_cast<int>(a - arms.begin()))
             : links[static_cast<std::size_t>(cell.human().link_index(a->spec.base_link))];
-    const std::string off = pose_error(scene.human_stance * base * a->chain.fk(q),
-                                       plan.human_handover * hand->second);
+    const std::string off =
+        pose_error(scene.human_stance * base * a->chain.fk(q), plan.human_handover * hand->second);
     if (!off.empty()) problem(where, "is " + off + " its grasp on the presented board");
   };
   takes(goal->human_arm, plan.human_joints, goal->human_grasp_id, plan.human_arm);
   if (!goal->second_arm.empty()) {
-    takes(goal->second_arm, plan.second_human_joints, goal->second_grasp_id,
-          plan.second_human_arm);
+    takes(goal->second_arm, plan.second_human_joints, goal->second_grasp_id, plan.second_human_arm);
   }
 }
 
@@ -243,7 +242,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       }
       if (step.time.front() < clock - 1e-9) problem(where, "starts before the previous step ends");
       clock = step.time.back();
-      const auto events = split_events(step.event);
+      const auto events = split_events(online::events_text(step));
       bool released = false, grasped = false;
       for (const auto& e : events) {
         if (e == "tool_released") {
@@ -308,7 +307,7 @@ PlanCheck check_plan(const online::PlannerModel& model, const online::Scene& sce
       problem(where, "expected a known arm and one time per waypoint");
       return out;
     }
-    const auto events = split_events(step.event);
+    const auto events = split_events(online::events_text(step));
     bool started = true;
     for (const auto& e : events) {
       if (!starts_step(e)) {

@@ -21,6 +21,32 @@ int arm_index_of(const core::Cell& cell, const core::Arm& arm) {
 
 }  // namespace
 
+const char* to_string(MotionVia via) {
+  switch (via) {
+    case MotionVia::kNone:
+      return "";
+    case MotionVia::kDirect:
+      return "direct";
+    case MotionVia::kStored:
+      return "stored";
+    case MotionVia::kRoadmap:
+      return "roadmap";
+    case MotionVia::kStoredRoadmap:
+      return "stored+roadmap";
+    case MotionVia::kStoredRepair:
+      return "stored+repair";
+    case MotionVia::kBridge:
+      return "bridge";
+    case MotionVia::kRepaired:
+      return "repaired";
+    case MotionVia::kRrtConnect:
+      return "rrt_connect";
+    case MotionVia::kLazyPrm:
+      return "lazy_prm";
+  }
+  return "?";
+}
+
 const char* to_string(MotionStatus status) {
   switch (status) {
     case MotionStatus::kSolved:
@@ -507,7 +533,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     r.edges_invalidated = invalidated_;
     if (status != MotionStatus::kSolved) {
       r.path.clear();
-    } else if (r.via != "direct") {
+    } else if (r.via != MotionVia::kDirect) {
       shorten(r.path);
     }
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -527,7 +553,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
   }
   if (segment_valid(request.start, request.goal)) {
     r.path = {request.start, request.goal};
-    r.via = "direct";
+    r.via = MotionVia::kDirect;
     return finish(MotionStatus::kSolved, "");
   }
   // The start or goal in contact is valid by design (the lift's first state, the tool set
@@ -549,7 +575,8 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
                                request.deadline);
     }
     if (!r.path.empty()) {
-      r.via = to_string(settings_.planner);
+      r.via = settings_.planner == MotionPlannerKind::kRrtConnect ? MotionVia::kRrtConnect
+                                                                  : MotionVia::kLazyPrm;
       return finish(MotionStatus::kSolved, "");
     }
     return finish(late() ? MotionStatus::kTimeout : MotionStatus::kNoPath,
@@ -560,7 +587,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     r.path = follow(*request.rejected, request.start, request.goal, settings_.fine_repair_checks,
                     valid_here, request.deadline, settings_.fine_repairs);
     if (!r.path.empty()) {
-      r.via = "repaired";
+      r.via = MotionVia::kRepaired;
       return finish(MotionStatus::kSolved, "");
     }
   }
@@ -569,7 +596,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     if (late()) return finish(MotionStatus::kTimeout, "the deadline passed on a stored path");
     r.path = follow(*hint, request.start, request.goal, 0, valid_here, request.deadline, 0);
     if (!r.path.empty()) {
-      r.via = "stored";
+      r.via = MotionVia::kStored;
       return finish(MotionStatus::kSolved, "");
     }
   }
@@ -690,7 +717,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
       for (const int n : path.nodes)
         r.path.push_back(roadmap_.record.nodes[static_cast<std::size_t>(n)]);
       r.path.insert(r.path.end(), tail.begin(), tail.end());
-      r.via = lead.size() > 1 || tail.size() > 1 ? "stored+roadmap" : "roadmap";
+      r.via = lead.size() > 1 || tail.size() > 1 ? MotionVia::kStoredRoadmap : MotionVia::kRoadmap;
       return true;
     }
     return false;
@@ -755,7 +782,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
       r.path = follow(*hint, request.start, request.goal, budget, valid_here, request.deadline,
                       settings_.max_repairs);
       if (!r.path.empty()) {
-        r.via = "stored+repair";
+        r.via = MotionVia::kStoredRepair;
         return finish(MotionStatus::kSolved, "");
       }
       if (!late()) remember_failure(repair);
@@ -779,7 +806,7 @@ MotionResult ArmMotionPlanner::plan(const MotionRequest& request) {
     r.path = core::plan_bridge(arm_, valid_here, request.start, request.goal, bridge);
   }
   if (!r.path.empty()) {
-    r.via = "bridge";
+    r.via = MotionVia::kBridge;
     return finish(MotionStatus::kSolved, "");
   }
   if (late()) return finish(MotionStatus::kTimeout, "the deadline passed during the bridge");

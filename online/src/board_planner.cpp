@@ -38,6 +38,40 @@ const char* to_string(DeliveryMode mode) {
   return "?";
 }
 
+const char* to_string(StepEvent event) {
+  switch (event) {
+    case StepEvent::kNone:
+      return "";
+    case StepEvent::kSuctionOn:
+      return "suction_on";
+    case StepEvent::kSuctionOff:
+      return "suction_off";
+    case StepEvent::kGripperClose:
+      return "gripper_close";
+    case StepEvent::kGripperOpen:
+      return "gripper_open";
+    case StepEvent::kToolGrasped:
+      return "tool_grasped";
+    case StepEvent::kToolReleased:
+      return "tool_released";
+    case StepEvent::kSetDown:
+      return "set_down";
+    case StepEvent::kWaitForHuman:
+      return "wait_for_human";
+  }
+  return "?";
+}
+
+std::string events_text(const PlanStep& step) {
+  const std::string start = to_string(step.start_event);
+  const std::string end = to_string(step.end_event);
+  return start.empty() ? end : end.empty() ? start : start + "," + end;
+}
+
+std::string via_text(const PlanStep& step) {
+  return std::string(to_string(step.via)) + (step.staged ? "+staging" : "");
+}
+
 const char* to_string(AttemptResult result) {
   switch (result) {
     case AttemptResult::kPlanned:

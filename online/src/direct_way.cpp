@@ -105,7 +105,9 @@ void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
   MotionRequest to = r;
   to.start = arm_q(st, suction_);
   to.goal = above.front();
-  if (auto e = step(st, suction_planner_, suction_, to, "tool_to_place", "", ""); !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, to, "tool_to_place", StepEvent::kNone,
+                    StepEvent::kNone);
+      !e.empty()) {
     st.failure = e;
     return;
   }
@@ -113,7 +115,8 @@ void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
   down.start = above.front();
   down.goal = *at;
   down.end_in_contact = true;
-  if (auto e = step(st, suction_planner_, suction_, down, "tool_lower", "", "tool_released");
+  if (auto e = step(st, suction_planner_, suction_, down, "tool_lower", StepEvent::kNone,
+                    StepEvent::kToolReleased);
       !e.empty()) {
     st.failure = e;
     return;
@@ -123,7 +126,9 @@ void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
   MotionRequest back = r;
   back.start = *at;
   back.goal = before.front();
-  if (auto e = step(st, suction_planner_, suction_, back, "tool_retreat", "", ""); !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, back, "tool_retreat", StepEvent::kNone,
+                    StepEvent::kNone);
+      !e.empty()) {
     st.failure = e;
   }
 }
@@ -156,7 +161,8 @@ std::string Run::return_tool(const core::Pose& board_world, std::vector<PlanStep
       home.board_world = board_world;
       home.start = arm_q(st, suction_);
       home.goal = suction_.spec.home;
-      if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home_empty", "", "");
+      if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home_empty",
+                        StepEvent::kNone, StepEvent::kNone);
           !e.empty()) {
         st.failure = e;
       }
@@ -226,15 +232,16 @@ void Run::take(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& gras
   MotionRequest r = standing;
   r.start = now;
   r.goal = *before;
-  if (auto e = step(st, planner, arm, r, again ? "regrasp_approach" : "gripper_approach", "", "");
+  if (auto e = step(st, planner, arm, r, again ? "regrasp_approach" : "gripper_approach",
+                    StepEvent::kNone, StepEvent::kNone);
       !e.empty()) {
     st.failure = e;
     return;
   }
   r.start = *before;
   r.goal = *at;
-  if (auto e =
-          step(st, planner, arm, r, again ? "regrasp_grasp" : "gripper_grasp", "", "gripper_close");
+  if (auto e = step(st, planner, arm, r, again ? "regrasp_grasp" : "gripper_grasp",
+                    StepEvent::kNone, StepEvent::kGripperClose);
       !e.empty()) {
     st.failure = e;
     return;
@@ -243,7 +250,9 @@ void Run::take(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& gras
   carry.start = *at;
   carry.goal = *up;
   carry.start_in_contact = true;  // the board still rests where it was detected or set down
-  if (auto e = step(st, planner, arm, carry, again ? "regrasp_lift" : "lift", "", ""); !e.empty()) {
+  if (auto e = step(st, planner, arm, carry, again ? "regrasp_lift" : "lift", StepEvent::kNone,
+                    StepEvent::kNone);
+      !e.empty()) {
     st.failure = e;
   }
 }
@@ -275,7 +284,8 @@ void Run::present_held(Stage& st, const core::Arm& arm, const db::RobotGraspReco
   present.start = up;
   present.goal = *rh_q;
   present.filter = filter_for(arm, "gripper", grasp.id);
-  if (auto e = step(st, planner, arm, present, "transfer_to_human", "", "wait_for_human");
+  if (auto e = step(st, planner, arm, present, "transfer_to_human", StepEvent::kNone,
+                    StepEvent::kWaitForHuman);
       !e.empty()) {
     st.failure = e;
   }

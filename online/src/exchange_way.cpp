@@ -75,8 +75,7 @@ std::string Run::chain(const db::HandoverCandidateRecord& goal, const db::Shared
     // Nothing is planned for a grasp whose goal the receiving arm cannot reach (the present
     // stage's own first check, made first): neither the exchange nor the suction arm's pick and
     // transfer, which fail expensively where the scene moved the exchange out of reach.
-    if (stages[0]->ok() &&
-        (!settings_.reach_human_pose_first || reaches_human_pose(grasp, goal))) {
+    if (stages[0]->ok() && (!settings_.reach_human_pose_first || reaches_human_pose(grasp, goal))) {
       // The transfer chooses the suction grasp (its stand-ins) and plans the pick it follows.
       const Stage& moved = transfer(rr);
       stages[1] = &pick(moved.cup);
@@ -154,7 +153,8 @@ const Stage& Run::tool() {
   MotionRequest approach = r;
   approach.start = arm_q(st, suction_);
   approach.goal = *before;
-  if (auto e = step(st, suction_planner_, suction_, approach, "tool_approach", "", "");
+  if (auto e = step(st, suction_planner_, suction_, approach, "tool_approach", StepEvent::kNone,
+                    StepEvent::kNone);
       !e.empty()) {
     st.failure = e;
     return st;
@@ -162,7 +162,8 @@ const Stage& Run::tool() {
   MotionRequest in = r;
   in.start = *before;
   in.goal = *at;
-  if (auto e = step(st, suction_planner_, suction_, in, "tool_grasp", "", "tool_grasped");
+  if (auto e = step(st, suction_planner_, suction_, in, "tool_grasp", StepEvent::kNone,
+                    StepEvent::kToolGrasped);
       !e.empty()) {
     st.failure = e;
     return st;
@@ -173,14 +174,18 @@ const Stage& Run::tool() {
   lift.start = *at;
   lift.goal = *raised;
   lift.start_in_contact = true;  // the cup still stands on the table
-  if (auto e = step(st, suction_planner_, suction_, lift, "tool_lift", "", ""); !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, lift, "tool_lift", StepEvent::kNone,
+                    StepEvent::kNone);
+      !e.empty()) {
     st.failure = e;
     return st;
   }
   MotionRequest home = r;
   home.start = *raised;
   home.goal = suction_.spec.home;
-  if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home", "", ""); !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home", StepEvent::kNone,
+                    StepEvent::kNone);
+      !e.empty()) {
     st.failure = e;
   }
   return st;
@@ -245,19 +250,21 @@ const Stage& Run::pick(std::int64_t cup_id) {
     r.goal = branch.before;
     // The stored transits end at the build's branch: they lead only to a branch near it.
     if (b == 0) r.hints = paths_of(transits);
-    std::string e = step(attempt, suction_planner_, suction_, r, "suction_approach", "", "");
+    std::string e = step(attempt, suction_planner_, suction_, r, "suction_approach",
+                         StepEvent::kNone, StepEvent::kNone);
     if (e.empty()) {
       r.hints.clear();
       r.start = branch.before;
       r.goal = branch.at;
-      e = step(attempt, suction_planner_, suction_, r, "suction_pick", "", "suction_on");
+      e = step(attempt, suction_planner_, suction_, r, "suction_pick", StepEvent::kNone,
+               StepEvent::kSuctionOn);
     }
     if (e.empty()) {
       MotionRequest up = carry;
       up.start = branch.at;
       up.goal = branch.up;
       up.start_in_contact = true;  // the board still rests where it was detected
-      e = step(attempt, suction_planner_, suction_, up, "lift", "", "");
+      e = step(attempt, suction_planner_, suction_, up, "lift", StepEvent::kNone, StepEvent::kNone);
     }
     if (e.empty()) {
       st = std::move(attempt);
@@ -377,7 +384,8 @@ std::string Run::transfer_steps(Stage& st, const db::RobotHandoverRecord& rr, st
   carry.goal = *rr_q;
   carry.filter = filter_for(suction_, "suction", cup.id);
   carry.hints = paths_of(stored);
-  return step(st, suction_planner_, suction_, carry, "transfer_to_robot_handover", "", "");
+  return step(st, suction_planner_, suction_, carry, "transfer_to_robot_handover", StepEvent::kNone,
+              StepEvent::kNone);
 }
 
 const Stage& Run::receive(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp) {
@@ -474,15 +482,16 @@ std::string Run::preposition(Stage& st, const db::RobotHandoverRecord& rr,
   wait.board_world = up_tcp * on_cup(cup).board_in_tcp;
   wait.start = arm_q(st, receiving_);
   wait.goal = *pre_q;
-  if (auto e = step(st, receiving_planner_, receiving_, wait, "receiving_approach", "", "");
+  if (auto e = step(st, receiving_planner_, receiving_, wait, "receiving_approach",
+                    StepEvent::kNone, StepEvent::kNone);
       !e.empty()) {
     return e;
   }
   if (auto e = transfer_steps(st, rr, cup_id); !e.empty()) return e;
   at_exchange.start = *pre_q;
   at_exchange.goal = grasp_q;
-  return step(st, receiving_planner_, receiving_, at_exchange, "receiving_grasp", "",
-              "gripper_close");
+  return step(st, receiving_planner_, receiving_, at_exchange, "receiving_grasp", StepEvent::kNone,
+              StepEvent::kGripperClose);
 }
 
 std::optional<Eigen::VectorXd> Run::pre_grasp(const Stage& st, const MotionRequest& request,
@@ -517,8 +526,8 @@ std::string Run::reach_exchange(Stage& st, const db::RobotHandoverRecord& rr,
   reach.hints = std::move(hints);
   if (pre_q) {
     reach.goal = *pre_q;
-    if (auto e =
-            step(st, receiving_planner_, receiving_, reach, "receiving_approach", "", "", stagings);
+    if (auto e = step(st, receiving_planner_, receiving_, reach, "receiving_approach",
+                      StepEvent::kNone, StepEvent::kNone, stagings);
         !e.empty()) {
       return e;
     }
@@ -527,8 +536,8 @@ std::string Run::reach_exchange(Stage& st, const db::RobotHandoverRecord& rr,
     stagings.clear();
   }
   reach.goal = grasp_q;
-  return step(st, receiving_planner_, receiving_, reach, "receiving_grasp", "", "gripper_close",
-              stagings);
+  return step(st, receiving_planner_, receiving_, reach, "receiving_grasp", StepEvent::kNone,
+              StepEvent::kGripperClose, stagings);
 }
 
 const Stage& Run::release(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp) {
@@ -555,7 +564,8 @@ std::string Run::let_go_of_cup(Stage& st, const db::SuctionGraspRecord& cup,
   if (!back.empty() && first_valid(st, suction_planner_, leave, {back.front()}) &&
       suction_planner_.segment_valid(at_q, back.front())) {
     leave.goal = back.front();
-    if (auto e = step(st, suction_planner_, suction_, leave, "suction_retreat", "suction_off", "");
+    if (auto e = step(st, suction_planner_, suction_, leave, "suction_retreat",
+                      StepEvent::kSuctionOff, StepEvent::kNone);
         !e.empty()) {
       return e;
     }
@@ -564,7 +574,7 @@ std::string Run::let_go_of_cup(Stage& st, const db::SuctionGraspRecord& cup,
   }
   leave.goal = suction_.spec.home;
   return step(st, suction_planner_, suction_, leave, "suction_arm_home",
-              backed_off ? "" : "suction_off", "");
+              backed_off ? StepEvent::kNone : StepEvent::kSuctionOff, StepEvent::kNone);
 }
 
 const Stage& Run::present(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp,
@@ -596,8 +606,8 @@ const Stage& Run::present(const db::RobotHandoverRecord& rr, const db::RobotGras
   present.goal = *rh_q;
   present.filter = filter_for(receiving_, "gripper", grasp.id);
   present.hints = paths_of(stored);
-  if (auto e = step(st, receiving_planner_, receiving_, present, "transfer_to_human", "",
-                    "wait_for_human");
+  if (auto e = step(st, receiving_planner_, receiving_, present, "transfer_to_human",
+                    StepEvent::kNone, StepEvent::kWaitForHuman);
       !e.empty()) {
     st.failure = e;
   }

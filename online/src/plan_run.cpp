@@ -187,9 +187,8 @@ Hints Run::paths_of(const std::vector<const db::RegraspEdgeRecord*>& edges) {
 // --- The step pipeline ---------------------------------------------------------------------------
 
 std::string Run::step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& arm,
-                      MotionRequest request, const std::string& name,
-                      const std::string& start_event, const std::string& end_event,
-                      const std::vector<Eigen::VectorXd>& stagings) {
+                      MotionRequest request, const std::string& name, StepEvent start_event,
+                      StepEvent end_event, const std::vector<Eigen::VectorXd>& stagings) {
   if (std::chrono::steady_clock::now() >= deadline_) {
     stage.deadline_passed = true;
     return name + ": the deadline passed";
@@ -209,7 +208,7 @@ std::string Run::step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& 
     MotionResult via_staging = timed_plan(planner, staged);
     if (!via_staging.solved() || !planner.segment_valid(stagings[i], request.goal)) continue;
     via_staging.path.push_back(request.goal);
-    via_staging.via += "+staging";
+    via_staging.staged = true;
     motion = std::move(via_staging);
   }
   if (!motion.solved()) {
@@ -262,6 +261,7 @@ std::string Run::step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& 
     pending.request.hints.clear();
     pending.request.late_hints = nullptr;
     s.via = pending.found.via;
+    s.staged = pending.found.staged;
     timed.time = {0.0, 0.0};
     timed.q = {path.front(), path.back()};
     stage.pending.push_back(std::move(pending));
@@ -274,13 +274,14 @@ std::string Run::step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& 
       }
     }
     s.via = motion.via;
+    s.staged = motion.staged;
   }
   s.name = name;
   s.arm = arm.spec.name;
   for (const double t : timed.time) s.time.push_back(clock + t);
   s.q = timed.q;
-  s.event =
-      start_event.empty() ? end_event : start_event + (end_event.empty() ? "" : "," + end_event);
+  s.start_event = start_event;
+  s.end_event = end_event;
   s.path_length = path_length(path);
   cell_.set_arm(stage.end.robot_q, arm, path.back());
   stage.paths.push_back(std::move(path));
@@ -370,7 +371,7 @@ std::string Run::recover(const Motion& frame, const MotionRequest& request,
     // A bridge, found at a large cost, is mended where it is blocked rather than searched for
     // again at that cost; a roadmap path is searched again, which is cheap and finds shorter
     // ways than mending.
-    if (motion.via.find("bridge") != std::string::npos) fine.rejected = &motion.path;
+    if (motion.via == MotionVia::kBridge) fine.rejected = &motion.path;
     MotionResult again = timed_plan(planner, fine);
     if (again.solved()) {
       motion = std::move(again);
@@ -463,6 +464,7 @@ bool Run::settle(std::span<const Stage* const> chain) {
       // Another path between the same ends (the found one, or a new plan).
       retime(*st, p.step, path, timed);
       s.via = p.found.via;
+      s.staged = p.found.staged;
     }
     abandon(*st);  // after a step it could not recover, the rest are not wanted either
   }
@@ -609,7 +611,9 @@ std::string Run::retreat(
   if (!away) return "release_retreat: no clear way back from the robot-human pose";
   release.start = rh_q;
   release.goal = *away;
-  if (auto e = step(st, planner, arm, release, "release_retreat", "gripper_open", ""); !e.empty()) {
+  if (auto e = step(st, planner, arm, release, "release_retreat", StepEvent::kGripperOpen,
+                    StepEvent::kNone);
+      !e.empty()) {
     return e;
   }
   release.start = *away;
@@ -639,7 +643,7 @@ std::string Run::retreat(
   // Only where the retreat attaches to no roadmap node: mostly the roadmap's way is shorter.
   release.follow_hints = false;
   // The board is the human's now; it no longer stands where the arm goes home.
-  return step(st, planner, arm, release, home_step, "", "");
+  return step(st, planner, arm, release, home_step, StepEvent::kNone, StepEvent::kNone);
 }
 
 }  // namespace hila::online::detail

@@ -98,7 +98,8 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
   to.start = up;
   to.goal = *over;
   to.filter = filter_for(arm, "gripper", grasp.id);
-  if (auto e = step(st, planner, arm, to, "set_down_transfer", "", ""); !e.empty()) {
+  if (auto e = step(st, planner, arm, to, "set_down_transfer", StepEvent::kNone, StepEvent::kNone);
+      !e.empty()) {
     st.failure = e;
     return st;
   }
@@ -106,7 +107,9 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
   down.start = *over;
   down.goal = *at;
   down.end_in_contact = true;  // the board meets the table at the last sample
-  if (auto e = step(st, planner, arm, down, "set_down_lower", "", "set_down"); !e.empty()) {
+  if (auto e =
+          step(st, planner, arm, down, "set_down_lower", StepEvent::kNone, StepEvent::kSetDown);
+      !e.empty()) {
     st.failure = e;
     return st;
   }
@@ -114,7 +117,8 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
   MotionRequest back = standing;
   back.start = *at;
   back.goal = *out;
-  if (auto e = step(st, planner, arm, back, "set_down_retreat", "", ""); !e.empty()) {
+  if (auto e = step(st, planner, arm, back, "set_down_retreat", StepEvent::kNone, StepEvent::kNone);
+      !e.empty()) {
     st.failure = e;
     return st;
   }
@@ -123,7 +127,9 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
     MotionRequest home = standing;
     home.start = *out;
     home.goal = arm.spec.home;
-    if (auto e = step(st, planner, arm, home, "set_down_arm_home", "", ""); !e.empty()) {
+    if (auto e =
+            step(st, planner, arm, home, "set_down_arm_home", StepEvent::kNone, StepEvent::kNone);
+        !e.empty()) {
       st.failure = e;
     }
   }
@@ -131,7 +137,7 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
 }
 
 const Stage& Run::tool_down_after_set_down(const db::TableRegraspRecord& regrasp,
-                                            const Stage& set) {
+                                           const Stage& set) {
   const auto found = relay_tool_downs_.find(regrasp.id);
   if (found != relay_tool_downs_.end()) return found->second;
   Stage& st = relay_tool_downs_[regrasp.id];

@@ -11,8 +11,7 @@ namespace hila::online::detail {
 std::string Run::suction_chain(const db::HandoverCandidateRecord& goal,
                                const db::SuctionDeliveryRecord& delivery,
                                std::vector<PlanStep>& steps, ArmsState& end) {
-  if (suction_grasps_.count(delivery.suction_grasp_id) == 0 ||
-      delivery.arm != suction_.spec.name) {
+  if (suction_grasps_.count(delivery.suction_grasp_id) == 0 || delivery.arm != suction_.spec.name) {
     return "the database's suction delivery refers to a missing record or another arm";
   }
   const Stage* stages[4] = {};
@@ -80,10 +79,9 @@ const Stage& Run::suction_present(const db::SuctionDeliveryRecord& delivery,
       const Eigen::VectorXd up = arm_q(attempt, suction_);
       // The build's branch first: its stored transfer's end, else the delivery's (for the
       // database's cup; a stand-in's TCP is turned).
-      const Eigen::VectorXd* preferred =
-          !stored.empty()                         ? &stored.front()->path.back()
-          : cup_id == delivery.suction_grasp_id ? &delivery.joints_rh
-                                                : nullptr;
+      const Eigen::VectorXd* preferred = !stored.empty() ? &stored.front()->path.back()
+                                         : cup_id == delivery.suction_grasp_id ? &delivery.joints_rh
+                                                                               : nullptr;
       const auto rh_q = first_valid(attempt, suction_planner_, carry,
                                     solutions(cell_, suction_, rh_tcp, up, preferred));
       if (!rh_q) {
@@ -93,8 +91,8 @@ const Stage& Run::suction_present(const db::SuctionDeliveryRecord& delivery,
         carry.goal = *rh_q;
         carry.filter = filter_for(suction_, "suction", cup_id);
         carry.hints = paths_of(stored);
-        e = step(attempt, suction_planner_, suction_, carry, "transfer_to_human", "",
-                 "wait_for_human");
+        e = step(attempt, suction_planner_, suction_, carry, "transfer_to_human", StepEvent::kNone,
+                 StepEvent::kWaitForHuman);
       }
       if (e.empty()) {
         st = std::move(attempt);

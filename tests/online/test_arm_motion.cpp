@@ -129,7 +129,8 @@ std::optional<CratedJoin> crate_on_the_join(online::ArmMotionPlanner& nominal_pl
   CratedJoin join{request(start, b), {}, online::nominal_scene(cell, cabinet())};
   join.request.allow_bridge = false;
   const auto before = nominal_planner.plan(join.request);
-  if (!before.solved() || before.via != "roadmap" || before.path.size() < 3) return std::nullopt;
+  if (!before.solved() || before.via != online::MotionVia::kRoadmap || before.path.size() < 3)
+    return std::nullopt;
   join.entry = before.path[1];
   const core::Pose middle =
       core::arm_base_in_world(cell, left) * left.chain.fk(0.5 * (start + join.entry));
@@ -152,7 +153,8 @@ std::optional<CratedPath> crate_on_a_roadmap_path() {
   online::ArmMotionPlanner planner(nominal_world, left_roadmap(), "left");
   for (const auto& pair : far_pairs(20)) {
     online::MotionResult before = planner.plan(request(pair.first, pair.second));
-    if (!before.solved() || before.via != "roadmap" || before.path.size() < 4) continue;
+    if (!before.solved() || before.via != online::MotionVia::kRoadmap || before.path.size() < 4)
+      continue;
     const core::Arm& left = cell.arm("left");
     const core::Pose tcp =
         core::arm_base_in_world(cell, left) * left.chain.fk(before.path[before.path.size() / 2]);
@@ -198,7 +200,7 @@ TEST(ArmMotion, SolvedMotionsPassTheIndependentValidator) {
     EXPECT_TRUE(result.path.back().isApprox(b, 0.0));
     const auto report =
         online::validate_motion(world, data, timed(result.path, cabinet().part("top").initial));
-    EXPECT_TRUE(report.valid()) << result.via << ": " << describe(report);
+    EXPECT_TRUE(report.valid()) << online::to_string(result.via) << ": " << describe(report);
   }
   EXPECT_GE(solved, 6) << "of 8 node pairs";
 }
@@ -214,7 +216,8 @@ TEST_F(ArmMotionCrated, AnObstacleOnTheStoredPathIsRepairedAround) {
   online::ArmMotionPlanner repaired(world, left_roadmap(), "left");
   const auto after = repaired.plan(request(a, b));
   ASSERT_TRUE(after.solved()) << after.reason;
-  EXPECT_TRUE(after.via == "bridge" || after.edges_invalidated > 0) << after.via;
+  EXPECT_TRUE(after.via == online::MotionVia::kBridge || after.edges_invalidated > 0)
+      << online::to_string(after.via);
   const auto report =
       online::validate_motion(world, data, timed(after.path, cabinet().part("top").initial));
   EXPECT_TRUE(report.valid()) << describe(report);
@@ -241,7 +244,7 @@ TEST_F(ArmMotionCrated, AStoredPathBlockedMidwayIsRepairedLocally) {
   ASSERT_FALSE(repairing.valid(stored[crate_at])) << "the crate must block the stored path";
   const auto repaired = repairing.plan(r);
   ASSERT_TRUE(repaired.solved()) << repaired.reason;
-  EXPECT_EQ(repaired.via, "stored+repair");
+  EXPECT_EQ(repaired.via, online::MotionVia::kStoredRepair);
   EXPECT_TRUE(repaired.path.front().isApprox(a, 0.0));
   EXPECT_TRUE(repaired.path.back().isApprox(b, 0.0));
   // Kept up to the blockage (shortcutting only drops waypoints between kept ones, and the
@@ -257,7 +260,7 @@ TEST_F(ArmMotionCrated, AStoredPathBlockedMidwayIsRepairedLocally) {
   online::ArmMotionPlanner plain(world, left_roadmap(), "left");  // repair_checks 0
   const auto without = plain.plan(r);
   EXPECT_FALSE(without.wedged);
-  EXPECT_NE(without.via, "stored+repair");
+  EXPECT_NE(without.via, online::MotionVia::kStoredRepair);
 
   // Ends that attach to no roadmap node (none is tried here): the default settings repair
   // (wedged_repair_checks), and the motion says it was wedged only when it fails.
@@ -266,12 +269,12 @@ TEST_F(ArmMotionCrated, AStoredPathBlockedMidwayIsRepairedLocally) {
   online::ArmMotionPlanner wedged(world, left_roadmap(), "left", unattached);
   const auto led = wedged.plan(r);
   ASSERT_TRUE(led.solved()) << led.reason;
-  EXPECT_EQ(led.via, "stored+repair");
+  EXPECT_EQ(led.via, online::MotionVia::kStoredRepair);
   unattached.wedged_repair_checks = 0;
   unattached.bridge_checks = 200;
   online::ArmMotionPlanner no_repair(world, left_roadmap(), "left", unattached);
   const auto stuck = no_repair.plan(r);
-  EXPECT_NE(stuck.via, "stored+repair");
+  EXPECT_NE(stuck.via, online::MotionVia::kStoredRepair);
   if (!stuck.solved()) {
     EXPECT_TRUE(stuck.wedged);
     EXPECT_NE(stuck.reason.find("attaches to no roadmap node"), std::string::npos) << stuck.reason;
@@ -301,7 +304,7 @@ TEST_F(ArmMotionCrated, AStoredPathTheSceneBlocksGivesWayToTheNextOne) {
     online::ArmMotionPlanner planner(world, left_roadmap(), "left");
     const auto found = planner.plan(r);
     ASSERT_TRUE(found.solved()) << found.reason;
-    EXPECT_EQ(found.via, "stored");
+    EXPECT_EQ(found.via, online::MotionVia::kStored);
     EXPECT_EQ(found.searches, 0) << "no roadmap search when a stored path holds";
     // The clear path's waypoints (shortcutting keeps a subset, in order, ends exact).
     EXPECT_TRUE(found.path.front().isApprox(a, 0.0));
@@ -318,7 +321,7 @@ TEST_F(ArmMotionCrated, AStoredPathTheSceneBlocksGivesWayToTheNextOne) {
   online::MotionRequest alone = request(a, b);
   alone.hints = {&stored};
   online::ArmMotionPlanner planner(world, left_roadmap(), "left");
-  EXPECT_NE(planner.plan(alone).via, "stored");
+  EXPECT_NE(planner.plan(alone).via, online::MotionVia::kStored);
 }
 
 // A path the validator rejected (the crate planted on it after it was found): given back as
@@ -338,7 +341,7 @@ TEST_F(ArmMotionCrated, ARejectedPathIsMendedWhereItIsBlocked) {
   online::ArmMotionPlanner planner(world, left_roadmap(), "left");
   const auto mended = planner.plan(r);
   ASSERT_TRUE(mended.solved()) << mended.reason;
-  EXPECT_EQ(mended.via, "repaired");
+  EXPECT_EQ(mended.via, online::MotionVia::kRepaired);
   EXPECT_TRUE(mended.path.front().isApprox(a, 0.0));
   EXPECT_TRUE(mended.path.back().isApprox(b, 0.0));
   const auto report =
@@ -349,7 +352,7 @@ TEST_F(ArmMotionCrated, ARejectedPathIsMendedWhereItIsBlocked) {
   no_mending.fine_repair_checks = 0;
   online::ArmMotionPlanner again(world, left_roadmap(), "left", no_mending);
   const auto replanned = again.plan(r);
-  EXPECT_NE(replanned.via, "repaired");
+  EXPECT_NE(replanned.via, online::MotionVia::kRepaired);
 }
 
 TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
@@ -372,7 +375,7 @@ TEST(ArmMotion, AGoalInsideAnObstacleAndAPastDeadlineAreStatusesWithReasons) {
   late.deadline = std::chrono::steady_clock::now() - std::chrono::seconds(1);
   const auto result = free_planner.plan(late);
   // Only a direct straight segment can beat a deadline that has passed.
-  if (result.via != "direct") {
+  if (result.via != online::MotionVia::kDirect) {
     EXPECT_EQ(result.status, online::MotionStatus::kTimeout) << result.reason;
     EXPECT_TRUE(result.path.empty());
   }
@@ -389,7 +392,8 @@ TEST_F(ArmMotionCrated, BlockedEdgesAreRememberedOnlyWhileTheSceneIsPosedTheSame
   online::ArmMotionPlanner planner(world, left_roadmap(), "left");
   const auto first = planner.plan(request(a, b));
   ASSERT_TRUE(first.solved()) << first.reason;
-  ASSERT_EQ(first.via, "roadmap") << "the crate should cut single edges, not the roadmap";
+  ASSERT_EQ(first.via, online::MotionVia::kRoadmap)
+      << "the crate should cut single edges, not the roadmap";
   ASSERT_GT(first.edges_invalidated, 0);
   const auto again = planner.plan(request(a, b));
   ASSERT_TRUE(again.solved());
@@ -456,7 +460,7 @@ TEST(ArmMotion, ABlockedJoinIntoTheRoadmapIsReplacedByOneThatHolds) {
     ASSERT_GE(result.path.size(), 3u);
     EXPECT_FALSE(result.path[1].isApprox(entry, 0.0)) << "entered through the blocked join";
     const auto report = validate_in(world, result.path);
-    EXPECT_TRUE(report.valid()) << result.via << ": " << describe(report);
+    EXPECT_TRUE(report.valid()) << online::to_string(result.via) << ": " << describe(report);
     return;
   }
   FAIL() << "no far pair with a blocked join that plans (" << tried << " tried)";
@@ -494,7 +498,7 @@ TEST(ArmMotion, CheckedJoinsKeepOnlyTheFirstThatHold) {
     ++compared;
     for (const auto* result : {&with_two, &with_six}) {
       const auto report = validate_in(world, result->path);
-      EXPECT_TRUE(report.valid()) << result->via << ": " << describe(report);
+      EXPECT_TRUE(report.valid()) << online::to_string(result->via) << ": " << describe(report);
     }
     checks_two += two_kept.checks();
     checks_six += six_kept.checks();
@@ -531,12 +535,13 @@ TEST(ArmMotion, AWedgedStartEntersTheRoadmapAlongAStoredPath) {
     online::MotionRequest r = request(a, b);
     r.allow_bridge = false;
     const auto alone = cut.plan(r);
-    EXPECT_FALSE(alone.solved()) << "the start attaches to no node of the roadmap: " << alone.via;
+    EXPECT_FALSE(alone.solved()) << "the start attaches to no node of the roadmap: "
+                                 << online::to_string(alone.via);
 
     r.hints = {&stored};
     const auto led = cut.plan(r);
     ASSERT_TRUE(led.solved()) << led.reason;
-    EXPECT_EQ(led.via, "stored+roadmap");
+    EXPECT_EQ(led.via, online::MotionVia::kStoredRoadmap);
     ASSERT_GE(led.path.size(), 3u);
     EXPECT_TRUE(led.path.front().isApprox(a, 0.0));
     // Through the stored path's end (its halfway point shortcut away).
@@ -606,13 +611,13 @@ TEST(ArmMotion, ACutRoadmapIsEnteredAlongAStoredPathBeforeABridge) {
     r.allow_bridge = false;
     r.follow_hints = false;  // the stored path only leads in, as for the way home
     const auto without = cut_planner.plan(r);
-    ASSERT_FALSE(without.solved()) << without.via;
+    ASSERT_FALSE(without.solved()) << online::to_string(without.via);
     EXPECT_NE(without.reason.find("does not connect"), std::string::npos) << without.reason;
 
     r.hints = {&stored};
     const auto led = cut_planner.plan(r);
     ASSERT_TRUE(led.solved()) << led.reason;
-    EXPECT_EQ(led.via, "stored+roadmap");
+    EXPECT_EQ(led.via, online::MotionVia::kStoredRoadmap);
     EXPECT_TRUE(led.path.front().isApprox(a, 0.0));
     EXPECT_TRUE(led.path.back().isApprox(b, 0.0));
     EXPECT_NE(std::find_if(led.path.begin(), led.path.end(),
@@ -678,7 +683,7 @@ TEST(ArmMotion, ABlockedNodeIsDroppedWithAllItsEdgesAtOnce) {
       EXPECT_LE(result.searches, 2) << "the blocked node's edges were dropped one search at a time";
       EXPECT_EQ(result.edges_invalidated, 7) << "every edge of the blocked node, each once";
       const auto report = validate_in(world, result.path);
-      EXPECT_TRUE(report.valid()) << result.via << ": " << describe(report);
+      EXPECT_TRUE(report.valid()) << online::to_string(result.via) << ": " << describe(report);
       return;
     }
   }
@@ -731,7 +736,7 @@ TEST(ArmMotion, EndsTheFilteredRoadmapDoesNotJoinAreNotSearchedAgain) {
     }
     if (!premises) continue;
     const auto once = planner.plan(r);
-    ASSERT_FALSE(once.solved()) << once.via;
+    ASSERT_FALSE(once.solved()) << online::to_string(once.via);
     ASSERT_GT(once.nodes_expanded, 0);
     const auto again = planner.plan(r);
     EXPECT_EQ(again.status, once.status);
@@ -865,7 +870,7 @@ TEST_F(ArmMotionCrated, AWedgedEndsBridgeIsFocusedAndCappedInTheFirstRound) {
   planner.set_wedged_bridge_checks(settings.bridge_checks);
   const auto lifted = planner.plan(request(a, b));
   ASSERT_TRUE(lifted.solved()) << lifted.reason;
-  EXPECT_EQ(lifted.via, "bridge");
+  EXPECT_EQ(lifted.via, online::MotionVia::kBridge);
   EXPECT_TRUE(lifted.path.front().isApprox(a, 0.0));
   EXPECT_TRUE(lifted.path.back().isApprox(b, 0.0));
   const auto report = validate_in(world, lifted.path);
@@ -954,7 +959,7 @@ TEST_F(ArmMotionCrated, AWedgedMotionTriesEveryStoredPathCheaplyFirst) {
 
   for (const auto* result : {&at_full, &at_cheap}) {
     ASSERT_TRUE(result->solved()) << result->reason;
-    EXPECT_EQ(result->via, "stored+repair");
+    EXPECT_EQ(result->via, online::MotionVia::kStoredRepair);
     EXPECT_TRUE(result->wedged);
     EXPECT_TRUE(result->path.front().isApprox(a, 0.0));
     EXPECT_TRUE(result->path.back().isApprox(b, 0.0));

@@ -74,7 +74,7 @@ void expect_plan_well_formed(const online::PlannerModel& model, const online::Sc
     EXPECT_GE(step.time.front(), clock - 1e-12) << step.name;
     clock = step.time.back();
     at[step.arm] = step.q.back();
-    if (!step.event.empty()) events += step.event + " ";
+    if (const std::string e = online::events_text(step); !e.empty()) events += e + " ";
     EXPECT_TRUE(step.validation.valid()) << step.name;
   }
   const std::vector<std::string> order =
@@ -191,14 +191,14 @@ void expect_same_steps(const online::BoardPlan& a, const online::BoardPlan& b) {
 // How the receiving arm went home after the release ("(none)" without such a step).
 std::string home_via(const online::BoardPlan& plan) {
   for (const auto& step : plan.steps) {
-    if (step.name == "receiving_arm_home") return step.via;
+    if (step.name == "receiving_arm_home") return online::via_text(step);
   }
   return "(none)";
 }
 
 bool bridged(const online::BoardPlan& plan) {
   return std::any_of(plan.steps.begin(), plan.steps.end(),
-                     [](const auto& step) { return step.via.find("bridge") == 0; });
+                     [](const auto& step) { return step.via == online::MotionVia::kBridge; });
 }
 
 void print_plan(const online::BoardPlan& plan) {
@@ -553,9 +553,10 @@ TEST_F(BoardPlanner, NothingIsPlannedForAGoalTheReceivingArmCannotReach) {
   EXPECT_EQ(late.status, checked.status);
   EXPECT_EQ(checked.motions_planned, 0);
   EXPECT_GT(late.motions_planned, 0);
-  std::printf("the unreachable goal alone: %d motions planned with the reach checked first, %d "
-              "with the exchange first\n",
-              checked.motions_planned, late.motions_planned);
+  std::printf(
+      "the unreachable goal alone: %d motions planned with the reach checked first, %d "
+      "with the exchange first\n",
+      checked.motions_planned, late.motions_planned);
 }
 
 // A validator stricter than the planner (a held board kept 2 deg inside theta_c) rejects

@@ -5,9 +5,8 @@
 
 #include <string>
 
-#include "hila/core/stage_scene.hpp"
-
 #include "hila/core/mesh.hpp"
+#include "hila/core/stage_scene.hpp"
 #include "hila/db/database.hpp"
 #include "hila/offline/build.hpp"
 #include "hila/online/board_planner.hpp"
@@ -77,7 +76,7 @@ void expect_direct_plan(const online::PlannerModel& model, const online::Scene& 
     clock = step.time.back();
     EXPECT_GT(step.validation.samples, 0) << step.name;
     EXPECT_TRUE(step.validation.valid()) << step.name;
-    if (!step.event.empty()) events += step.event + " ";
+    if (const std::string e = online::events_text(step); !e.empty()) events += e + " ";
   }
   EXPECT_EQ(events, first_events + "gripper_close wait_for_human gripper_open ");
   for (const auto& a : model.cell().arms()) {
@@ -87,7 +86,7 @@ void expect_direct_plan(const online::PlannerModel& model, const online::Scene& 
   const auto& grasp = model.board_records(plan.board)->robot_grasps.at(plan.robot_grasp_id);
   const core::Arm& picker = model.cell().arm(arm);
   for (const auto& step : plan.steps) {
-    if (step.event != "gripper_close") continue;
+    if (step.end_event != online::StepEvent::kGripperClose) continue;
     const core::Pose tcp =
         core::arm_base_in_world(model.cell(), picker) * picker.chain.fk(step.q.back());
     const core::Pose want = scene.initial_pose(model.product().part(plan.board)) * grasp.tcp;

@@ -85,7 +85,7 @@ TEST(RegraspWay, ABracketTheGripperCannotDeliverAsItLiesIsSetDownAndTakenAgain) 
     at = step.q.back();
     EXPECT_GT(step.validation.samples, 0) << step.name;
     EXPECT_TRUE(step.validation.valid()) << step.name;
-    if (!step.event.empty()) events += step.event + " ";
+    if (const std::string e = online::events_text(step); !e.empty()) events += e + " ";
   }
   EXPECT_EQ(events, "gripper_close set_down gripper_close wait_for_human gripper_open ");
   EXPECT_LT((at - arm.spec.home).norm(), 1e-9);
@@ -113,7 +113,8 @@ TEST(RegraspWay, ABracketTheGripperCannotDeliverAsItLiesIsSetDownAndTakenAgain) 
   const core::Pose base = core::arm_base_in_world(model->cell(), arm);
   std::vector<core::Pose> closes;
   for (const auto& step : plan.steps) {
-    if (step.event == "gripper_close") closes.push_back(base * arm.chain.fk(step.q.back()));
+    if (step.end_event == online::StepEvent::kGripperClose)
+      closes.push_back(base * arm.chain.fk(step.q.back()));
   }
   ASSERT_EQ(closes.size(), 2u);
   const core::Pose first = initial * grasps.at(plan.pick_grasp_id).tcp;
@@ -188,8 +189,9 @@ TEST(RegraspWay, ABracketOnlyTheOtherArmDeliversIsRelayedOnTheTable) {
     at[step.arm] = step.q.back();
     EXPECT_TRUE(step.validation.valid()) << step.name;
     EXPECT_GT(step.validation.samples, 0) << step.name;  // the validator's report is in
-    if (!step.event.empty()) events += step.arm + ":" + step.event + " ";
-    if (step.event == "gripper_close") {
+    if (const std::string e = online::events_text(step); !e.empty())
+      events += step.arm + ":" + e + " ";
+    if (step.end_event == online::StepEvent::kGripperClose) {
       const core::Arm& arm = cell.arm(step.arm);
       closes.emplace_back(step.arm,
                           core::arm_base_in_world(cell, arm) * arm.chain.fk(step.q.back()));

@@ -82,8 +82,7 @@ TEST(SuctionWay, APanelNoExchangeServesIsPresentedOnTheCupOfTheArmThatPickedIt) 
     for (const auto& d : records.suction_deliveries.at(goal.id)) {
       EXPECT_EQ(d.arm, "right");
       // The stored IK holds the cup where the suction grasp meets the panel at the goal (FK).
-      const core::Pose tcp =
-          core::arm_base_in_world(cell, right) * right.chain.fk(d.joints_rh);
+      const core::Pose tcp = core::arm_base_in_world(cell, right) * right.chain.fk(d.joints_rh);
       const core::Pose want = goal.board * records.suction_grasps.at(d.suction_grasp_id).cup;
       const core::Pose cup = tcp * cup_in_tcp;
       EXPECT_LT((cup.translation() - want.translation()).norm(), 1e-6);
@@ -116,11 +115,10 @@ TEST(SuctionWay, APanelNoExchangeServesIsPresentedOnTheCupOfTheArmThatPickedIt) 
     at = step.q.back();
     EXPECT_TRUE(step.validation.valid()) << step.name;
     EXPECT_GT(step.validation.samples, 0) << step.name;  // the validator's report is in
-    if (!step.event.empty()) events += step.event + " ";
-    if (step.event == "wait_for_human") {
-      const core::Pose board =
-          core::arm_base_in_world(cell, right) * right.chain.fk(step.q.back()) * cup_in_tcp *
-          cup.cup.inverse();
+    if (const std::string e = online::events_text(step); !e.empty()) events += e + " ";
+    if (step.end_event == online::StepEvent::kWaitForHuman) {
+      const core::Pose board = core::arm_base_in_world(cell, right) *
+                               right.chain.fk(step.q.back()) * cup_in_tcp * cup.cup.inverse();
       EXPECT_LT((board.translation() - plan.human_handover.translation()).norm(), 1e-6);
       EXPECT_TRUE(board.linear().isApprox(plan.human_handover.linear(), 1e-6));
     }

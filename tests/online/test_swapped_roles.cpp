@@ -64,7 +64,8 @@ std::string events_of(const online::BoardPlan& plan, Eigen::VectorXd& robot_q,
     EXPECT_TRUE(step.q.front().isApprox(cell.arm_joints(robot_q, arm), 1e-9)) << step.name;
     cell.set_arm(robot_q, arm, step.q.back());
     EXPECT_TRUE(step.validation.valid()) << step.name;
-    if (!step.event.empty()) events += step.arm + ":" + step.event + " ";
+    if (const std::string e = online::events_text(step); !e.empty())
+      events += step.arm + ":" + e + " ";
   }
   return events;
 }
@@ -208,10 +209,10 @@ TEST(SwappedRoles, TheRightArmCarriesTheToolToTheRelayWhereTheLeftArmTakesIt) {
            handle_in_tcp;
   };
   for (const auto& step : plan.steps) {
-    if (step.event == "tool_released" && step.arm == "right") {
+    if (step.end_event == online::StepEvent::kToolReleased && step.arm == "right") {
       EXPECT_TRUE(handle_after(step).isApprox(*plan.tool_place, 1e-6)) << step.name;
     }
-    if (step.event == "tool_grasped" && step.arm == "left") {
+    if (step.end_event == online::StepEvent::kToolGrasped && step.arm == "left") {
       EXPECT_TRUE(handle_after(step).isApprox(*plan.tool_place, 1e-6)) << step.name;
     }
   }

@@ -86,15 +86,35 @@ struct MotionRequest {
 enum class MotionStatus { kSolved, kInvalidStart, kInvalidGoal, kNoPath, kTimeout };
 const char* to_string(MotionStatus status);
 
+// How a motion was found: kDirect (the straight segment), kStored (an offline path
+// re-validated), kRoadmap, kStoredRoadmap (the roadmap entered or left along the part of a stored
+// path that holds), kStoredRepair (a stored path bridged around what blocks it), kBridge,
+// kRepaired (a rejected path mended where it was blocked, MotionRequest::rejected); the
+// baselines' kRrtConnect or kLazyPrm. kNone: not found.
+enum class MotionVia {
+  kNone,
+  kDirect,
+  kStored,
+  kRoadmap,
+  kStoredRoadmap,
+  kStoredRepair,
+  kBridge,
+  kRepaired,
+  kRrtConnect,
+  kLazyPrm
+};
+// "direct", "stored", "roadmap", "stored+roadmap", "stored+repair", "bridge", "repaired",
+// "rrt_connect", "lazy_prm"; "" for kNone.
+const char* to_string(MotionVia via);
+
 struct MotionResult {
   MotionStatus status = MotionStatus::kNoPath;
   std::string reason;                 // why not solved, naming what is in the way
   std::vector<Eigen::VectorXd> path;  // start ... goal, straight segments between waypoints
-  // "direct", "stored" (an offline path re-validated), "roadmap", "stored+roadmap" (the roadmap
-  // entered or left along the part of a stored path that holds), "stored+repair" (a stored path
-  // bridged around what blocks it), "bridge", "repaired" (a rejected path mended where it was
-  // blocked, MotionRequest::rejected); the baselines' "rrt_connect" or "lazy_prm"
-  std::string via;
+  MotionVia via = MotionVia::kNone;
+  // Found to a staging pose near the goal, the last segment straight from there (the board
+  // planner's stagings: a gripper's way in along its approach).
+  bool staged = false;
   // Set once the roadmap search is over: an end attached to no roadmap node, directly or along
   // a stored path (a failure then is a wedge, not a cut roadmap).
   bool wedged = false;

@@ -94,19 +94,47 @@ struct BoardPlanSettings {
   bool blocked_exchanges_last = true;
 };
 
-// One arm's timed motion within the plan, with what happens at its end.
+// What happens with a step (PlanStep::start_event, end_event): the suction cup takes the board
+// or lets go of it, the gripper closes on the board or opens, the tool is taken from the table or
+// set down on it, the board is set down on the table (a regrasp or a relay), or the robot holds
+// the board still for the human to take it.
+enum class StepEvent {
+  kNone,
+  kSuctionOn,
+  kSuctionOff,
+  kGripperClose,
+  kGripperOpen,
+  kToolGrasped,
+  kToolReleased,
+  kSetDown,
+  kWaitForHuman
+};
+// "suction_on", "suction_off", "gripper_close", "gripper_open", "tool_grasped",
+// "tool_released", "set_down", "wait_for_human"; "" for kNone.
+const char* to_string(StepEvent event);
+
+// One arm's timed motion within the plan, with what happens at its start and at its end.
 struct PlanStep {
   std::string name;  // e.g. "suction_pick", "transfer_to_robot_handover"
   std::string arm;
-  std::string via;           // how the motion was found (MotionResult::via)
-  std::vector<double> time;  // s from the start of the board's plan
+  MotionVia via = MotionVia::kNone;  // how the motion was found (MotionResult::via)
+  bool staged = false;               // through a staging pose (MotionResult::staged)
+  std::vector<double> time;          // s from the start of the board's plan
   std::vector<Eigen::VectorXd> q;
-  std::string event;  // at the end: "suction_on", "suction_off", "gripper_close", "gripper_open",
-                      // "tool_grasped" or ""
+  // As the step starts (the arm lets go, then moves away: kSuctionOff, kGripperOpen) and when it
+  // has arrived (every other event); kNone: nothing.
+  StepEvent start_event = StepEvent::kNone;
+  StepEvent end_event = StepEvent::kNone;
   double path_length = 0.0;  // rad, of the executed (smoothed) path
   bool smoothed = false;     // the found path was smoothed (else executed as found)
   ValidationReport validation;
 };
+
+// The step's events as the plan file writes them: "start,end", either alone, or "" for none.
+std::string events_text(const PlanStep& step);
+// How the step's motion was found as the plan file writes it: to_string(via), "+staging" after
+// it where it went through a staging pose.
+std::string via_text(const PlanStep& step);
 
 // How the board reaches the human. kExchange: the suction arm picks the board with the tool and
 // hands it to the other arm's gripper. kDirect: one arm's gripper picks it where it lies.
