@@ -3,10 +3,8 @@
 // one of them past its limit, fails it with the hand named.
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <string>
 
 #include "hila/offline/build.hpp"
@@ -24,16 +22,12 @@ namespace {
 class PlanCheck : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    // The tests' cabinet database (HILA_TEST_DATABASE, as tools/test builds it), else a quick one.
-    std::string out;
-    if (const char* given = std::getenv("HILA_TEST_DATABASE")) {
-      out = given;
-    } else {
-      // One folder per process: ctest runs each case in a process of its own, two at a time.
-      out = test::temp_dir("plan_check_" + std::to_string(::getpid())) + "/cabinet.hila";
-      offline::build_database(test::product_path(), test::cell_path(), out,
-                              test::quick_build_settings(7, 2));
-    }
+    // Else a quick build with maps dense enough for goals a stepped-aside human still takes.
+    offline::BuildSettings quick = test::quick_build_settings(7, 2);
+    quick.comfort.samples = 400000;
+    quick.handover.candidates = 200;
+    quick.handover.max_candidates = 400;
+    const std::string out = test::cabinet_database("plan_check", quick);
     model_ = online::PlannerModel::load(out, test::cell_path(), test::product_path());
     scene_ = online::load_scene(test::data_path("cabinet/scene.yaml"), model_->cell(),
                                 model_->product());

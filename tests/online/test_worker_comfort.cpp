@@ -1,5 +1,4 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -30,18 +29,11 @@ class WorkerComfortTest : public ::testing::Test {
     // A prebuilt cabinet database without a body set (HILA_TEST_DATABASE, as tools/test builds
     // it for the board planner's tests), else a quick build with maps dense enough that every
     // board has goals.
-    std::string out;
-    if (const char* given = std::getenv("HILA_TEST_DATABASE")) {
-      out = given;
-    } else {
-      // One folder per process: ctest runs each case in a process of its own, two at a time.
-      out = test::temp_dir("worker_comfort_" + std::to_string(::getpid())) + "/cabinet.hila";
-      offline::BuildSettings settings = test::quick_build_settings(7, 2);
-      settings.comfort.samples = 400000;
-      settings.handover.candidates = 200;
-      settings.handover.max_candidates = 400;
-      offline::build_database(test::product_path(), test::cell_path(), out, settings);
-    }
+    offline::BuildSettings settings = test::quick_build_settings(7, 2);
+    settings.comfort.samples = 400000;
+    settings.handover.candidates = 200;
+    settings.handover.max_candidates = 400;
+    const std::string out = test::cabinet_database("worker_comfort", settings);
     model_ = online::PlannerModel::load(out, test::cell_path(), test::product_path());
   }
   static void TearDownTestSuite() { model_.reset(); }

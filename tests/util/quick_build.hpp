@@ -1,8 +1,13 @@
 #pragma once
 
+#include <unistd.h>
+
 #include <cstdint>
+#include <cstdlib>
+#include <string>
 
 #include "hila/offline/build.hpp"
+#include "util/test_util.hpp"
 
 namespace hila::test {
 
@@ -24,6 +29,18 @@ inline offline::BuildSettings quick_build_settings(std::uint64_t seed = 7, int j
   s.ergonomics.flexion_step_deg = 15.0;
   s.roadmap.nodes = 300;
   return s;
+}
+
+// The cabinet database a test plans from: the one tools/test builds (HILA_TEST_DATABASE: the
+// default build with 1200 roadmap nodes), else the cabinet built with `settings` into a folder of
+// this process's own named after `name` (ctest runs each case in a process of its own, two at a
+// time).
+inline std::string cabinet_database(const std::string& name,
+                                    const offline::BuildSettings& settings) {
+  if (const char* given = std::getenv("HILA_TEST_DATABASE")) return given;
+  const std::string out = temp_dir(name + "_" + std::to_string(::getpid())) + "/cabinet.hila";
+  offline::build_database(product_path(), cell_path(), out, settings);
+  return out;
 }
 
 }  // namespace hila::test
