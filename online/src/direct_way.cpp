@@ -105,9 +105,7 @@ void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
   MotionRequest to = r;
   to.start = arm_q(st, suction_);
   to.goal = above.front();
-  if (auto e = step(st, suction_planner_, suction_, to, "tool_to_place", StepEvent::kNone,
-                    StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, to, "tool_to_place"); !e.empty()) {
     st.failure = e;
     return;
   }
@@ -126,9 +124,7 @@ void Run::put_tool_down(Stage& st, const core::Pose& board_world) {
   MotionRequest back = r;
   back.start = *at;
   back.goal = before.front();
-  if (auto e = step(st, suction_planner_, suction_, back, "tool_retreat", StepEvent::kNone,
-                    StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, back, "tool_retreat"); !e.empty()) {
     st.failure = e;
   }
 }
@@ -161,9 +157,7 @@ std::string Run::return_tool(const core::Pose& board_world, std::vector<PlanStep
       home.board_world = board_world;
       home.start = arm_q(st, suction_);
       home.goal = suction_.spec.home;
-      if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home_empty",
-                        StepEvent::kNone, StepEvent::kNone);
-          !e.empty()) {
+      if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home_empty"); !e.empty()) {
         st.failure = e;
       }
     }
@@ -232,8 +226,7 @@ void Run::take(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& gras
   MotionRequest r = standing;
   r.start = now;
   r.goal = *before;
-  if (auto e = step(st, planner, arm, r, again ? "regrasp_approach" : "gripper_approach",
-                    StepEvent::kNone, StepEvent::kNone);
+  if (auto e = step(st, planner, arm, r, again ? "regrasp_approach" : "gripper_approach");
       !e.empty()) {
     st.failure = e;
     return;
@@ -250,9 +243,7 @@ void Run::take(Stage& st, const core::Arm& arm, const db::RobotGraspRecord& gras
   carry.start = *at;
   carry.goal = *up;
   carry.start_in_contact = true;  // the board still rests where it was detected or set down
-  if (auto e = step(st, planner, arm, carry, again ? "regrasp_lift" : "lift", StepEvent::kNone,
-                    StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, planner, arm, carry, again ? "regrasp_lift" : "lift"); !e.empty()) {
     st.failure = e;
   }
 }

@@ -153,9 +153,7 @@ const Stage& Run::tool() {
   MotionRequest approach = r;
   approach.start = arm_q(st, suction_);
   approach.goal = *before;
-  if (auto e = step(st, suction_planner_, suction_, approach, "tool_approach", StepEvent::kNone,
-                    StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, approach, "tool_approach"); !e.empty()) {
     st.failure = e;
     return st;
   }
@@ -174,18 +172,14 @@ const Stage& Run::tool() {
   lift.start = *at;
   lift.goal = *raised;
   lift.start_in_contact = true;  // the cup still stands on the table
-  if (auto e = step(st, suction_planner_, suction_, lift, "tool_lift", StepEvent::kNone,
-                    StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, lift, "tool_lift"); !e.empty()) {
     st.failure = e;
     return st;
   }
   MotionRequest home = r;
   home.start = *raised;
   home.goal = suction_.spec.home;
-  if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home", StepEvent::kNone,
-                    StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, suction_planner_, suction_, home, "tool_to_home"); !e.empty()) {
     st.failure = e;
   }
   return st;
@@ -250,8 +244,7 @@ const Stage& Run::pick(std::int64_t cup_id) {
     r.goal = branch.before;
     // The stored transits end at the build's branch: they lead only to a branch near it.
     if (b == 0) r.hints = paths_of(transits);
-    std::string e = step(attempt, suction_planner_, suction_, r, "suction_approach",
-                         StepEvent::kNone, StepEvent::kNone);
+    std::string e = step(attempt, suction_planner_, suction_, r, "suction_approach");
     if (e.empty()) {
       r.hints.clear();
       r.start = branch.before;
@@ -264,7 +257,7 @@ const Stage& Run::pick(std::int64_t cup_id) {
       up.start = branch.at;
       up.goal = branch.up;
       up.start_in_contact = true;  // the board still rests where it was detected
-      e = step(attempt, suction_planner_, suction_, up, "lift", StepEvent::kNone, StepEvent::kNone);
+      e = step(attempt, suction_planner_, suction_, up, "lift");
     }
     if (e.empty()) {
       st = std::move(attempt);
@@ -384,8 +377,7 @@ std::string Run::transfer_steps(Stage& st, const db::RobotHandoverRecord& rr, st
   carry.goal = *rr_q;
   carry.filter = filter_for(suction_, "suction", cup.id);
   carry.hints = paths_of(stored);
-  return step(st, suction_planner_, suction_, carry, "transfer_to_robot_handover", StepEvent::kNone,
-              StepEvent::kNone);
+  return step(st, suction_planner_, suction_, carry, "transfer_to_robot_handover");
 }
 
 const Stage& Run::receive(const db::RobotHandoverRecord& rr, const db::RobotGraspRecord& grasp) {
@@ -482,9 +474,7 @@ std::string Run::preposition(Stage& st, const db::RobotHandoverRecord& rr,
   wait.board_world = up_tcp * on_cup(cup).board_in_tcp;
   wait.start = arm_q(st, receiving_);
   wait.goal = *pre_q;
-  if (auto e = step(st, receiving_planner_, receiving_, wait, "receiving_approach",
-                    StepEvent::kNone, StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, receiving_planner_, receiving_, wait, "receiving_approach"); !e.empty()) {
     return e;
   }
   if (auto e = transfer_steps(st, rr, cup_id); !e.empty()) return e;

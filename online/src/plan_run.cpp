@@ -643,7 +643,7 @@ std::string Run::retreat(
   // Only where the retreat attaches to no roadmap node: mostly the roadmap's way is shorter.
   release.follow_hints = false;
   // The board is the human's now; it no longer stands where the arm goes home.
-  return step(st, planner, arm, release, home_step, StepEvent::kNone, StepEvent::kNone);
+  return step(st, planner, arm, release, home_step);
 }
 
 }  // namespace hila::online::detail

@@ -344,8 +344,9 @@ class Run {
   // no roadmap node while a pose a few centimetres away does.
   // A failure that is the deadline's marks the stage (Stage::deadline_passed).
   std::string step(Stage& stage, ArmMotionPlanner& planner, const core::Arm& arm,
-                   MotionRequest request, const std::string& name, StepEvent start_event,
-                   StepEvent end_event, const std::vector<Eigen::VectorXd>& stagings = {});
+                   MotionRequest request, const std::string& name,
+                   StepEvent start_event = StepEvent::kNone, StepEvent end_event = StepEvent::kNone,
+                   const std::vector<Eigen::VectorXd>& stagings = {});
 
   // Whether a found path is smoothed: every one with more than one segment, unless its start
   // touches by design (a lift).

@@ -98,8 +98,7 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
   to.start = up;
   to.goal = *over;
   to.filter = filter_for(arm, "gripper", grasp.id);
-  if (auto e = step(st, planner, arm, to, "set_down_transfer", StepEvent::kNone, StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, planner, arm, to, "set_down_transfer"); !e.empty()) {
     st.failure = e;
     return st;
   }
@@ -117,8 +116,7 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
   MotionRequest back = standing;
   back.start = *at;
   back.goal = *out;
-  if (auto e = step(st, planner, arm, back, "set_down_retreat", StepEvent::kNone, StepEvent::kNone);
-      !e.empty()) {
+  if (auto e = step(st, planner, arm, back, "set_down_retreat"); !e.empty()) {
     st.failure = e;
     return st;
   }
@@ -127,9 +125,7 @@ const Stage& Run::set_down(const core::Arm& arm, const db::RobotGraspRecord& gra
     MotionRequest home = standing;
     home.start = *out;
     home.goal = arm.spec.home;
-    if (auto e =
-            step(st, planner, arm, home, "set_down_arm_home", StepEvent::kNone, StepEvent::kNone);
-        !e.empty()) {
+    if (auto e = step(st, planner, arm, home, "set_down_arm_home"); !e.empty()) {
       st.failure = e;
     }
   }
