@@ -28,15 +28,19 @@ Eigen::VectorXd random_configuration(const KinematicChain& chain, std::mt19937_6
 namespace {
 
 // One Levenberg-Marquardt step dq = J^T (J J^T + lambda I)^-1 e over the task's Rows rows, in
-// fixed-size matrices (no allocation in the IK loop); the columns of held joints are left out.
+// fixed-size matrices (no allocation in the IK loop); the columns of held joints are left out
+// (zeroed in a copy, `free_jac`, only when a joint is held).
 template <int Rows>
 void lm_step(const Jacobian& jac, const Eigen::Matrix<double, 6, 1>& e, double lambda,
              const std::vector<bool>& held, Jacobian& free_jac, Eigen::VectorXd& dq) {
-  free_jac = jac;
-  for (std::size_t i = 0; i < held.size(); ++i) {
-    if (held[i]) free_jac.col(static_cast<Eigen::Index>(i)).setZero();
+  const bool any_held = std::find(held.begin(), held.end(), true) != held.end();
+  if (any_held) {
+    free_jac = jac;
+    for (std::size_t i = 0; i < held.size(); ++i) {
+      if (held[i]) free_jac.col(static_cast<Eigen::Index>(i)).setZero();
+    }
   }
-  const auto j = free_jac.topRows<Rows>();
+  const auto j = (any_held ? free_jac : jac).topRows<Rows>();
   Eigen::Matrix<double, Rows, Rows> jjt = j * j.transpose();
   jjt.diagonal().array() += lambda;
   const Eigen::Matrix<double, Rows, 1> y = jjt.ldlt().solve(e.head<Rows>());
