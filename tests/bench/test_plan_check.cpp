@@ -22,12 +22,8 @@ namespace {
 class PlanCheck : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    // Else a quick build with maps dense enough for goals a stepped-aside human still takes.
-    offline::BuildSettings quick = test::quick_build_settings(7, 2);
-    quick.comfort.samples = 400000;
-    quick.handover.candidates = 200;
-    quick.handover.max_candidates = 400;
-    const std::string out = test::cabinet_database("plan_check", quick);
+    const std::string out =
+        test::cabinet_database("plan_check", test::dense_quick_build_settings());
     model_ = online::PlannerModel::load(out, test::cell_path(), test::product_path());
     scene_ = online::load_scene(test::data_path("cabinet/scene.yaml"), model_->cell(),
                                 model_->product());

@@ -29,11 +29,8 @@ class WorkerComfortTest : public ::testing::Test {
     // A prebuilt cabinet database without a body set (HILA_TEST_DATABASE, as tools/test builds
     // it for the board planner's tests), else a quick build with maps dense enough that every
     // board has goals.
-    offline::BuildSettings settings = test::quick_build_settings(7, 2);
-    settings.comfort.samples = 400000;
-    settings.handover.candidates = 200;
-    settings.handover.max_candidates = 400;
-    const std::string out = test::cabinet_database("worker_comfort", settings);
+    const std::string out =
+        test::cabinet_database("worker_comfort", test::dense_quick_build_settings());
     model_ = online::PlannerModel::load(out, test::cell_path(), test::product_path());
   }
   static void TearDownTestSuite() { model_.reset(); }

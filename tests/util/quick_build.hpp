@@ -31,6 +31,16 @@ inline offline::BuildSettings quick_build_settings(std::uint64_t seed = 7, int j
   return s;
 }
 
+// The quick build with comfort maps and goal candidates dense enough that every board has goals
+// a human standing a few centimetres off the cell's stance still takes.
+inline offline::BuildSettings dense_quick_build_settings(std::uint64_t seed = 7, int jobs = 2) {
+  offline::BuildSettings s = quick_build_settings(seed, jobs);
+  s.comfort.samples = 400000;
+  s.handover.candidates = 200;
+  s.handover.max_candidates = 400;
+  return s;
+}
+
 // The cabinet database a test plans from: the one tools/test builds (HILA_TEST_DATABASE: the
 // default build with 1200 roadmap nodes), else the cabinet built with `settings` into a folder of
 // this process's own named after `name` (ctest runs each case in a process of its own, two at a
