@@ -1,9 +1,11 @@
 #include "hila/offline/ergonomics.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
 #include "hila/core/comfort.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/core/mesh_symmetry.hpp"
 #include "hila/core/robot_model.hpp"
 #include "hila/offline/handover.hpp"
@@ -139,6 +141,72 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
   const core::Pose hand_world = board * human_grasps[static_cast<std::size_t>(posture.grasp)].hand;
   posture.reach = (hand_world.translation() - shoulder).norm();
   return posture;
+}
+
+Turn turn_in_hands(const core::Cell& cell, const HumanComfort& comfort, const core::Pose& stance,
+                   const core::Pose& from, const Eigen::Matrix3d& target,
+                   const std::vector<Eigen::Matrix3d>& symmetries, const Eigen::Vector3d& com,
+                   const std::vector<db::HumanGraspRecord>& human_grasps,
+                   const std::vector<int>& grasps, const ErgonomicsSettings& settings,
+                   const TurnSettings& turn, const core::HumanBody* body) {
+  // The fitted orientation nearest the taken one: the part turned by a symmetry R is the same
+  // part, so target R^T serves as well as target.
+  Eigen::Matrix3d goal = target;
+  double least = Eigen::AngleAxisd(from.linear().transpose() * target).angle();
+  for (const Eigen::Matrix3d& r : symmetries) {
+    const Eigen::Matrix3d candidate = target * r.transpose();
+    const double angle = Eigen::AngleAxisd(from.linear().transpose() * candidate).angle();
+    if (angle < least - 1e-12) {
+      least = angle;
+      goal = candidate;
+    }
+  }
+  Turn best;
+  best.turned_deg = core::rad_to_deg(least);
+  if (best.turned_deg < 1e-6) return best;
+  const int steps =
+      std::max(1, static_cast<int>(std::ceil(best.turned_deg / turn.step_deg - 1e-9)));
+  const Eigen::Quaterniond q0(from.linear()), q1(goal);
+  const core::HeightBand band = core::natural_height_band(cell, body, stance);
+  const Eigen::Vector3d forward = stance.linear().col(0);
+  bool chosen = false;
+  int best_unreachable = 0;
+  for (const double fraction : turn.band_fractions) {
+    for (const double distance : turn.distances) {
+      Turn t;
+      t.turned_deg = best.turned_deg;
+      t.point = stance.translation() + distance * forward;
+      t.point.z() = band.hip_z + fraction * (band.shoulder_z - band.hip_z);
+      int unreachable = 0;
+      for (int k = 0; k <= steps; ++k) {
+        core::Pose board = core::Pose::Identity();
+        board.linear() = q0.slerp(static_cast<double>(k) / steps, q1).toRotationMatrix();
+        board.translation() = t.point - board.linear() * com;
+        const Posture p = receiving_posture(cell, comfort, stance, board, human_grasps, grasps, -1,
+                                            settings, body);
+        if (!p.reachable) {
+          ++unreachable;
+        } else {
+          t.elevated_steps += p.shoulder_elevated ? 1 : 0;
+          t.max_flexion_deg = std::max(t.max_flexion_deg, p.torso_flexion_deg);
+        }
+        t.boards.push_back(board);
+        t.postures.push_back(p);
+      }
+      t.reachable = unreachable == 0;
+      const bool better =
+          !chosen || unreachable < best_unreachable ||
+          (unreachable == best_unreachable && (t.elevated_steps < best.elevated_steps ||
+                                               (t.elevated_steps == best.elevated_steps &&
+                                                t.max_flexion_deg < best.max_flexion_deg - 1e-9)));
+      if (better) {
+        best = std::move(t);
+        best_unreachable = unreachable;
+        chosen = true;
+      }
+    }
+  }
+  return best;
 }
 
 std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,

@@ -6,6 +6,7 @@
 
 #include "hila/core/human_body.hpp"
 #include "hila/core/mesh_symmetry.hpp"
+#include "hila/core/pose.hpp"
 #include "hila/core/product.hpp"
 #include "hila/offline/ergonomics.hpp"
 #include "hila/offline/handover.hpp"
@@ -265,4 +266,102 @@ TEST(Ergonomics, EachBodyTakesTheBoardWithItsOwnArms) {
     EXPECT_EQ(same_records[k].torso_flexion_deg, cell_records[k].torso_flexion_deg);
     EXPECT_EQ(same_records[k].quality, cell_records[k].quality);
   }
+}
+
+// The turn to the fitted orientation (turn_in_hands): a board taken as fitted, or turned by a
+// symmetry of the part, has nothing to turn; one taken a quarter turn off is turned about its
+// centre of mass, held at the turning point, in steps no larger than step_deg from the taken
+// orientation to the fitted one, the angle the same as least_rotation_angle_deg's.
+TEST(Ergonomics, TurnRunsFromTheTakenToTheFittedOrientationAboutTheCentre) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  const auto symmetries = core::mesh_symmetries(b.spec.mesh);
+  const core::Pose stance = cell->spec().human_stance;
+  const Eigen::Vector3d com = b.analysis.mass_properties.com;
+  const offline::ErgonomicsSettings settings;
+  offline::TurnSettings turn;
+  turn.band_fractions = {0.5};
+  turn.distances = {0.35};
+  const Eigen::Matrix3d target = b.spec.target.linear();
+  core::Pose as_fitted = b.spec.target;
+  const offline::Turn none =
+      offline::turn_in_hands(*cell, comfort(), stance, as_fitted, target, symmetries, com, b.grasps,
+                             b.one_hand, settings, turn);
+  EXPECT_NEAR(none.turned_deg, 0.0, 1e-9);
+  EXPECT_TRUE(none.postures.empty());
+  core::Pose half_turned = as_fitted;
+  half_turned.linear() = target * symmetries.back();  // the same part
+  EXPECT_TRUE(offline::turn_in_hands(*cell, comfort(), stance, half_turned, target, symmetries, com,
+                                     b.grasps, b.one_hand, settings, turn)
+                  .postures.empty());
+
+  core::Pose quarter = as_fitted;
+  quarter.linear() = Eigen::AngleAxisd(0.5 * M_PI, Eigen::Vector3d::UnitY()) * target;
+  const offline::Turn t =
+      offline::turn_in_hands(*cell, comfort(), stance, quarter, target, symmetries, com, b.grasps,
+                             b.one_hand, settings, turn);
+  EXPECT_NEAR(t.turned_deg, core::least_rotation_angle_deg(quarter.linear(), target, symmetries),
+              1e-9);
+  EXPECT_NEAR(t.turned_deg, 90.0, 1e-6);
+  ASSERT_EQ(t.boards.size(), 7u);  // 90 degrees in 15-degree steps, both ends
+  ASSERT_EQ(t.postures.size(), t.boards.size());
+  const core::HeightBand band = core::natural_height_band(*cell, nullptr, stance);
+  EXPECT_NEAR(t.point.z(), 0.5 * (band.hip_z + band.shoulder_z), 1e-12);
+  EXPECT_NEAR((t.point - stance.translation()).head<2>().norm(), 0.35, 1e-12);
+  EXPECT_LT(core::rotation_distance(t.boards.front().linear(), quarter.linear()), 1e-9);
+  EXPECT_LT(core::least_rotation_angle_deg(t.boards.back().linear(), target, symmetries), 1e-6);
+  for (std::size_t k = 0; k < t.boards.size(); ++k) {
+    EXPECT_LT((t.boards[k] * com - t.point).norm(), 1e-9);
+    if (k > 0) {
+      EXPECT_LE(
+          core::rad_to_deg(core::rotation_distance(t.boards[k - 1].linear(), t.boards[k].linear())),
+          turn.step_deg + 1e-6);
+    }
+  }
+}
+
+// The elbow-up steps of a turn are those whose posture raises an elbow to the shoulder, recomputed
+// here by the human model's FK from the returned configurations; a turning point above the
+// worker's shoulder raises it where one in the lower band does not.
+TEST(Ergonomics, TurnCountsTheStepsWithTheElbowAtOrAboveTheShoulder) {
+  const auto cell = test::reference_cell();
+  const Board b = shelf_board();
+  const auto symmetries = core::mesh_symmetries(b.spec.mesh);
+  const core::Pose stance = cell->spec().human_stance;
+  const Eigen::Matrix3d target = b.spec.target.linear();
+  core::Pose taken = b.spec.target;
+  taken.linear() = Eigen::AngleAxisd(0.5 * M_PI, Eigen::Vector3d::UnitX()) * target;
+  const core::RobotModel& human = cell->human();
+  auto elbow_up_by_fk = [&](const offline::Posture& p) {
+    std::vector<core::Pose> links;
+    human.link_poses(p.q, links);
+    const auto& names = cell->human_arms()[static_cast<std::size_t>(p.arm)].chain.joint_names();
+    auto z_of = [&](const std::string& joint) {
+      const auto& j = human.joints()[static_cast<std::size_t>(human.joint_index(joint))];
+      return (p.stance * links[static_cast<std::size_t>(j.child_link)]).translation().z();
+    };
+    std::string elbow;
+    for (const auto& n : names) {
+      if (n.find("elbow") != std::string::npos) elbow = n;
+    }
+    return z_of(elbow) >= z_of(names.front());
+  };
+  std::map<double, int> elevated;
+  for (const double fraction : {0.3, 1.5}) {
+    offline::TurnSettings turn;
+    turn.band_fractions = {fraction};
+    turn.distances = {0.30};
+    const offline::Turn t = offline::turn_in_hands(
+        *cell, comfort(), stance, taken, target, symmetries, b.analysis.mass_properties.com,
+        b.grasps, b.one_hand, offline::ErgonomicsSettings{}, turn);
+    ASSERT_FALSE(t.postures.empty());
+    int by_fk = 0;
+    for (const offline::Posture& p : t.postures) {
+      if (p.reachable) by_fk += elbow_up_by_fk(p) ? 1 : 0;
+    }
+    EXPECT_EQ(t.elevated_steps, by_fk) << "band fraction " << fraction;
+    elevated[fraction] = t.elevated_steps;
+  }
+  EXPECT_EQ(elevated[0.3], 0);
+  EXPECT_GT(elevated[1.5], 0);
 }

@@ -212,6 +212,15 @@ TEST_F(ReportErgonomics, TableAndAloneAreEachBodysOwnPostures) {
                                   : centre < m["hip_z"].get<double>()    ? "below the hip"
                                                                          : "in band";
         EXPECT_EQ(m["centre"], where);
+        // The turn left to the fitted orientation is the re-orientation left, in 15-degree steps
+        // with both ends; shoulder work is an elbow up at the take or in the turn.
+        const auto& turn = m["turn"];
+        const double turned = turn["turned_deg"].get<double>();
+        EXPECT_NEAR(turned, m["reorientation_deg"].get<double>(), 1e-6);
+        EXPECT_EQ(turn["steps"].get<int>(),
+                  turned < 1e-6 ? 0 : static_cast<int>(std::ceil(turned / 15.0 - 1e-9)) + 1);
+        EXPECT_EQ(m["shoulder_work"].get<bool>(),
+                  !m["elbow_below_shoulder"].get<bool>() || turn["elbow_up_steps"].get<int>() > 0);
         ++checked;
         if (std::string(method) != "table") continue;
         // At the table the worker stands at the scene's stance.
@@ -296,6 +305,11 @@ TEST_F(ReportErgonomics, WithoutWorkersTheCellsHuman) {
     for (const auto& [score, n] : s["rula_grand"].items()) by_score += n.get<int>();
     EXPECT_EQ(s["scored"].get<int>(), scored);
     EXPECT_EQ(by_score, scored);
+    int shoulder = 0;
+    for (const auto& b : w["boards"]) {
+      shoulder += b[method].value("shoulder_work", false) ? 1 : 0;
+    }
+    EXPECT_EQ(s["shoulder_work"].get<int>(), shoulder);
     EXPECT_EQ(s["boards"].get<int>(), static_cast<int>(w["boards"].size()));
     EXPECT_EQ(j["all_workers"][method], s);  // one worker: the all-workers totals are its own
   }

@@ -77,6 +77,15 @@ std::string centre_band(const online::PostureCheck& c) {
   return "in band";
 }
 
+// The elbow at or above the shoulder taking the board or turning it to its fitted orientation
+// (EAWS shoulder work), for a scored posture.
+bool elbow_up_turning(const TakenPosture& t) {
+  return t.turn && t.turn->elevated_steps > 0;
+}
+bool does_shoulder_work(const TakenPosture& t) {
+  return t.scored && (!t.ergonomics.check.elbow_below_shoulder || elbow_up_turning(t));
+}
+
 nlohmann::json taken_json(const TakenPosture& t, bool planned) {
   nlohmann::json m = {{"status", t.status}, {"scored", t.scored}};
   if (planned && t.status == "solved") {
@@ -113,6 +122,16 @@ nlohmann::json taken_json(const TakenPosture& t, bool planned) {
             {"two_hands", s.two_hands},
             {"load_kg", s.load_kg},
             {"ergonomics", receiving_ergonomics_json(t.ergonomics)}});
+  if (t.turn) {
+    const offline::Turn& turn = *t.turn;
+    m["turn"] = {{"turned_deg", turn.turned_deg},
+                 {"steps", turn.postures.size()},
+                 {"reachable", turn.reachable},
+                 {"elbow_up_steps", turn.elevated_steps},
+                 {"max_torso_flexion_deg", turn.max_flexion_deg},
+                 {"point", {turn.point.x(), turn.point.y(), turn.point.z()}}};
+  }
+  m["shoulder_work"] = does_shoulder_work(t);
   return m;
 }
 
@@ -121,7 +140,9 @@ struct Totals {
   int boards = 0;
   int scored = 0;
   int bent = 0;
-  int elbow_up = 0;  // an elbow at or above its shoulder
+  int elbow_up = 0;       // an elbow at or above its shoulder at the take
+  int turn_elbow_up = 0;  // ... while turning the board to its fitted orientation
+  int shoulder_work = 0;  // either
   int in_band = 0;
   int upright = 0;
   int natural = 0;
@@ -143,6 +164,8 @@ struct Totals {
     ++scored;
     bent += t.torso_flexion_deg >= kBentForwardDeg ? 1 : 0;
     elbow_up += c.elbow_below_shoulder ? 0 : 1;
+    turn_elbow_up += elbow_up_turning(t) ? 1 : 0;
+    shoulder_work += does_shoulder_work(t) ? 1 : 0;
     in_band += c.part_centre_z >= c.hip_z && c.part_centre_z <= c.shoulder_z ? 1 : 0;
     upright += c.upright() ? 1 : 0;
     natural += c.natural(kAcceptableRula) ? 1 : 0;
@@ -167,6 +190,8 @@ struct Totals {
             {"scored", scored},
             {"bent_forward", bent},
             {"elbow_at_or_above_shoulder", elbow_up},
+            {"elbow_up_turning", turn_elbow_up},
+            {"shoulder_work", shoulder_work},
             {"centre_in_band", in_band},
             {"upright", upright},
             {"natural", natural},
@@ -210,7 +235,7 @@ nlohmann::json verdict(const WorkerPostures& w, const std::string& baseline) {
   }
   return {{"boards", a.scored},
           {"bent_forward", fewer(a.bent, b.bent, "eliminated")},
-          {"shoulder_work", fewer(a.elbow_up, b.elbow_up, "eliminated")},
+          {"shoulder_work", fewer(a.shoulder_work, b.shoulder_work, "eliminated")},
           {"upright", a.upright > b.upright   ? "more"
                       : a.upright < b.upright ? "fewer"
                                               : "the same"},
@@ -271,7 +296,16 @@ std::string cell_text(const nlohmann::json& m) {
     << "/" << std::setprecision(2) << m["reach"].get<double>() << "/" << std::setprecision(0)
     << m["reorientation_deg"].get<double>() << "/" << std::setprecision(3)
     << m["quality"].get<double>() << "/" << m["rula_grand"].get<int>() << "/"
-    << m["reba"].get<int>();
+    << m["reba"].get<int>() << "/";
+  if (!m.contains("turn")) {
+    s << "--";
+  } else if (!m["turn"]["reachable"].get<bool>()) {
+    s << "unreachable";
+  } else {
+    s << (m["turn"]["steps"].get<std::size_t>() == 0   ? "--"
+          : m["turn"]["elbow_up_steps"].get<int>() > 0 ? "up"
+                                                       : "ok");
+  }
   return s.str();
 }
 
@@ -316,7 +350,9 @@ void print_worker(const nlohmann::json& w) {
   };
   std::cout << "  bent forward (>= " << std::setprecision(0) << kBentForwardDeg
             << " deg): " << counts("bent_forward") << "; upright: " << counts("upright")
-            << "; RULA <= " << kAcceptableRula << ": " << counts("rula_acceptable") << "\n";
+            << "; RULA <= " << kAcceptableRula << ": " << counts("rula_acceptable")
+            << "; shoulder work (elbow at or above the shoulder taking or turning it): "
+            << counts("shoulder_work") << "\n";
   for (const char* method : kErgonomicsMethods) {
     const auto& m = s[method];
     std::cout << "  " << std::left << std::setw(6) << method << std::right
@@ -346,7 +382,9 @@ void print_report(const nlohmann::json& j) {
                "(c) the worker alone from the stack\n"
             << "  per method: torso flexion deg / elbow at or above the shoulder (up) / part "
                "centre in the hip-shoulder band (in, high, low) / reach m / re-orientation left "
-               "deg / comfort Q / RULA grand / REBA\n";
+               "deg / comfort Q / RULA grand / REBA / turning it to its fitted orientation in "
+               "front of the "
+               "worker (ok, up: an elbow at or above the shoulder, --: nothing to turn)\n";
   for (const auto& w : j["workers"]) print_worker(w);
   const auto& all = j["all_workers"];
   std::cout << "all workers (" << j["workers"].size() << "):";

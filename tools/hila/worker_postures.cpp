@@ -151,6 +151,7 @@ WorkerPostures worker_postures(const ErgonomicsContext& context, const ReportWor
   out.band = core::natural_height_band(cell, worker.body.get(), scene.human_stance);
   const std::vector<std::string> boards = boards_to_plan(model, scene);
   std::map<std::string, TakenPosture> planned;
+  std::map<std::string, core::Pose> handed_over;  // the board where hila's plan hands it over
   // A planner of its own, as one `hila plan --all` run for this worker's scene.
   online::BoardPlanner planner(model);
   plan_in_sequence(
@@ -162,6 +163,7 @@ WorkerPostures worker_postures(const ErgonomicsContext& context, const ReportWor
             cell, plan, part.mass, planned_in.human_stance,
             records != nullptr ? records->part.mass_properties.com : Eigen::Vector3d::Zero(),
             planned_in.assembly_frame * part.target, context.symmetries.at(part.name));
+        handed_over[plan.board] = plan.human_handover;
       });
   // The offline search on the worker's body (nullptr for the cell's human: its own model).
   const core::HumanBody* body =
@@ -209,6 +211,28 @@ WorkerPostures worker_postures(const ErgonomicsContext& context, const ReportWor
     for (std::size_t k = 0; k < records.size(); ++k) {
       row.by_method[records[k].method] = searched_posture(
           cell, body, postures[k], records[k], part.mass, two_hands, record.mass_properties.com);
+    }
+    // Each scored take is followed by the turn to the fitted orientation, in front of the worker
+    // at the scene's stance, with the grasps the table and alone postures use.
+    std::vector<int> usable;
+    for (std::size_t g = 0; g < grasps.size(); ++g) {
+      if (!two_hands && grasps[g].one_hand_stable) usable.push_back(static_cast<int>(g));
+      if (two_hands) usable.push_back(static_cast<int>(g));
+    }
+    for (std::size_t k = 0; k < records.size(); ++k) {
+      TakenPosture& t = row.by_method[records[k].method];
+      if (t.scored) {
+        t.turn =
+            offline::turn_in_hands(cell, *context.comfort, scene.human_stance, postures[k].board,
+                                   in.target.linear(), in.symmetries, record.mass_properties.com,
+                                   grasps, usable, settings, offline::TurnSettings{}, body);
+      }
+    }
+    if (TakenPosture& t = row.by_method["hila"]; t.scored) {
+      t.turn =
+          offline::turn_in_hands(cell, *context.comfort, scene.human_stance, handed_over.at(name),
+                                 in.target.linear(), in.symmetries, record.mass_properties.com,
+                                 grasps, usable, settings, offline::TurnSettings{}, body);
     }
     out.boards.push_back(std::move(row));
   }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hila/core/human_body.hpp"
+#include "hila/offline/ergonomics.hpp"
 #include "hila/offline/human_comfort.hpp"
 #include "hila/online/planner_model.hpp"
 #include "hila/online/scene.hpp"
@@ -43,6 +44,9 @@ struct TakenPosture {
   double reorientation_deg = 0.0;  // left to the target, modulo the part's symmetries
   double quality = 0.0;            // Q (paper Eq. 4) of the arm at the posture; the weaker hand's
   ReceivingErgonomics ergonomics;  // RULA, REBA, where the posture puts the worker
+  // The re-orientation left, turned in the worker's hands at the scene's stance
+  // (offline::turn_in_hands, from the board as taken): set for a scored posture.
+  std::optional<offline::Turn> turn;
   // hila only: the goal planned, the way and whether the planner took it as a natural posture.
   int goal_rank = -1;
   std::int64_t candidate = 0;

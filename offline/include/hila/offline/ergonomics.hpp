@@ -89,6 +89,44 @@ std::vector<db::ErgonomicsRecord> evaluate_ergonomics(const core::Cell& cell,
                                                       const ErgonomicsSettings& settings,
                                                       std::vector<Posture>* postures = nullptr);
 
+// The re-orientation left, done in the worker's hands: the board turned from where it was taken
+// to its fitted orientation about its centre of mass, held at a turning point in front of the
+// worker. What EAWS counts as shoulder work (the paper's Table 2: "the robot hands over the board
+// in an already flipped pose") happens here as well as at the take.
+struct TurnSettings {
+  double step_deg = 15.0;  // the turn is checked at most this far apart (and at both ends)
+  // Turning points: the centre of mass at each fraction of the worker's hip-to-shoulder band
+  // (natural_height_band, 0 the hip, 1 the shoulder) and each distance (m) in front of the stance
+  // (its x axis). The turn is scored at the point that suits the worker best.
+  std::vector<double> band_fractions = {0.4, 0.7};
+  std::vector<double> distances = {0.30, 0.40};
+};
+
+struct Turn {
+  double turned_deg = 0.0;  // the rotation, modulo the part's symmetries; 0: nothing to turn
+  bool reachable = true;    // a grasp reachable at every step (torso bent up to its limit)
+  int elevated_steps = 0;   // steps with the elbow at or above the shoulder
+  double max_flexion_deg = 0.0;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  // the turning point chosen (world)
+  // The board (world) and the worker's posture at each step, from the taken orientation (first)
+  // to the fitted one (last); empty with nothing to turn.
+  std::vector<core::Pose> boards;
+  std::vector<Posture> postures;
+};
+
+// The turn from `from` (the board as taken, world) to `target` (world orientation; the nearest of
+// its symmetric equivalents, `symmetries` in the part frame) with the centre of mass `com` (part
+// frame) at each turning point; at each step the best posture receiving_posture finds with
+// `grasps` (indices into human_grasps). The chosen point: the fewest steps unreachable, then the
+// fewest with the elbow up, then the least torso flexion, then the first. The board's clearance
+// from the worker's body is not checked.
+Turn turn_in_hands(const core::Cell& cell, const HumanComfort& comfort, const core::Pose& stance,
+                   const core::Pose& from, const Eigen::Matrix3d& target,
+                   const std::vector<Eigen::Matrix3d>& symmetries, const Eigen::Vector3d& com,
+                   const std::vector<db::HumanGraspRecord>& human_grasps,
+                   const std::vector<int>& grasps, const ErgonomicsSettings& settings,
+                   const TurnSettings& turn, const core::HumanBody* body = nullptr);
+
 // The world pose of a board laid on the table at the spot with `placement` (part in plane).
 core::Pose table_drop_pose(const core::Cell& cell, const core::Pose& placement,
                            const ErgonomicsSettings& settings);
