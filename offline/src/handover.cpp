@@ -375,6 +375,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     band_rng.push_back(stream(2 * static_cast<std::uint64_t>(w) + 2));
   }
   const double max_rotation = core::deg_to_rad(settings.max_rotation_deg);
+  const double natural_max_rotation = core::deg_to_rad(settings.natural_max_rotation_deg);
   std::vector<HumanChoice> choices;
   double best_q = 0.0;
   // S's threshold: comfort_threshold, lowered towards comfort_floor for a part with no goal.
@@ -386,8 +387,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     pose.translation() = target.translation() + random_in_ball(settings.max_offset, from);
     return pose;
   };
-  // A natural band's: the orientation and the horizontal position of the part's centre as
-  // Eq. 1's (within max_rotation and max_offset of the target's), its height within the band
+  // A natural band's: the orientation within natural_max_rotation_deg and the horizontal position
+  // of the part's centre within max_offset of the target's, its height within the band
   // (kept kBandMargin inside its ends): the target lowered or raised to where the worker holds
   // it in front of the chest.
   const Eigen::Vector3d target_centre = target * grasps.com;
@@ -396,7 +397,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     return [&, band, w](std::mt19937_64& /*worker's*/) {
       std::mt19937_64& from = band_rng[static_cast<std::size_t>(w)];
       core::Pose pose = core::Pose::Identity();
-      pose.linear() = target.linear() * random_rotation_within(max_rotation, from);
+      pose.linear() = target.linear() * random_rotation_within(natural_max_rotation, from);
       Eigen::Vector3d centre = target_centre + random_in_ball(settings.max_offset, from);
       centre.z() = band.hip_z + kBandMargin +
                    uniform01(from) * std::max(0.0, band.shoulder_z - band.hip_z - 2 * kBandMargin);

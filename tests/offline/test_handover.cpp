@@ -600,3 +600,38 @@ TEST(Handover, AWorkerSetBuildsGoalsForEachBodyAndRecordsWhoTakesThem) {
   }
   EXPECT_GT(goals_for[0], hers_alone);
 }
+
+// natural_max_rotation_deg widens the band candidates' orientation alone: at 90 degrees the top's
+// band candidates (sample >= candidates) all lie within 90 degrees of the target's orientation and
+// some beyond 45, while Eq. 1's stay within 45; at the default every candidate is within 45.
+TEST(Handover, TheNaturalBandsOrientationLimitIsItsOwn) {
+  const auto cell = test::reference_cell();
+  std::size_t index = 0;
+  while (product().parts[index].name != "top") ++index;
+  const auto& part = product().parts[index];
+  const auto grasps = board_grasps(index);
+  const core::Pose target = product().target_in_world(part);
+  offline::HandoverSettings settings;
+  settings.natural_max_rotation_deg = 90.0;
+  const auto wide =
+      offline::plan_handover_goals(*cell, product(), index, grasps, comfort(), settings);
+  ASSERT_EQ(wide.stage.failure, "");
+  int band = 0, beyond = 0;
+  for (const auto& c : wide.candidates) {
+    const double angle = core::rad_to_deg(angle_between(c.board.linear(), target.linear()));
+    if (c.sample < settings.candidates) {
+      EXPECT_LT(angle, 45.0 + 1e-9);
+      continue;
+    }
+    ++band;
+    EXPECT_LT(angle, 90.0 + 1e-9);
+    beyond += angle > 45.0 ? 1 : 0;
+  }
+  EXPECT_GE(band, settings.natural_candidates);
+  EXPECT_GT(beyond, band / 4);  // uniform within 90 degrees: most of the volume lies beyond 45
+  const auto standard = offline::plan_handover_goals(*cell, product(), index, grasps, comfort(),
+                                                     offline::HandoverSettings{});
+  for (const auto& c : standard.candidates) {
+    EXPECT_LT(core::rad_to_deg(angle_between(c.board.linear(), target.linear())), 45.0 + 1e-9);
+  }
+}

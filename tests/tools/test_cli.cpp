@@ -1009,6 +1009,11 @@ TEST(Cli, NumericOptionsOutsideTheirRangeAreRefused) {
         build("--comfort-threshold", threshold),
         std::string("--comfort-threshold: expected a number in [0, 1], got ") + threshold);
   }
+  for (const char* degrees : {"nan", "0", "-45", "181"}) {
+    expect_one_line_error(
+        build("--natural-max-rotation", degrees),
+        std::string("--natural-max-rotation: expected a number in [1, 180], got ") + degrees);
+  }
   for (const auto& [option, value] :
        std::vector<std::pair<std::string, std::string>>{{"--comfort-samples", "0"},
                                                         {"--handover-candidates", "-5"},

@@ -33,6 +33,7 @@ struct BuildOptions {
   long comfort_samples = core::ComfortMapSettings{}.samples;
   int handover_candidates = offline::HandoverSettings{}.candidates;
   int natural_candidates = offline::HandoverSettings{}.natural_candidates;
+  double natural_max_rotation = offline::HandoverSettings{}.natural_max_rotation_deg;
   double comfort_threshold = offline::HandoverSettings{}.comfort_threshold;
   double comfort_floor = offline::HandoverSettings{}.comfort_floor;
   std::string bodies;
@@ -97,6 +98,7 @@ int run_build(const BuildOptions& opt) {
   settings.comfort.samples = opt.comfort_samples;
   settings.handover.candidates = opt.handover_candidates;
   settings.handover.natural_candidates = opt.natural_candidates;
+  settings.handover.natural_max_rotation_deg = opt.natural_max_rotation;
   settings.handover.comfort_threshold = opt.comfort_threshold;
   settings.handover.comfort_floor = opt.comfort_floor;
   settings.roadmap.nodes = opt.roadmap_nodes;
@@ -252,6 +254,11 @@ void add_build_command(CLI::App& app, Action& action) {
                    "per worker whose band the part's fitted centre lies outside of (0: none)")
       ->capture_default_str()
       ->check(int_in(0, kMaxCandidatesOrNodes));
+  build
+      ->add_option("--natural-max-rotation", opt->natural_max_rotation,
+                   "deg: the natural band candidates' orientation within this of the fitted one")
+      ->capture_default_str()
+      ->check(number_in(1.0, 180.0));
   build
       ->add_option("--comfort-threshold", opt->comfort_threshold,
                    "least human comfort Q of a handover goal (S)")
