@@ -387,17 +387,19 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     pose.translation() = target.translation() + random_in_ball(settings.max_offset, from);
     return pose;
   };
-  // A natural band's: the orientation within natural_max_rotation_deg and the horizontal position
-  // of the part's centre within max_offset of the target's, its height within the band
+  // A natural band's: the orientation within max_rotation_deg (natural_max_rotation_deg where that
+  // finds the worker no goal in the band) and the horizontal position of the part's centre within
+  // max_offset of the target's, its height within the band
   // (kept kBandMargin inside its ends): the target lowered or raised to where the worker holds
   // it in front of the chest.
   const Eigen::Vector3d target_centre = target * grasps.com;
   // `w`: the worker whose band it is (index body + 1), whose band stream it draws from.
-  auto draw_in_band = [&](const core::HeightBand& band, int w) {
-    return [&, band, w](std::mt19937_64& /*worker's*/) {
+  // `rotation`: the orientation's limit (rad).
+  auto draw_in_band = [&](const core::HeightBand& band, int w, double rotation) {
+    return [&, band, w, rotation](std::mt19937_64& /*worker's*/) {
       std::mt19937_64& from = band_rng[static_cast<std::size_t>(w)];
       core::Pose pose = core::Pose::Identity();
-      pose.linear() = target.linear() * random_rotation_within(natural_max_rotation, from);
+      pose.linear() = target.linear() * random_rotation_within(rotation, from);
       Eigen::Vector3d centre = target_centre + random_in_ball(settings.max_offset, from);
       centre.z() = band.hip_z + kBandMargin +
                    uniform01(from) * std::max(0.0, band.shoulder_z - band.hip_z - 2 * kBandMargin);
@@ -517,12 +519,15 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     sample_candidates(stage.candidates + (w == 0 ? settings.candidates : settings.body_candidates),
                       draw_eq1, w - 1);
   }
+  // Each worker's natural band (index body + 1) where the part's fitted centre lies outside it.
+  std::vector<std::optional<core::HeightBand>> outside_band(static_cast<std::size_t>(workers));
   for (int w = 0; w < workers; ++w) {
     const core::HeightBand band = core::natural_height_band(
         cell, w == 0 ? nullptr : &comfort.body(w - 1), cell.spec().human_stance);
     if (settings.natural_candidates > 0 && !band.contains(target_centre.z())) {
-      sample_candidates(stage.candidates + settings.natural_candidates, draw_in_band(band, w),
-                        w - 1);
+      outside_band[static_cast<std::size_t>(w)] = band;
+      sample_candidates(stage.candidates + settings.natural_candidates,
+                        draw_in_band(band, w, max_rotation), w - 1);
     }
   }
   // Nothing to search for: no candidate, or none the human takes even at the comfort floor.
@@ -1325,6 +1330,34 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     reset_state();
   };
   search_shared();
+  // A worker outside whose band the part is fitted and who takes no goal with the part's centre
+  // in that band: natural_candidates more there, within natural_max_rotation_deg of the target's
+  // orientation (a panel too tall to stand within max_rotation_deg below a short worker's
+  // shoulder above the table lies further over).
+  // Batch by batch, up to max_candidates more for each such worker.
+  std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
+  for (bool wider = natural_max_rotation > max_rotation;
+       wider && stage.draws < settings.max_draws;) {
+    wider = false;
+    for (int w = 0; w < workers; ++w) {
+      const auto wi = static_cast<std::size_t>(w);
+      const auto& band = outside_band[wi];
+      if (!band || wider_for[wi] >= settings.max_candidates) continue;
+      const bool has_band_goal =
+          std::any_of(result.candidates.begin(), result.candidates.end(), [&](const auto& c) {
+            const bool takes = w == 0 ? c.quality > threshold : ((c.bodies >> (w - 1)) & 1U) != 0;
+            return c.status == "goal" && takes && band->contains((c.board * grasps.com).z());
+          });
+      if (has_band_goal) continue;
+      const int batch =
+          std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
+      sample_candidates(stage.candidates + batch, draw_in_band(*band, w, natural_max_rotation),
+                        w - 1);
+      wider_for[wi] += batch;
+      wider = true;
+    }
+    if (wider) search_shared();
+  }
   // Thin boards (a worker with few goals after the first batches) get more candidates for each
   // such worker, batch by batch, up to max_candidates drawn for that worker.
   for (bool thin = true; thin && stage.draws < settings.max_draws;) {
