@@ -409,14 +409,15 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   };
   // Candidates until there are `until`, drawn by `draw`, the human's grasps chosen for worker
   // `body` (-1: the cell's human, else a body of the set).
-  std::vector<int> drawn_for;  // Eq. 1 and band candidates per worker (index body + 1)
+  std::vector<int> drawn_for;           // Eq. 1 and band candidates per worker (index body + 1)
+  int draw_limit = settings.max_draws;  // stage.draws stop here (the wider band batches: more)
   auto sample_candidates = [&](int until, const auto& draw, int body) {
     // The worker's own stream (the cell human's: `rng`); a band's draw brings its own.
     std::mt19937_64& from = body < 0 ? rng : body_rng[static_cast<std::size_t>(body + 1)];
     choosing_for = body;
     drawn_for.resize(static_cast<std::size_t>(comfort.body_count() + 1), 0);
     const int before = static_cast<int>(result.candidates.size());
-    while (static_cast<int>(result.candidates.size()) < until && stage.draws < settings.max_draws) {
+    while (static_cast<int>(result.candidates.size()) < until && stage.draws < draw_limit) {
       ++stage.draws;
       const core::Pose pose = draw(from);
       screen_data.set_body_pose(screen_board, pose);
@@ -1330,34 +1331,6 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     reset_state();
   };
   search_shared();
-  // A worker outside whose band the part is fitted and who takes no goal with the part's centre
-  // in that band: natural_candidates more there, within natural_max_rotation_deg of the target's
-  // orientation (a panel too tall to stand within max_rotation_deg below a short worker's
-  // shoulder above the table lies further over).
-  // Batch by batch, up to max_candidates more for each such worker.
-  std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
-  for (bool wider = natural_max_rotation > max_rotation;
-       wider && stage.draws < settings.max_draws;) {
-    wider = false;
-    for (int w = 0; w < workers; ++w) {
-      const auto wi = static_cast<std::size_t>(w);
-      const auto& band = outside_band[wi];
-      if (!band || wider_for[wi] >= settings.max_candidates) continue;
-      const bool has_band_goal =
-          std::any_of(result.candidates.begin(), result.candidates.end(), [&](const auto& c) {
-            const bool takes = w == 0 ? c.quality > threshold : ((c.bodies >> (w - 1)) & 1U) != 0;
-            return c.status == "goal" && takes && band->contains((c.board * grasps.com).z());
-          });
-      if (has_band_goal) continue;
-      const int batch =
-          std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
-      sample_candidates(stage.candidates + batch, draw_in_band(*band, w, natural_max_rotation),
-                        w - 1);
-      wider_for[wi] += batch;
-      wider = true;
-    }
-    if (wider) search_shared();
-  }
   // Thin boards (a worker with few goals after the first batches) get more candidates for each
   // such worker, batch by batch, up to max_candidates drawn for that worker.
   for (bool thin = true; thin && stage.draws < settings.max_draws;) {
@@ -1408,6 +1381,35 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
     searched = 0;
     search_shared();
+  }
+  // A worker outside whose band the part is fitted and who takes no goal with the part's centre
+  // in that band: batches of natural_candidates more there, within natural_max_rotation_deg of
+  // the target's orientation, up to max_candidates (a panel too tall to stand within
+  // max_rotation_deg below a short worker's shoulder above the table lies further over). Last,
+  // after every other batch and fallback: they add goals for that worker and take none away.
+  // They draw on a budget of max_draws of their own.
+  draw_limit = stage.draws + settings.max_draws;
+  std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
+  for (bool wider = natural_max_rotation > max_rotation; wider && stage.draws < draw_limit;) {
+    wider = false;
+    for (int w = 0; w < workers; ++w) {
+      const auto wi = static_cast<std::size_t>(w);
+      const auto& band = outside_band[wi];
+      if (!band || wider_for[wi] >= settings.max_candidates) continue;
+      const bool has_band_goal =
+          std::any_of(result.candidates.begin(), result.candidates.end(), [&](const auto& c) {
+            const bool takes = w == 0 ? c.quality > threshold : ((c.bodies >> (w - 1)) & 1U) != 0;
+            return c.status == "goal" && takes && band->contains((c.board * grasps.com).z());
+          });
+      if (has_band_goal) continue;
+      const int batch =
+          std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
+      sample_candidates(stage.candidates + batch, draw_in_band(*band, w, natural_max_rotation),
+                        w - 1);
+      wider_for[wi] += batch;
+      wider = true;
+    }
+    if (wider) search_shared();
   }
   // Eq. 8 ranks over every batch.
   std::vector<db::HandoverCandidateRecord*> goals;
