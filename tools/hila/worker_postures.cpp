@@ -216,8 +216,7 @@ WorkerPostures worker_postures(const ErgonomicsContext& context, const ReportWor
     // at the scene's stance, with the grasps the table and alone postures use.
     std::vector<int> usable;
     for (std::size_t g = 0; g < grasps.size(); ++g) {
-      if (!two_hands && grasps[g].one_hand_stable) usable.push_back(static_cast<int>(g));
-      if (two_hands) usable.push_back(static_cast<int>(g));
+      if (two_hands || grasps[g].one_hand_stable) usable.push_back(static_cast<int>(g));
     }
     for (std::size_t k = 0; k < records.size(); ++k) {
       TakenPosture& t = row.by_method[records[k].method];
