@@ -1382,12 +1382,12 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     searched = 0;
     search_shared();
   }
-  // A worker outside whose band the part is fitted and who takes fewer than min_goals goals with
-  // the part's centre in that band: batches of natural_candidates more there, within
-  // natural_max_rotation_deg of the target's orientation, up to max_candidates (a panel too tall to
-  // stand within max_rotation_deg below a short worker's shoulder above the table lies further
-  // over). Last, after every other batch and fallback: they add goals for that worker and take none
-  // away. They draw on a budget of max_draws of their own.
+  // A worker outside whose band the part is fitted and who takes no goal with the part's centre
+  // in that band: batches of natural_candidates more there, within natural_max_rotation_deg of
+  // the target's orientation, up to max_candidates (a panel too tall to stand within
+  // max_rotation_deg below a short worker's shoulder above the table lies further over). Last,
+  // after every other batch and fallback: they add goals for that worker and take none away.
+  // They draw on a budget of max_draws of their own.
   draw_limit = stage.draws + settings.max_draws;
   std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
   for (bool wider = natural_max_rotation > max_rotation; wider && stage.draws < draw_limit;) {
@@ -1396,12 +1396,12 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       const auto wi = static_cast<std::size_t>(w);
       const auto& band = outside_band[wi];
       if (!band || wider_for[wi] >= settings.max_candidates) continue;
-      const bool has_band_goals =
-          std::count_if(result.candidates.begin(), result.candidates.end(), [&](const auto& c) {
+      const bool has_band_goal =
+          std::any_of(result.candidates.begin(), result.candidates.end(), [&](const auto& c) {
             const bool takes = w == 0 ? c.quality > threshold : ((c.bodies >> (w - 1)) & 1U) != 0;
             return c.status == "goal" && takes && band->contains((c.board * grasps.com).z());
-          }) >= settings.min_goals;
-      if (has_band_goals) continue;
+          });
+      if (has_band_goal) continue;
       const int batch =
           std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
       sample_candidates(stage.candidates + batch, draw_in_band(*band, w, natural_max_rotation),
