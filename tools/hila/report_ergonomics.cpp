@@ -383,8 +383,8 @@ void print_report(const nlohmann::json& j) {
             << "  per method: torso flexion deg / elbow at or above the shoulder (up) / part "
                "centre in the hip-shoulder band (in, high, low) / reach m / re-orientation left "
                "deg / comfort Q / RULA grand / REBA / turning it to its fitted orientation in "
-               "front of the "
-               "worker (ok, up: an elbow at or above the shoulder, --: nothing to turn)\n";
+               "front of the worker (ok, up: an elbow at or above the shoulder, --: nothing to "
+               "turn)\n";
   for (const auto& w : j["workers"]) print_worker(w);
   const auto& all = j["all_workers"];
   std::cout << "all workers (" << j["workers"].size() << "):";
