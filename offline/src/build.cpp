@@ -296,7 +296,7 @@ std::string settings_hash(const BuildSettings& s) {
        << h.table_regrasp.support_tolerance << ' ' << h.swap_roles << ' ' << h.suction_delivery
        << ' ' << h.table_regrasp.relay << ' ' << h.table_regrasp.relay_spots << ' '
        << h.table_regrasp.relay_spacing << ' ' << h.natural_candidates << ' ' << h.body_candidates
-       << ' ' << h.natural_max_rotation_deg;
+       << ' ' << h.natural_max_rotation_deg << ' ' << h.natural_max_rula;
   for (const auto& p : h.rr_positions) text << ' ' << p.x() << ' ' << p.y() << ' ' << p.z();
   const auto& t = s.tool_relay;
   text << "\ntool_relay " << t.spacing << ' ' << t.yaw_steps << ' ' << t.clearance;

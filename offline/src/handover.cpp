@@ -7,12 +7,15 @@
 #include <memory>
 #include <optional>
 #include <random>
+#include <set>
+#include <tuple>
 
 #include "hila/core/collision.hpp"
 #include "hila/core/comfort.hpp"
 #include "hila/core/comfort_map.hpp"
 #include "hila/core/error.hpp"
 #include "hila/core/pre_grasp.hpp"
+#include "hila/core/receiving_posture.hpp"
 #include "hila/core/soft_finger.hpp"
 #include "hila/core/stage_scene.hpp"
 #include "hila/offline/arm_workspace.hpp"
@@ -1382,26 +1385,61 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     searched = 0;
     search_shared();
   }
-  // A worker outside whose band the part is fitted and who takes no goal with the part's centre
-  // in that band: batches of natural_candidates more there, within natural_max_rotation_deg of
-  // the target's orientation, up to max_candidates (a panel too tall to stand within
-  // max_rotation_deg below a short worker's shoulder above the table lies further over). Last,
-  // after every other batch and fallback: they add goals for that worker and take none away.
-  // They draw on a budget of max_draws of their own.
+  // A worker outside whose band the part is fitted and none of whose goals the online planner
+  // would find natural for them (BoardPlanner: the goal's centre in their band, their arm reached
+  // as core::reach_hand does from the goal's stored posture, else from zero, upright with RULA at
+  // most natural_max_rula): batches of natural_candidates more in that band, within
+  // natural_max_rotation_deg of the target's orientation, up to max_candidates (a panel too tall
+  // to stand within max_rotation_deg below a short worker's shoulder above the table lies further
+  // over). Last, after every other batch and fallback: they add goals and take none away. They
+  // draw on a budget of max_draws of their own.
   draw_limit = stage.draws + settings.max_draws;
   std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
+  // Goals judged not natural for a worker (index body + 1): judged once.
+  std::vector<std::set<int>> not_natural(static_cast<std::size_t>(workers));
+  auto natural_for = [&](int ci, int w, const core::HeightBand& band) {
+    const auto& c = result.candidates[static_cast<std::size_t>(ci)];
+    const Eigen::Vector3d centre = c.board * grasps.com;
+    if (c.status != "goal" || !band.contains(centre.z())) return false;
+    if (not_natural[static_cast<std::size_t>(w)].count(ci) > 0) return false;
+    const HumanChoice& h = choices[static_cast<std::size_t>(ci)];
+    const core::HumanBody* body = w == 0 ? nullptr : &comfort.body(w - 1);
+    std::vector<std::pair<std::string, Eigen::VectorXd>> held;
+    // The cell's human at a goal that stores the posture: the planner takes it as stored.
+    if (w == 0 && c.human_joints.size() > 0 &&
+        (h.second_grasp < 0 || c.second_joints.size() > 0)) {
+      held.emplace_back(comfort.arm_name(h.arm), c.human_joints);
+      if (h.second_grasp >= 0) held.emplace_back(comfort.arm_name(h.second_arm), c.second_joints);
+    } else {
+      for (const auto& [arm, grasp, seed] :
+           {std::tuple{h.arm, h.grasp, &c.human_joints},
+            std::tuple{h.second_arm, h.second_grasp, &c.second_joints}}) {
+        if (grasp < 0) continue;
+        const core::ComfortResult r = core::reach_hand(
+            cell, body, cell.spec().human_stance, comfort.arm_name(arm),
+            c.board * grasps.human[static_cast<std::size_t>(grasp)].hand, *seed);
+        if (!r.reachable) break;
+        held.emplace_back(comfort.arm_name(arm), r.joints);
+      }
+    }
+    const bool natural =
+        held.size() == (h.second_grasp >= 0 ? 2U : 1U) &&
+        core::check_receiving_posture(cell, body, cell.spec().human_stance, held, centre, part.mass)
+            .natural(settings.natural_max_rula);
+    if (!natural) not_natural[static_cast<std::size_t>(w)].insert(ci);
+    return natural;
+  };
   for (bool wider = natural_max_rotation > max_rotation; wider && stage.draws < draw_limit;) {
     wider = false;
     for (int w = 0; w < workers; ++w) {
       const auto wi = static_cast<std::size_t>(w);
       const auto& band = outside_band[wi];
       if (!band || wider_for[wi] >= settings.max_candidates) continue;
-      const bool has_band_goal =
-          std::any_of(result.candidates.begin(), result.candidates.end(), [&](const auto& c) {
-            const bool takes = w == 0 ? c.quality > threshold : ((c.bodies >> (w - 1)) & 1U) != 0;
-            return c.status == "goal" && takes && band->contains((c.board * grasps.com).z());
-          });
-      if (has_band_goal) continue;
+      bool has_natural_goal = false;
+      for (int ci = 0; ci < static_cast<int>(result.candidates.size()) && !has_natural_goal; ++ci) {
+        has_natural_goal = natural_for(ci, w, *band);
+      }
+      if (has_natural_goal) continue;
       const int batch =
           std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
       sample_candidates(stage.candidates + batch, draw_in_band(*band, w, natural_max_rotation),

@@ -38,30 +38,10 @@ WorkerComfort::GoalReach WorkerComfort::goal_reach(
     const core::Cell& cell, const db::HandoverCandidateRecord& goal,
     const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps, const core::Pose& stance,
     const core::HumanBody* body, const core::ComfortSettings& ik) {
-  std::vector<core::Pose> links;
-  cell.human().link_poses(cell.human_neutral(), links);
-  const std::vector<core::HumanArm>& arms = body != nullptr ? body->arms() : cell.human_arms();
   auto hand = [&](const std::string& name, std::int64_t grasp_id, const Eigen::VectorXd& built) {
-    const auto a = std::find_if(arms.begin(), arms.end(),
-                                [&](const core::HumanArm& h) { return h.spec.name == name; });
     const auto it = human_grasps.find(grasp_id);
-    if (a == arms.end() || it == human_grasps.end()) return core::ComfortResult{};
-    const core::Pose base_in_stance =
-        body != nullptr
-            ? body->base_in_stance(static_cast<int>(a - arms.begin()))
-            : links[static_cast<std::size_t>(cell.human().link_index(a->spec.base_link))];
-    const core::Pose in_base = (stance * base_in_stance).inverse() * (goal.board * it->second.hand);
-    // Beyond the stretched arm from the shoulder: out of reach without solving.
-    const double reach = core::characteristic_length(a->chain);
-    if ((in_base.translation() - a->chain.first_joint_position()).norm() > reach) {
-      return core::ComfortResult{};
-    }
-    const Eigen::VectorXd seed = built.size() == a->chain.dof()
-                                     ? built
-                                     : Eigen::VectorXd::Zero(a->chain.dof())
-                                           .cwiseMax(a->chain.lower_limits())
-                                           .cwiseMin(a->chain.upper_limits());
-    return core::best_comfort(a->chain, in_base, seed, ik);
+    if (it == human_grasps.end()) return core::ComfortResult{};
+    return core::reach_hand(cell, body, stance, name, goal.board * it->second.hand, built, ik);
   };
   GoalReach r;
   if (goal.human_arm.empty()) return r;

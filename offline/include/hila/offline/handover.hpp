@@ -30,12 +30,17 @@ struct HandoverSettings {
   // tries first (BoardPlanSettings::natural_posture_first). 0: Eq. 1's candidates only.
   int natural_candidates = 200;
   // A worker whose band the first natural_candidates (within max_rotation_deg) give no goal they
-  // take with the part's centre in the band gets batches of natural_candidates more within this
-  // of the target's orientation (deg), up to max_candidates, until they have one: a part too tall
-  // to stand within 45 degrees of its fitted orientation below a short worker's shoulder above the
-  // table (the cabinet's 700 mm laterals for a 1.50 m woman) is presented lying further over, and
-  // the worker has more to turn. Equal to max_rotation_deg: no wider batches.
+  // take in a natural posture gets batches of natural_candidates more within this of the target's
+  // orientation (deg), up to max_candidates, until they have one: a part too tall to stand within
+  // 45 degrees of its fitted orientation below a short worker's shoulder above the table (the
+  // cabinet's 700 mm laterals for a 1.50 m woman) is presented lying further over, and the worker
+  // has more to turn. Equal to max_rotation_deg: no wider batches.
   double natural_max_rotation_deg = 90.0;
+  // A natural posture, as the online planner judges it (BoardPlanSettings::natural_max_rula,
+  // core::PostureCheck::natural): the worker's arm IK at the goal's grasps upright (no forward
+  // bend, elbows below the shoulders, the part's centre between hip and shoulder height) with a
+  // RULA grand score of at most this.
+  int natural_max_rula = 3;
   // With a body set (BuildSettings::human_bodies), each body's own Eq. 1 candidates besides the
   // cell human's `candidates`: the human's grasps chosen and the goal confirmed for that body.
   int body_candidates = 250;

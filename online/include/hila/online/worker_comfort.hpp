@@ -10,6 +10,7 @@
 #include "hila/core/comfort_map.hpp"
 #include "hila/core/human_body.hpp"
 #include "hila/core/pose.hpp"
+#include "hila/core/receiving_posture.hpp"
 #include "hila/db/records.hpp"
 
 namespace hila::online {
@@ -63,17 +64,8 @@ class WorkerComfort {
                               const std::map<std::int64_t, db::HumanGraspRecord>& human_grasps,
                               const core::Pose& stance, const core::HumanBody* body = nullptr,
                               const core::ComfortSettings& ik = reach_settings());
-  // For a reach check: 8 attempts, stopping at the first solution, to 1e-7 m and rad (far below
-  // what a human hand notices), with the joints at a limit held out of the step (receiving
-  // postures often have a wrist or elbow at its end stop: clipped steps crawl along it).
-  static core::ComfortSettings reach_settings() {
-    core::ComfortSettings s;
-    s.ik_attempts = 8;
-    s.attempts_after_found = 0;
-    s.tolerance = 1e-7;
-    s.hold_joints_at_limits = true;
-    return s;
-  }
+  // For a reach check: core::reach_settings().
+  static core::ComfortSettings reach_settings() { return core::reach_settings(); }
 
  private:
   struct Arm {
