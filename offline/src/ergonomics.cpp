@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hila/core/collision.hpp"
 #include "hila/core/comfort.hpp"
 #include "hila/core/human_body.hpp"
 #include "hila/core/mesh_symmetry.hpp"
@@ -146,6 +147,7 @@ Posture receiving_posture(const core::Cell& cell, const HumanComfort& comfort,
 Turn turn_in_hands(const core::Cell& cell, const HumanComfort& comfort, const core::Pose& stance,
                    const core::Pose& from, const Eigen::Matrix3d& target,
                    const std::vector<Eigen::Matrix3d>& symmetries, const Eigen::Vector3d& com,
+                   const core::TriangleMesh* mesh,
                    const std::vector<db::HumanGraspRecord>& human_grasps,
                    const std::vector<int>& grasps, const ErgonomicsSettings& settings,
                    const TurnSettings& turn, const core::HumanBody* body) {
@@ -169,6 +171,34 @@ Turn turn_in_hands(const core::Cell& cell, const HumanComfort& comfort, const co
   const Eigen::Quaterniond q0(from.linear()), q1(goal);
   const core::HeightBand band = core::natural_height_band(cell, body, stance);
   const Eigen::Vector3d forward = stance.linear().col(0);
+  // The worker's body and the board, for the clearance check: the arms that hold the board may
+  // touch it, the torso, head and legs may not. The model the postures are searched on (a body
+  // that is the cell's human is the cell's human, as receiving_posture does).
+  const core::HumanBody* searched = body != nullptr && !body->same_as_cell() ? body : nullptr;
+  const core::RobotModel& human = searched != nullptr ? searched->model() : cell.human();
+  core::CollisionModel clearance;
+  core::RobotBodies human_bodies;
+  int board_body = -1;
+  if (mesh != nullptr) {
+    human_bodies = core::add_robot(clearance, human, "human/");
+    board_body = clearance.add_mesh_body("board", *mesh, false);
+    for (const auto& arm : searched != nullptr ? searched->arms() : cell.human_arms()) {
+      const auto& first = human.joints()[static_cast<std::size_t>(
+          human.joint_index(arm.chain.joint_names().front()))];
+      for (const int b : core::subtree_bodies(human, human_bodies, first.child_link)) {
+        clearance.allow(board_body, b);
+      }
+    }
+  }
+  core::CollisionData clearance_data(clearance);
+  std::vector<core::Pose> links;
+  auto blocked = [&](const Posture& p, const core::Pose& board) {
+    if (board_body < 0) return false;
+    human.link_poses(p.q, links);
+    core::set_robot_pose(clearance_data, human_bodies, links, p.stance);
+    clearance_data.set_body_pose(board_body, board);
+    return core::in_collision(clearance, clearance_data, std::vector<int>{board_body});
+  };
   bool chosen = false;
   int best_unreachable = 0;
   for (const double fraction : turn.band_fractions) {
@@ -184,8 +214,13 @@ Turn turn_in_hands(const core::Cell& cell, const HumanComfort& comfort, const co
         board.translation() = t.point - board.linear() * com;
         const Posture p = receiving_posture(cell, comfort, stance, board, human_grasps, grasps, -1,
                                             settings, body);
+        const bool in_body = p.reachable && blocked(p, board);
+        t.blocked.push_back(in_body);
         if (!p.reachable) {
           ++unreachable;
+        } else if (in_body) {
+          ++unreachable;
+          ++t.blocked_steps;
         } else {
           t.elevated_steps += p.shoulder_elevated ? 1 : 0;
           t.max_flexion_deg = std::max(t.max_flexion_deg, p.torso_flexion_deg);
@@ -193,7 +228,7 @@ Turn turn_in_hands(const core::Cell& cell, const HumanComfort& comfort, const co
         t.boards.push_back(board);
         t.postures.push_back(p);
       }
-      t.reachable = unreachable == 0;
+      t.reachable = unreachable == t.blocked_steps;
       const bool better =
           !chosen || unreachable < best_unreachable ||
           (unreachable == best_unreachable && (t.elevated_steps < best.elevated_steps ||

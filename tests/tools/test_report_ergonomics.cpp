@@ -221,6 +221,9 @@ TEST_F(ReportErgonomics, TableAndAloneAreEachBodysOwnPostures) {
                   turned < 1e-6 ? 0 : static_cast<int>(std::ceil(turned / 15.0 - 1e-9)) + 1);
         EXPECT_EQ(m["shoulder_work"].get<bool>(),
                   !m["elbow_below_shoulder"].get<bool>() || turn["elbow_up_steps"].get<int>() > 0);
+        // Steps blocked by the body are among the steps, none without a turn.
+        EXPECT_GE(turn["blocked_steps"].get<int>(), 0);
+        EXPECT_LE(turn["blocked_steps"].get<int>(), turn["steps"].get<int>());
         ++checked;
         if (std::string(method) != "table") continue;
         // At the table the worker stands at the scene's stance.

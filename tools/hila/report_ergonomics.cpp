@@ -127,6 +127,7 @@ nlohmann::json taken_json(const TakenPosture& t, bool planned) {
     m["turn"] = {{"turned_deg", turn.turned_deg},
                  {"steps", turn.postures.size()},
                  {"reachable", turn.reachable},
+                 {"blocked_steps", turn.blocked_steps},
                  {"elbow_up_steps", turn.elevated_steps},
                  {"max_torso_flexion_deg", turn.max_flexion_deg},
                  {"point", {turn.point.x(), turn.point.y(), turn.point.z()}}};
@@ -301,6 +302,8 @@ std::string cell_text(const nlohmann::json& m) {
     s << "--";
   } else if (!m["turn"]["reachable"].get<bool>()) {
     s << "unreachable";
+  } else if (m["turn"]["blocked_steps"].get<int>() > 0) {
+    s << "blocked";
   } else {
     s << (m["turn"]["steps"].get<std::size_t>() == 0   ? "--"
           : m["turn"]["elbow_up_steps"].get<int>() > 0 ? "up"
@@ -383,8 +386,8 @@ void print_report(const nlohmann::json& j) {
             << "  per method: torso flexion deg / elbow at or above the shoulder (up) / part "
                "centre in the hip-shoulder band (in, high, low) / reach m / re-orientation left "
                "deg / comfort Q / RULA grand / REBA / turning it to its fitted orientation in "
-               "front of the worker (ok, up: an elbow at or above the shoulder, --: nothing to "
-               "turn)\n";
+               "front of the worker (ok, up: an elbow at or above the shoulder, blocked: the board "
+               "runs into the body at every turning point, --: nothing to turn)\n";
   for (const auto& w : j["workers"]) print_worker(w);
   const auto& all = j["all_workers"];
   std::cout << "all workers (" << j["workers"].size() << "):";

@@ -224,14 +224,16 @@ WorkerPostures worker_postures(const ErgonomicsContext& context, const ReportWor
         t.turn =
             offline::turn_in_hands(cell, *context.comfort, scene.human_stance, postures[k].board,
                                    in.target.linear(), in.symmetries, record.mass_properties.com,
-                                   grasps, usable, settings, offline::TurnSettings{}, body);
+                                   &part.mesh, grasps, usable, settings, offline::TurnSettings{},
+                                   body);
       }
     }
     if (TakenPosture& t = row.by_method["hila"]; t.scored) {
       t.turn =
           offline::turn_in_hands(cell, *context.comfort, scene.human_stance, handed_over.at(name),
                                  in.target.linear(), in.symmetries, record.mass_properties.com,
-                                 grasps, usable, settings, offline::TurnSettings{}, body);
+                                 &part.mesh, grasps, usable, settings, offline::TurnSettings{},
+                                 body);
     }
     out.boards.push_back(std::move(row));
   }

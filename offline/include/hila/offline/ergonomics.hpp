@@ -7,6 +7,7 @@
 
 #include "hila/core/cell.hpp"
 #include "hila/core/human_body.hpp"
+#include "hila/core/mesh.hpp"
 #include "hila/db/records.hpp"
 #include "hila/offline/human_comfort.hpp"
 
@@ -97,32 +98,41 @@ struct TurnSettings {
   double step_deg = 15.0;  // the turn is checked at most this far apart (and at both ends)
   // Turning points: the centre of mass at each fraction of the worker's hip-to-shoulder band
   // (natural_height_band, 0 the hip, 1 the shoulder) and each distance (m) in front of the stance
-  // (its x axis). The turn is scored at the point that suits the worker best.
-  std::vector<double> band_fractions = {0.4, 0.7};
-  std::vector<double> distances = {0.30, 0.40};
+  // (its x axis). The turn is scored at the point that suits the worker best; the higher and
+  // farther points are where a long board turns clear of the body.
+  std::vector<double> band_fractions = {0.4, 0.7, 1.0};
+  std::vector<double> distances = {0.30, 0.40, 0.50};
 };
 
 struct Turn {
   double turned_deg = 0.0;  // the rotation, modulo the part's symmetries; 0: nothing to turn
   bool reachable = true;    // a grasp reachable at every step (torso bent up to its limit)
-  int elevated_steps = 0;   // steps with the elbow at or above the shoulder
+  // Steps where the board, at the posture found, runs into the worker's body: the torso, head and
+  // legs (the arms that hold it excepted). Checked where the board's mesh is given.
+  int blocked_steps = 0;
+  int elevated_steps = 0;  // steps with the elbow at or above the shoulder
   double max_flexion_deg = 0.0;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();  // the turning point chosen (world)
   // The board (world) and the worker's posture at each step, from the taken orientation (first)
   // to the fitted one (last); empty with nothing to turn.
   std::vector<core::Pose> boards;
   std::vector<Posture> postures;
+  std::vector<bool> blocked;  // per step: the board in the worker's body (blocked_steps)
+  // Reachable at every step and clear of the body at every step.
+  bool feasible() const { return reachable && blocked_steps == 0; }
 };
 
 // The turn from `from` (the board as taken, world) to `target` (world orientation; the nearest of
 // its symmetric equivalents, `symmetries` in the part frame) with the centre of mass `com` (part
 // frame) at each turning point; at each step the best posture receiving_posture finds with
-// `grasps` (indices into human_grasps). The chosen point: the fewest steps unreachable, then the
-// fewest with the elbow up, then the least torso flexion, then the first. The board's clearance
-// from the worker's body is not checked.
+// `grasps` (indices into human_grasps), and, with `mesh` (the part's, part frame), the board
+// checked against the worker's body at that posture. The chosen point: the fewest steps
+// unreachable or blocked, then the fewest with the elbow up, then the least torso flexion, then
+// the first.
 Turn turn_in_hands(const core::Cell& cell, const HumanComfort& comfort, const core::Pose& stance,
                    const core::Pose& from, const Eigen::Matrix3d& target,
                    const std::vector<Eigen::Matrix3d>& symmetries, const Eigen::Vector3d& com,
+                   const core::TriangleMesh* mesh,
                    const std::vector<db::HumanGraspRecord>& human_grasps,
                    const std::vector<int>& grasps, const ErgonomicsSettings& settings,
                    const TurnSettings& turn, const core::HumanBody* body = nullptr);
