@@ -15,20 +15,6 @@
 
 using namespace hila;
 
-namespace {
-
-// A configuration drawn uniformly within the chain's joint limits.
-Eigen::VectorXd random_within(const core::KinematicChain& chain, std::mt19937_64& rng) {
-  Eigen::VectorXd q(chain.dof());
-  for (int i = 0; i < chain.dof(); ++i) {
-    q[i] = std::uniform_real_distribution<double>(chain.lower_limits()[i],
-                                                  chain.upper_limits()[i])(rng);
-  }
-  return q;
-}
-
-}  // namespace
-
 // Where a receiving posture puts a worker of another body (BoardPlan::worker): the hip and
 // shoulder heights are the anthropometric ratios of that body (0.530 H, 0.818 H above the
 // stance), the elbow's height against the shoulder comes from a chain of its own (the torso to
@@ -47,10 +33,10 @@ TEST(ReceivingPosture, APostureCheckOfAWorkersBodyFollowsItsForwardKinematics) {
     for (int trial = 0; trial < 200; ++trial) {
       std::vector<std::pair<std::string, Eigen::VectorXd>> arms;
       const auto& first = body.arms()[static_cast<std::size_t>(trial % 2)];
-      arms.emplace_back(first.spec.name, random_within(first.chain, rng));
+      arms.emplace_back(first.spec.name, test::random_within(first.chain, rng));
       if (trial % 3 == 0) {
         const auto& second = body.arms()[static_cast<std::size_t>((trial + 1) % 2)];
-        arms.emplace_back(second.spec.name, random_within(second.chain, rng));
+        arms.emplace_back(second.spec.name, test::random_within(second.chain, rng));
       }
       const Eigen::Vector3d centre = stance * Eigen::Vector3d(0.4, 0.0, 1.0 + 0.25 * (trial % 5));
       const core::PostureCheck c =
@@ -99,7 +85,7 @@ TEST(ReceivingPosture, AWholeConfigurationIsScoredAsItIs) {
           .variable;
   for (int trial = 0; trial < 20; ++trial) {
     const std::vector<std::pair<std::string, Eigen::VectorXd>> arms{
-        {arm.spec.name, random_within(arm.chain, rng)}};
+        {arm.spec.name, test::random_within(arm.chain, rng)}};
     Eigen::VectorXd q = body.posture(arms);
     const auto joints = core::receiving_scores(*cell, &body, arms, 3.0);
     const auto whole = core::receiving_scores(*cell, &body, q, {arm.spec.name}, 3.0, false);
@@ -164,7 +150,7 @@ TEST(ReceivingPosture, AReachedHandIsWhereItWasAsked) {
     const auto& arms = body != nullptr ? body->arms() : cell->human_arms();
     for (int trial = 0; trial < 40; ++trial) {
       const auto& arm = arms[static_cast<std::size_t>(trial % 2)];
-      const Eigen::VectorXd placed = random_within(arm.chain, rng);
+      const Eigen::VectorXd placed = test::random_within(arm.chain, rng);
       const std::vector<std::pair<std::string, Eigen::VectorXd>> held{{arm.spec.name, placed}};
       auto hand_at = [&](const Eigen::VectorXd& joints) {
         const Eigen::VectorXd q = body != nullptr

@@ -56,6 +56,26 @@ Board shelf_board() {
   return b;
 }
 
+// The shelf board taken a quarter turn about `axis` (world) off its fitted orientation, the worker
+// at the cell's stance: what the turn tests turn back.
+struct QuarterTurned {
+  Board b;
+  std::vector<Eigen::Matrix3d> symmetries;
+  core::Pose stance;
+  Eigen::Matrix3d target;
+  core::Pose taken;
+};
+
+QuarterTurned quarter_turned(const core::Cell& cell, const Eigen::Vector3d& axis) {
+  QuarterTurned q{shelf_board(), {}, cell.spec().human_stance, Eigen::Matrix3d::Identity(),
+                  core::Pose::Identity()};
+  q.symmetries = core::mesh_symmetries(q.b.spec.mesh);
+  q.target = q.b.spec.target.linear();
+  q.taken = q.b.spec.target;
+  q.taken.linear() = Eigen::AngleAxisd(0.5 * M_PI, axis) * q.target;
+  return q;
+}
+
 // The board at its target and in the stack, laid on its first stable placement, with its human
 // grasps: the inputs evaluate_ergonomics takes (the cell's human at the cell's stance).
 offline::ErgonomicsInputs inputs_of(const Board& b) {
@@ -326,12 +346,8 @@ TEST(Ergonomics, TurnRunsFromTheTakenToTheFittedOrientationAboutTheCentre) {
 // worker's shoulder raises it where one in the lower band does not.
 TEST(Ergonomics, TurnCountsTheStepsWithTheElbowAtOrAboveTheShoulder) {
   const auto cell = test::reference_cell();
-  const Board b = shelf_board();
-  const auto symmetries = core::mesh_symmetries(b.spec.mesh);
-  const core::Pose stance = cell->spec().human_stance;
-  const Eigen::Matrix3d target = b.spec.target.linear();
-  core::Pose taken = b.spec.target;
-  taken.linear() = Eigen::AngleAxisd(0.5 * M_PI, Eigen::Vector3d::UnitX()) * target;
+  const auto [b, symmetries, stance, target, taken] =
+      quarter_turned(*cell, Eigen::Vector3d::UnitX());
   const core::RobotModel& human = cell->human();
   auto elbow_up_by_fk = [&](const offline::Posture& p) {
     std::vector<core::Pose> links;
@@ -375,12 +391,8 @@ TEST(Ergonomics, TurnCountsTheStepsWithTheElbowAtOrAboveTheShoulder) {
 // scored at the clear one.
 TEST(Ergonomics, TurnChecksTheBoardAgainstTheWorkersBody) {
   const auto cell = test::reference_cell();
-  const Board b = shelf_board();
-  const auto symmetries = core::mesh_symmetries(b.spec.mesh);
-  const core::Pose stance = cell->spec().human_stance;
-  const Eigen::Matrix3d target = b.spec.target.linear();
-  core::Pose taken = b.spec.target;
-  taken.linear() = Eigen::AngleAxisd(0.5 * M_PI, Eigen::Vector3d::UnitY()) * target;
+  const auto [b, symmetries, stance, target, taken] =
+      quarter_turned(*cell, Eigen::Vector3d::UnitY());
   const Eigen::Vector3d com = b.analysis.mass_properties.com;
   const offline::ErgonomicsSettings settings;
   // The reference: the board against the torso and the base alone.

@@ -670,7 +670,9 @@ TEST(Handover, AWorkerWithoutANaturalGoalGetsBandCandidatesTurnedFurther) {
     const auto wider = offline::plan_handover_goals(*cell, product(), index, grasps, set, settings);
     hers(wider, maps_only, natural);
     EXPECT_GT(natural, 0);
-    if (name == "back_upper") EXPECT_GT(maps_only, 0);
+    if (name == "back_upper") {
+      EXPECT_GT(maps_only, 0);
+    }
     int beyond = 0;
     for (const auto& c : wider.candidates) {
       const double angle = angle_deg(c, target);

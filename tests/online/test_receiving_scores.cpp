@@ -131,15 +131,6 @@ int expect_scores_follow_fk(const core::Cell& cell, const online::BoardPlan& pla
   return checked;
 }
 
-Eigen::VectorXd random_within(const core::KinematicChain& chain, std::mt19937_64& rng) {
-  Eigen::VectorXd q(chain.dof());
-  for (int i = 0; i < chain.dof(); ++i) {
-    q[i] = std::uniform_real_distribution<double>(chain.lower_limits()[i],
-                                                  chain.upper_limits()[i])(rng);
-  }
-  return q;
-}
-
 }  // namespace
 
 // Random receiving postures of one hand and of two (fixed seed): the reported sub-scores follow
@@ -154,11 +145,11 @@ TEST(ReceivingScores, FollowTheArmAnglesFromForwardKinematics) {
     plan.status = online::BoardPlanStatus::kSolved;
     const auto& first = cell->human_arms()[trial % 2];
     plan.human_arm = first.spec.name;
-    plan.human_joints = random_within(first.chain, rng);
+    plan.human_joints = test::random_within(first.chain, rng);
     if (trial % 3 == 0) {
       const auto& second = cell->human_arms()[(trial + 1) % 2];
       plan.second_human_arm = second.spec.name;
-      plan.second_human_joints = random_within(second.chain, rng);
+      plan.second_human_joints = test::random_within(second.chain, rng);
     }
     SCOPED_TRACE("trial " + std::to_string(trial));
     checked += expect_scores_follow_fk(*cell, plan, 4.0);

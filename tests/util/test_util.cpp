@@ -77,6 +77,15 @@ std::string read_file(const std::string& path) {
   return buffer.str();
 }
 
+Eigen::VectorXd random_within(const core::KinematicChain& chain, std::mt19937_64& rng) {
+  Eigen::VectorXd q(chain.dof());
+  for (int i = 0; i < chain.dof(); ++i) {
+    q[i] = std::uniform_real_distribution<double>(chain.lower_limits()[i],
+                                                  chain.upper_limits()[i])(rng);
+  }
+  return q;
+}
+
 core::Pose random_pose(std::mt19937_64& rng, double position_range) {
   std::uniform_real_distribution<double> u(-position_range, position_range);
   std::normal_distribution<double> n(0.0, 1.0);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "hila/core/cell.hpp"
+#include "hila/core/kinematic_chain.hpp"
 #include "hila/core/pose.hpp"
 
 namespace hila::test {
@@ -47,6 +48,8 @@ std::string cell_variant(const std::string& dir, const std::string& from, const 
 std::string bracket_product(const std::string& dir);
 
 core::Pose random_pose(std::mt19937_64& rng, double position_range = 1.0);
+// Joints drawn uniformly within the chain's limits.
+Eigen::VectorXd random_within(const core::KinematicChain& chain, std::mt19937_64& rng);
 
 // Runs `fn`, expects core::InputError whose message contains every fragment.
 void expect_input_error(const std::function<void()>& fn,
