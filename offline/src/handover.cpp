@@ -523,13 +523,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     sample_candidates(stage.candidates + (w == 0 ? settings.candidates : settings.body_candidates),
                       draw_eq1, w - 1);
   }
-  // Each worker's natural band (index body + 1) where the part's fitted centre lies outside it.
-  std::vector<std::optional<core::HeightBand>> outside_band(static_cast<std::size_t>(workers));
+  // Each worker's natural band (index body + 1); band candidates at once for a worker outside
+  // whose band the part's fitted centre lies.
+  std::vector<core::HeightBand> band_of;
   for (int w = 0; w < workers; ++w) {
     const core::HeightBand band = core::natural_height_band(
         cell, w == 0 ? nullptr : &comfort.body(w - 1), cell.spec().human_stance);
+    band_of.push_back(band);
     if (settings.natural_candidates > 0 && !band.contains(target_centre.z())) {
-      outside_band[static_cast<std::size_t>(w)] = band;
       sample_candidates(stage.candidates + settings.natural_candidates,
                         draw_in_band(band, w, max_rotation), w - 1);
     }
@@ -1385,14 +1386,15 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     searched = 0;
     search_shared();
   }
-  // A worker outside whose band the part is fitted and none of whose goals the online planner
-  // would find natural for them (BoardPlanner: the goal's centre in their band, their arm reached
-  // as core::reach_hand does from the goal's stored posture, else from zero, upright with RULA at
-  // most natural_max_rula): batches of natural_candidates more in that band, within
-  // natural_max_rotation_deg of the target's orientation, up to max_candidates (a panel too tall
-  // to stand within max_rotation_deg below a short worker's shoulder above the table lies further
-  // over). Last, after every other batch and fallback: they add goals and take none away. They
-  // draw on a budget of max_draws of their own.
+  // A worker none of whose goals the online planner would find natural for them (BoardPlanner:
+  // the goal's centre in their band, their arm reached as core::reach_hand does from the goal's
+  // stored posture, else from zero, upright with RULA at most natural_max_rula): batches of
+  // natural_candidates more in their band, within natural_max_rotation_deg of the target's
+  // orientation, up to max_candidates, until one is. Whether the part is fitted inside their band
+  // or not: a panel too tall to stand within max_rotation_deg below a short worker's shoulder
+  // above the table lies further over; the goals Eq. 1 found for a part fitted in the band may all
+  // be held high (the exchanges that reach them). Last, after every other batch and fallback: they
+  // add goals and take none away. They draw on a budget of max_draws of their own.
   draw_limit = stage.draws + settings.max_draws;
   std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
   // Goals judged not natural for a worker (index body + 1): judged once.
@@ -1433,16 +1435,16 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     wider = false;
     for (int w = 0; w < workers; ++w) {
       const auto wi = static_cast<std::size_t>(w);
-      const auto& band = outside_band[wi];
-      if (!band || wider_for[wi] >= settings.max_candidates) continue;
+      const core::HeightBand& band = band_of[wi];
+      if (settings.natural_candidates <= 0 || wider_for[wi] >= settings.max_candidates) continue;
       bool has_natural_goal = false;
       for (int ci = 0; ci < static_cast<int>(result.candidates.size()) && !has_natural_goal; ++ci) {
-        has_natural_goal = natural_for(ci, w, *band);
+        has_natural_goal = natural_for(ci, w, band);
       }
       if (has_natural_goal) continue;
       const int batch =
           std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
-      sample_candidates(stage.candidates + batch, draw_in_band(*band, w, natural_max_rotation),
+      sample_candidates(stage.candidates + batch, draw_in_band(band, w, natural_max_rotation),
                         w - 1);
       wider_for[wi] += batch;
       wider = true;

@@ -29,12 +29,13 @@ struct HandoverSettings {
   // worker takes with the elbow low and the part in front of the chest, which the online planner
   // tries first (BoardPlanSettings::natural_posture_first). 0: Eq. 1's candidates only.
   int natural_candidates = 200;
-  // A worker whose band the first natural_candidates (within max_rotation_deg) give no goal they
-  // take in a natural posture gets batches of natural_candidates more within this of the target's
-  // orientation (deg), up to max_candidates, until they have one: a part too tall to stand within
-  // 45 degrees of its fitted orientation below a short worker's shoulder above the table (the
+  // A worker none of whose goals is natural for them (natural_max_rula), after every other batch,
+  // gets batches of natural_candidates more in their band within this of the target's
+  // orientation (deg), up to max_candidates, until one is: a part too tall to stand within 45
+  // degrees of its fitted orientation below a short worker's shoulder above the table (the
   // cabinet's 700 mm laterals for a 1.50 m woman) is presented lying further over, and the worker
-  // has more to turn. Equal to max_rotation_deg: no wider batches.
+  // has more to turn; a part whose goals all came out held high is presented lower. Equal to
+  // max_rotation_deg: no wider batches.
   double natural_max_rotation_deg = 90.0;
   // A natural posture, as the online planner judges it (BoardPlanSettings::natural_max_rula,
   // core::PostureCheck::natural): the worker's arm IK at the goal's grasps upright (no forward
