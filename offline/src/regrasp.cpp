@@ -767,7 +767,13 @@ RegraspResult plan_regrasp(const core::Cell& cell, const core::ProductSpec& prod
     }
     suction.workspace.release();
     if (ends.empty()) ends.push_back(d.joints_rh);
-    if (transfer.connected) std::swap(ends.front(), ends[chosen]);
+    if (transfer.connected) {
+      std::swap(ends.front(), ends[chosen]);
+      // The path starts at the pick, below the lift (as the exchanges' transfers).
+      transfer.path.insert(transfer.path.begin(),
+                           result.nodes[static_cast<std::size_t>(pick.node)].solutions.front());
+      transfer.cost = path_length(transfer.path);
+    }
     const int node = add_node("human_handover", settings.suction_arm, "suction", d.suction_grasp_id,
                               -1, d.candidate_id, candidate.board, ends);
     add_edge("transfer", settings.suction_arm, pick.node, node, pick.filter, transfer);

@@ -81,6 +81,8 @@ void expect_plan_well_formed(const online::PlannerModel& model, const online::Sc
       plan.mode == online::DeliveryMode::kExchange
           ? std::vector<std::string>{"suction_on", "gripper_close", "suction_off", "wait_for_human",
                                      "gripper_open"}
+      : plan.mode == online::DeliveryMode::kSuction  // presented on the cup
+          ? std::vector<std::string>{"suction_on", "wait_for_human", "suction_off"}
           : std::vector<std::string>{"gripper_close", "wait_for_human", "gripper_open"};
   std::size_t from = 0;
   for (const auto& e : order) {

@@ -318,7 +318,9 @@ TEST(Cli, BuildThenInspectSummaryGraspsAndDigest) {
     if (!b["hila"]["scored"].get<bool>()) continue;
     ++planned;
     EXPECT_FALSE(b["hila"]["bent_forward"].get<bool>()) << b["board"];
-    EXPECT_LT(b["hila"]["reorientation_deg"].get<double>(), 45.0);
+    // Eq. 1's goals within 45 degrees of fitted, the band's within natural_max_rotation_deg
+    // (HandoverSettings, default 90).
+    EXPECT_LE(b["hila"]["reorientation_deg"].get<double>(), 90.0 + 1e-6);
   }
   EXPECT_GT(planned, 0);
   EXPECT_GT(alone_bent, 0);
