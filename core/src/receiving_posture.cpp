@@ -27,8 +27,8 @@ std::vector<std::string> arm_names(
 void check_configuration(const RobotModel& human, const Eigen::VectorXd& q) {
   if (q.size() != human.num_variables() || !q.allFinite()) {
     throw InputError("receiving posture", "human configuration",
-                           std::to_string(human.num_variables()) + " finite values",
-                           std::to_string(q.size()) + (q.allFinite() ? "" : " (not finite)"));
+                     std::to_string(human.num_variables()) + " finite values",
+                     std::to_string(q.size()) + (q.allFinite() ? "" : " (not finite)"));
   }
 }
 
@@ -80,9 +80,9 @@ ReceivingScores receiving_scores(const Cell& cell, const HumanBody* body,
                           arms.size() > 1);
 }
 
-ReceivingScores receiving_scores(const Cell& cell, const HumanBody* body,
-                                 const Eigen::VectorXd& q, const std::vector<std::string>& arms,
-                                 double load_kg, bool two_hands) {
+ReceivingScores receiving_scores(const Cell& cell, const HumanBody* body, const Eigen::VectorXd& q,
+                                 const std::vector<std::string>& arms, double load_kg,
+                                 bool two_hands) {
   ReceivingScores r;
   if (arms.empty()) return r;
   const RobotModel& human = body != nullptr ? body->model() : cell.human();
@@ -122,17 +122,15 @@ PostureCheck check_receiving_posture(
                                  part_centre, load_kg, arms.size() > 1);
 }
 
-PostureCheck check_receiving_posture(const Cell& cell, const HumanBody* body,
-                                     const Pose& stance, const Eigen::VectorXd& q,
-                                     const std::vector<std::string>& arms,
+PostureCheck check_receiving_posture(const Cell& cell, const HumanBody* body, const Pose& stance,
+                                     const Eigen::VectorXd& q, const std::vector<std::string>& arms,
                                      const Eigen::Vector3d& part_centre, double load_kg,
                                      bool two_hands) {
   PostureCheck c;
   c.part_centre_z = part_centre.z();
   if (arms.empty()) return c;
   const RobotModel& human = body != nullptr ? body->model() : cell.human();
-  const std::vector<HumanArm>& human_arms =
-      body != nullptr ? body->arms() : cell.human_arms();
+  const std::vector<HumanArm>& human_arms = body != nullptr ? body->arms() : cell.human_arms();
   check_configuration(human, q);
   std::vector<Pose> links;
   human.link_poses(q, links);
@@ -144,8 +142,7 @@ PostureCheck check_receiving_posture(const Cell& cell, const HumanBody* body,
     if (arm == human_arms.end()) {
       std::string names;
       for (const auto& h : human_arms) names += (names.empty() ? "" : ", ") + h.spec.name;
-      throw InputError("receiving posture", "human arms", "one of: " + names,
-                             "'" + name + "'");
+      throw InputError("receiving posture", "human arms", "one of: " + names, "'" + name + "'");
     }
     const Pose base =
         stance * links[static_cast<std::size_t>(human.link_index(arm->spec.base_link))];

@@ -1408,8 +1408,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     const core::HumanBody* body = w == 0 ? nullptr : &comfort.body(w - 1);
     std::vector<std::pair<std::string, Eigen::VectorXd>> held;
     // The cell's human at a goal that stores the posture: the planner takes it as stored.
-    if (w == 0 && c.human_joints.size() > 0 &&
-        (h.second_grasp < 0 || c.second_joints.size() > 0)) {
+    if (w == 0 && c.human_joints.size() > 0 && (h.second_grasp < 0 || c.second_joints.size() > 0)) {
       held.emplace_back(comfort.arm_name(h.arm), c.human_joints);
       if (h.second_grasp >= 0) held.emplace_back(comfort.arm_name(h.second_arm), c.second_joints);
     } else {
@@ -1417,9 +1416,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
            {std::tuple{h.arm, h.grasp, &c.human_joints},
             std::tuple{h.second_arm, h.second_grasp, &c.second_joints}}) {
         if (grasp < 0) continue;
-        const core::ComfortResult r = core::reach_hand(
-            cell, body, cell.spec().human_stance, comfort.arm_name(arm),
-            c.board * grasps.human[static_cast<std::size_t>(grasp)].hand, *seed);
+        const core::ComfortResult r =
+            core::reach_hand(cell, body, cell.spec().human_stance, comfort.arm_name(arm),
+                             c.board * grasps.human[static_cast<std::size_t>(grasp)].hand, *seed);
         if (!r.reachable) break;
         held.emplace_back(comfort.arm_name(arm), r.joints);
       }

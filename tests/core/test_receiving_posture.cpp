@@ -92,8 +92,8 @@ TEST(ReceivingPosture, AWholeConfigurationIsScoredAsItIs) {
     EXPECT_EQ(whole.rula().grand, joints.rula().grand);
     EXPECT_EQ(whole.reba().reba, joints.reba().reba);
     const auto upright = core::check_receiving_posture(*cell, &body, stance, arms, centre, 3.0);
-    const auto same = core::check_receiving_posture(*cell, &body, stance, q, {arm.spec.name},
-                                                      centre, 3.0, false);
+    const auto same =
+        core::check_receiving_posture(*cell, &body, stance, q, {arm.spec.name}, centre, 3.0, false);
     EXPECT_EQ(same.shoulder_z, upright.shoulder_z);
     EXPECT_EQ(same.elbow_below_shoulder, upright.elbow_below_shoulder);
     EXPECT_EQ(same.rula_grand, upright.rula_grand);
@@ -106,8 +106,8 @@ TEST(ReceivingPosture, AWholeConfigurationIsScoredAsItIs) {
     EXPECT_EQ(bent.hands[0].reba.trunk, 3);
     EXPECT_DOUBLE_EQ(bent.hands[0].rula_inputs.load_kg, 1.5);
     EXPECT_DOUBLE_EQ(bent.hands[0].reba_inputs.load_kg, 3.0);
-    const auto check = core::check_receiving_posture(*cell, &body, stance, q, {arm.spec.name},
-                                                       centre, 3.0, true);
+    const auto check =
+        core::check_receiving_posture(*cell, &body, stance, q, {arm.spec.name}, centre, 3.0, true);
     EXPECT_NEAR(check.trunk_flexion_deg, 30.0, 1e-9);
     EXPECT_EQ(check.rula_grand, bent.rula().grand);
     EXPECT_NEAR(check.hip_z, upright.hip_z, 1e-12);
@@ -120,14 +120,13 @@ TEST(ReceivingPosture, AWholeConfigurationIsScoredAsItIs) {
   }
   test::expect_input_error(
       [&] {
-        core::receiving_scores(*cell, &body, Eigen::VectorXd::Zero(3), {arm.spec.name}, 1.0,
-                                 false);
+        core::receiving_scores(*cell, &body, Eigen::VectorXd::Zero(3), {arm.spec.name}, 1.0, false);
       },
       {"human configuration", "finite values", "got 3"});
   test::expect_input_error(
       [&] {
-        core::check_receiving_posture(*cell, &body, stance, body.neutral(), {"middle"}, centre,
-                                        1.0, false);
+        core::check_receiving_posture(*cell, &body, stance, body.neutral(), {"middle"}, centre, 1.0,
+                                      false);
       },
       {"'middle'", "left"});
 }
@@ -158,8 +157,8 @@ TEST(ReceivingPosture, AReachedHandIsWhereItWasAsked) {
                                       : core::human_posture(*cell, {{arm.spec.name, joints}});
         std::vector<core::Pose> links;
         human.link_poses(q, links);
-        return core::Pose(stance * links[static_cast<std::size_t>(
-                                       human.link_index(arm.spec.tip_link))]);
+        return core::Pose(stance *
+                          links[static_cast<std::size_t>(human.link_index(arm.spec.tip_link))]);
       };
       const core::Pose hand = hand_at(placed);
       const core::ComfortResult r =

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <map>
 
-#include "hila/core/human_body.hpp"
 #include "hila/core/collision.hpp"
+#include "hila/core/human_body.hpp"
 #include "hila/core/mesh_symmetry.hpp"
 #include "hila/core/pose.hpp"
 #include "hila/core/product.hpp"
@@ -67,7 +67,10 @@ struct QuarterTurned {
 };
 
 QuarterTurned quarter_turned(const core::Cell& cell, const Eigen::Vector3d& axis) {
-  QuarterTurned q{shelf_board(), {}, cell.spec().human_stance, Eigen::Matrix3d::Identity(),
+  QuarterTurned q{shelf_board(),
+                  {},
+                  cell.spec().human_stance,
+                  Eigen::Matrix3d::Identity(),
                   core::Pose::Identity()};
   q.symmetries = core::mesh_symmetries(q.b.spec.mesh);
   q.target = q.b.spec.target.linear();
@@ -419,9 +422,9 @@ TEST(Ergonomics, TurnChecksTheBoardAgainstTheWorkersBody) {
     offline::TurnSettings turn;
     turn.band_fractions = {0.6};
     turn.distances = {distance};
-    const offline::Turn t = offline::turn_in_hands(*cell, comfort(), stance, taken, target,
-                                                   symmetries, com, &b.spec.mesh, b.grasps,
-                                                   b.one_hand, settings, turn);
+    const offline::Turn t =
+        offline::turn_in_hands(*cell, comfort(), stance, taken, target, symmetries, com,
+                               &b.spec.mesh, b.grasps, b.one_hand, settings, turn);
     ASSERT_EQ(t.blocked.size(), t.postures.size());
     int by_reference = 0;
     for (std::size_t k = 0; k < t.postures.size(); ++k) {
@@ -434,9 +437,9 @@ TEST(Ergonomics, TurnChecksTheBoardAgainstTheWorkersBody) {
     EXPECT_EQ(t.feasible(), t.reachable && by_reference == 0);
     blocked[distance] = t.blocked_steps;
     if (distance < 0.5) {
-      const offline::Turn unchecked = offline::turn_in_hands(
-          *cell, comfort(), stance, taken, target, symmetries, com, nullptr, b.grasps, b.one_hand,
-          settings, turn);
+      const offline::Turn unchecked =
+          offline::turn_in_hands(*cell, comfort(), stance, taken, target, symmetries, com, nullptr,
+                                 b.grasps, b.one_hand, settings, turn);
       EXPECT_EQ(unchecked.blocked_steps, 0);
     }
   }
@@ -446,7 +449,7 @@ TEST(Ergonomics, TurnChecksTheBoardAgainstTheWorkersBody) {
   both.band_fractions = {0.6};
   both.distances = {0.12, 0.60};
   const offline::Turn chosen =
-      offline::turn_in_hands(*cell, comfort(), stance, taken, target, symmetries, com,
-                             &b.spec.mesh, b.grasps, b.one_hand, settings, both);
+      offline::turn_in_hands(*cell, comfort(), stance, taken, target, symmetries, com, &b.spec.mesh,
+                             b.grasps, b.one_hand, settings, both);
   EXPECT_NEAR((chosen.point - stance.translation()).head<2>().norm(), 0.60, 1e-12);
 }

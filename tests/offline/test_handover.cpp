@@ -657,9 +657,9 @@ TEST(Handover, AWorkerWithoutANaturalGoalGetsBandCandidatesTurnedFurther) {
              {std::tuple{c.human_arm, c.human_grasp_id, c.human_joints},
               std::tuple{c.second_arm, c.second_grasp_id, c.second_joints}}) {
           if (arm.empty()) continue;
-          const auto reached = core::reach_hand(
-              *cell, &her, stance, arm,
-              c.board * grasps.human[static_cast<std::size_t>(grasp)].hand, seed);
+          const auto reached =
+              core::reach_hand(*cell, &her, stance, arm,
+                               c.board * grasps.human[static_cast<std::size_t>(grasp)].hand, seed);
           if (reached.reachable) held.emplace_back(arm, reached.joints);
         }
         const bool is_natural =

@@ -221,19 +221,17 @@ WorkerPostures worker_postures(const ErgonomicsContext& context, const ReportWor
     for (std::size_t k = 0; k < records.size(); ++k) {
       TakenPosture& t = row.by_method[records[k].method];
       if (t.scored) {
-        t.turn =
-            offline::turn_in_hands(cell, *context.comfort, scene.human_stance, postures[k].board,
-                                   in.target.linear(), in.symmetries, record.mass_properties.com,
-                                   &part.mesh, grasps, usable, settings, offline::TurnSettings{},
-                                   body);
+        t.turn = offline::turn_in_hands(cell, *context.comfort, scene.human_stance,
+                                        postures[k].board, in.target.linear(), in.symmetries,
+                                        record.mass_properties.com, &part.mesh, grasps, usable,
+                                        settings, offline::TurnSettings{}, body);
       }
     }
     if (TakenPosture& t = row.by_method["hila"]; t.scored) {
-      t.turn =
-          offline::turn_in_hands(cell, *context.comfort, scene.human_stance, handed_over.at(name),
-                                 in.target.linear(), in.symmetries, record.mass_properties.com,
-                                 &part.mesh, grasps, usable, settings, offline::TurnSettings{},
-                                 body);
+      t.turn = offline::turn_in_hands(cell, *context.comfort, scene.human_stance,
+                                      handed_over.at(name), in.target.linear(), in.symmetries,
+                                      record.mass_properties.com, &part.mesh, grasps, usable,
+                                      settings, offline::TurnSettings{}, body);
     }
     out.boards.push_back(std::move(row));
   }

@@ -65,9 +65,9 @@ ReceivingScores receiving_scores(const Cell& cell, const HumanBody* body,
 // e.g. with the torso bent forward: the hands `arms` (human arm names) scored there. `two_hands`:
 // the load is shared by two hands even where `arms` names one (a part held with both hands whose
 // one hand's posture stands for both); with two arms it is shared anyway.
-ReceivingScores receiving_scores(const Cell& cell, const HumanBody* body,
-                                 const Eigen::VectorXd& q, const std::vector<std::string>& arms,
-                                 double load_kg, bool two_hands);
+ReceivingScores receiving_scores(const Cell& cell, const HumanBody* body, const Eigen::VectorXd& q,
+                                 const std::vector<std::string>& arms, double load_kg,
+                                 bool two_hands);
 
 // Where a receiving posture puts the worker (docs/online.md, "Goals a person would choose"):
 // the torso's forward bend, whether every receiving elbow is below its shoulder, and the part's
@@ -83,8 +83,8 @@ struct PostureCheck {
   // No forward bend (within kNeutralBandDeg), the elbows below the shoulders, the centre
   // between hip and shoulder height.
   bool upright() const {
-    return trunk_flexion_deg <= kNeutralBandDeg && elbow_below_shoulder &&
-           part_centre_z >= hip_z && part_centre_z <= shoulder_z;
+    return trunk_flexion_deg <= kNeutralBandDeg && elbow_below_shoulder && part_centre_z >= hip_z &&
+           part_centre_z <= shoulder_z;
   }
   // Upright, and RULA grand at most `max_rula`.
   bool natural(int max_rula) const { return upright() && rula_grand <= max_rula; }
@@ -94,9 +94,8 @@ PostureCheck check_receiving_posture(
     const std::vector<std::pair<std::string, Eigen::VectorXd>>& arms,
     const Eigen::Vector3d& part_centre, double load_kg);
 // The same at a whole configuration `q` (receiving_scores above: `arms` by name, `two_hands`).
-PostureCheck check_receiving_posture(const Cell& cell, const HumanBody* body,
-                                     const Pose& stance, const Eigen::VectorXd& q,
-                                     const std::vector<std::string>& arms,
+PostureCheck check_receiving_posture(const Cell& cell, const HumanBody* body, const Pose& stance,
+                                     const Eigen::VectorXd& q, const std::vector<std::string>& arms,
                                      const Eigen::Vector3d& part_centre, double load_kg,
                                      bool two_hands);
 
