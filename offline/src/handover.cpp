@@ -34,6 +34,8 @@ constexpr std::size_t kReachCensus = 200;
 constexpr double kHandOpeningMargin = 0.01;
 // m: a natural band's candidates keep the part's centre this far inside the band's ends.
 constexpr double kBandMargin = 0.03;
+// Grasps per arm, best first by the maps' Q, judged for a natural posture by the worker's IK.
+constexpr int kNaturalGrasps = 24;
 const Eigen::Vector3d kDown(0.0, 0.0, -1.0);
 
 double uniform01(std::mt19937_64& rng) {
@@ -360,6 +362,25 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     }
   };
 
+  // Candidate c takes the human's choice h (its grasps, each hand's Q and the worker set's).
+  auto set_human = [&](db::HandoverCandidateRecord& c, const HumanChoice& h) {
+    c.human_arm.clear();
+    c.human_grasp_id = -1;
+    c.second_arm.clear();
+    c.second_grasp_id = -1;
+    if (h.grasp >= 0) {
+      c.human_arm = comfort.arm_name(h.arm);
+      c.human_grasp_id = h.grasp;
+      c.human_quality = h.arm_quality;
+    }
+    if (h.second_grasp >= 0) {
+      c.second_arm = comfort.arm_name(h.second_arm);
+      c.second_grasp_id = h.second_grasp;
+      c.second_quality = h.second_quality;
+    }
+    if (comfort.body_count() > 0) record_worker_set(c, h);
+  };
+
   // --- Eq. 1 candidates and S ----------------------------------------------------------------
   // The cell human's Eq. 1 candidates and the robot-robot search draw from `rng`; each body of a
   // worker set and each natural band from a stream of its own, so that adding a worker or a band
@@ -383,6 +404,66 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   double best_q = 0.0;
   // S's threshold: comfort_threshold, lowered towards comfort_floor for a part with no goal.
   double threshold = settings.comfort_threshold;
+  // The human's grasps as worker `choosing_for` takes the part at `board` naturally, as the
+  // online planner judges it (core::reach_hand from zero; core::check_receiving_posture natural
+  // at natural_max_rula): of the grasps the maps rank first per arm (kNaturalGrasps, clear of
+  // the cell, the maps' Q above `floor`) those whose hand alone is natural, the best by the maps'
+  // Q, one hand where the part allows one, else a pair far enough apart and clear together; no
+  // grasp where none is. A hand's RULA, its elbow and the part's centre do not depend on the
+  // other hand (each carries half the load), so a pair of natural hands is natural. The maps'
+  // best grasps can need a bent wrist or a raised upper arm that the maps' Q (Eq. 4) weighs less
+  // than RULA does.
+  auto choose_natural = [&](const core::Pose& board, double floor) {
+    const core::HumanBody* body = choosing_for < 0 ? nullptr : &comfort.body(choosing_for);
+    const core::Pose& stance = cell.spec().human_stance;
+    const Eigen::Vector3d centre = board * grasps.com;
+    // The hand of `arm` at `grasp` natural alone, carrying `load` kg.
+    auto natural_hand = [&](int arm, int grasp, double load) {
+      const std::string name = comfort.arm_name(arm);
+      const core::ComfortResult r = core::reach_hand(
+          cell, body, stance, name, board * grasps.human[static_cast<std::size_t>(grasp)].hand, {});
+      return r.reachable &&
+             core::check_receiving_posture(cell, body, stance, {{name, r.joints}}, centre, load)
+                 .natural(settings.natural_max_rula);
+    };
+    HumanChoice best;
+    best.body = choosing_for;
+    screen_data.set_body_pose(screen_board, board);
+    const int arms = comfort.arm_count();
+    if (!stage.two_hands) {
+      for (int a = 0; a < arms; ++a) {
+        int tried = 0;
+        for (const auto& s :
+             score_grasps(comfort, choosing_for, a, board, grasps.human, eligible)) {
+          if (s.quality <= std::max(best.quality, floor) || ++tried > kNaturalGrasps) break;
+          if (!human_hand_clear(board, 0, s.grasp) || !natural_hand(a, s.grasp, part.mass)) {
+            continue;
+          }
+          best.quality = best.arm_quality = s.quality;
+          best.default_quality = s.default_quality;
+          best.arm = a;
+          best.grasp = s.grasp;
+        }
+      }
+      park_hand(screen_data, screen_hands[0]);
+    }
+    if (best.grasp < 0 && arms >= 2) {
+      std::vector<ScoredGrasp> lists[2];
+      for (int a = 0; a < 2; ++a) {
+        int tried = 0;
+        for (const auto& s :
+             score_grasps(comfort, choosing_for, a, board, grasps.human, both_hands)) {
+          if (s.quality <= floor || ++tried > kNaturalGrasps) break;
+          if (human_hand_clear(board, a, s.grasp) && natural_hand(a, s.grasp, 0.5 * part.mass)) {
+            lists[a].push_back(s);
+          }
+        }
+      }
+      choose_pair(board, lists, best);
+    }
+    screen_data.set_body_pose(screen_board, kParked);
+    return best;
+  };
   // Eq. 1: within max_rotation of the target's orientation and max_offset of its position.
   auto draw_eq1 = [&](std::mt19937_64& from) {
     core::Pose pose = core::Pose::Identity();
@@ -433,20 +514,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
       c.quality = h.quality;
       best_q = std::max(best_q, h.quality);
       c.status = "uncomfortable";
-      if (h.grasp >= 0) {
-        c.human_arm = comfort.arm_name(h.arm);
-        c.human_grasp_id = h.grasp;
-        c.human_quality = h.arm_quality;
-      } else {
-        c.human_grasp_id = -1;
-      }
-      c.second_grasp_id = -1;
-      if (h.second_grasp >= 0) {
-        c.second_arm = comfort.arm_name(h.second_arm);
-        c.second_grasp_id = h.second_grasp;
-        c.second_quality = h.second_quality;
-      }
-      if (comfort.body_count() > 0) record_worker_set(c, h);
+      set_human(c, h);
       if (h.default_quality > settings.comfort_threshold) ++stage.comfortable_default_body;
       if (h.quality > settings.comfort_threshold) ++stage.comfortable;
       if (h.quality > threshold) c.status = "no_shared_grasp";
@@ -1107,6 +1175,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // any candidate the maps' grasps pass: where it has goals, they are kept as the maps rank them.
   bool rechoose_allowed = false;
   std::vector<int> ik_rejected;  // candidates the human's IK rejected at the maps' grasps
+  // Copies of goals at the grasps a worker takes them naturally at (the wider band batches): in S
+  // down to comfort_floor, a natural posture (RULA) weighing above the maps' Q (Eq. 4) there.
+  std::set<int> natural_copies;
   // `only`: these candidates alone (those still unserved), else those from `searched` on.
   auto search_shared = [&](const std::vector<int>* only = nullptr) {
     std::vector<int> comfortable;
@@ -1281,15 +1352,25 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         if (confirmed < settings.human_ik_goals) {
           // The worker it was drawn for confirms it: a goal for a body other than the cell's
           // human keeps no posture (the online planner solves the worker's own).
+          // A copy at a worker's natural grasps is confirmed at the posture that is natural (as
+          // choose_natural reached it, and the online planner reaches it), not at the best Q.
           const int who = h.body;
-          const core::ComfortResult first = solve_human(c.board, h.arm, h.grasp, who);
+          const bool natural_copy = natural_copies.count(ci) > 0;
+          auto confirm = [&](int arm, int grasp) {
+            if (!natural_copy) return solve_human(c.board, arm, grasp, who);
+            return core::reach_hand(cell, who < 0 ? nullptr : &comfort.body(who),
+                                    cell.spec().human_stance, comfort.arm_name(arm),
+                                    c.board * grasps.human[static_cast<std::size_t>(grasp)].hand,
+                                    {});
+          };
+          const core::ComfortResult first = confirm(h.arm, h.grasp);
           core::ComfortResult second;
-          if (h.second_grasp >= 0) {
-            second = solve_human(c.board, h.second_arm, h.second_grasp, who);
-          }
+          if (h.second_grasp >= 0) second = confirm(h.second_arm, h.second_grasp);
           const double q =
               h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
-          if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) || q <= threshold) {
+          const double floor =
+              natural_copy ? std::min(threshold, settings.comfort_floor) : threshold;
+          if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) || q <= floor) {
             // The ways were found with the human's hands at the maps' grasps: they go.
             std::erase_if(result.shared,
                           [&](const db::SharedGraspRecord& r) { return r.candidate_id == ci; });
@@ -1393,12 +1474,16 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // orientation, up to max_candidates, until one is. Whether the part is fitted inside their band
   // or not: a panel too tall to stand within max_rotation_deg below a short worker's shoulder
   // above the table lies further over; the goals Eq. 1 found for a part fitted in the band may all
-  // be held high (the exchanges that reach them). Last, after every other batch and fallback: they
+  // be held high (the exchanges that reach them). Before each batch, a goal in their band that
+  // they would take naturally at other grasps (choose_natural) gets a copy at those grasps,
+  // searched for its ways as a new candidate. Last, after every other batch and fallback: they
   // add goals and take none away. They draw on a budget of max_draws of their own.
   draw_limit = stage.draws + settings.max_draws;
   std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
   // Goals judged not natural for a worker (index body + 1): judged once.
   std::vector<std::set<int>> not_natural(static_cast<std::size_t>(workers));
+  // Goals whose natural grasps were looked for, per worker (index body + 1).
+  std::vector<std::set<std::size_t>> regrasped(static_cast<std::size_t>(workers));
   auto natural_for = [&](int ci, int w, const core::HeightBand& band) {
     const auto& c = result.candidates[static_cast<std::size_t>(ci)];
     const Eigen::Vector3d centre = c.board * grasps.com;
@@ -1441,6 +1526,39 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
         has_natural_goal = natural_for(ci, w, band);
       }
       if (has_natural_goal) continue;
+      // A goal in their band natural for them at other grasps (choose_natural): a copy of it with
+      // those, searched for its ways as any candidate, before more are drawn.
+      bool copied = false;
+      choosing_for = w - 1;
+      for (std::size_t ci = 0, n = result.candidates.size(); ci < n; ++ci) {
+        const auto& c = result.candidates[ci];
+        if (c.status != "goal" || !band.contains((c.board * grasps.com).z()) ||
+            !regrasped[wi].insert(ci).second) {
+          continue;
+        }
+        const HumanChoice h = choose_natural(c.board, std::min(threshold, settings.comfort_floor));
+        if (h.grasp < 0 ||
+            (h.grasp == choices[ci].grasp && h.second_grasp == choices[ci].second_grasp)) {
+          continue;
+        }
+        db::HandoverCandidateRecord copy;
+        copy.sample = static_cast<int>(result.candidates.size());
+        copy.board = c.board;
+        copy.distance = c.distance;
+        copy.quality = h.quality;
+        copy.status = "no_shared_grasp";
+        set_human(copy, h);
+        natural_copies.insert(static_cast<int>(result.candidates.size()));
+        result.candidates.push_back(copy);
+        choices.push_back(h);
+        if (threshold == settings.comfort_threshold) ++stage.comfortable;  // in S (its floor)
+        copied = true;
+      }
+      stage.candidates = static_cast<int>(result.candidates.size());
+      if (copied) {
+        wider = true;
+        continue;
+      }
       const int batch =
           std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
       sample_candidates(stage.candidates + batch, draw_in_band(band, w, natural_max_rotation),

@@ -101,8 +101,10 @@ struct HandoverStageRecord {
   std::int64_t part_id = 0;
   std::vector<std::string> finished_parts;  // in assembly order
   int draws = 0;                            // poses drawn to obtain the candidates
-  int candidates = 0;   // poses satisfying Eq. 1 (rotation < 45 deg, offset < 0.5 m, no collision)
-  int comfortable = 0;  // |S|: above the comfort threshold for the worker each was drawn for
+  int candidates = 0;  // poses satisfying Eq. 1 (rotation < 45 deg, offset < 0.5 m, no collision)
+  // |S|: above the comfort threshold for the worker each was drawn for (a goal's copy at the
+  // grasps a worker takes it naturally at: above comfort_floor; docs/handover.md)
+  int comfortable = 0;
   // Candidates the cell's own human takes above the threshold (at the grasps chosen for the
   // worker each was drawn for): without a body set, |S| before the human's IK confirmed any.
   int comfortable_default_body = 0;
