@@ -1175,9 +1175,9 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // any candidate the maps' grasps pass: where it has goals, they are kept as the maps rank them.
   bool rechoose_allowed = false;
   std::vector<int> ik_rejected;  // candidates the human's IK rejected at the maps' grasps
-  // Copies of goals at the grasps a worker takes them naturally at (the wider band batches): in S
-  // down to comfort_floor, a natural posture (RULA) weighing above the maps' Q (Eq. 4) there.
-  std::set<int> natural_copies;
+  // Copies of goals at the grasps a worker takes them naturally at (after the wider band
+  // batches' natural check): in S down to the floor each was chosen at.
+  std::map<int, double> natural_copies;  // candidate index: the floor of its Q
   // `only`: these candidates alone (those still unserved), else those from `searched` on.
   auto search_shared = [&](const std::vector<int>* only = nullptr) {
     std::vector<int> comfortable;
@@ -1355,7 +1355,8 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
           // A copy at a worker's natural grasps is confirmed at the posture that is natural (as
           // choose_natural reached it, and the online planner reaches it), not at the best Q.
           const int who = h.body;
-          const bool natural_copy = natural_copies.count(ci) > 0;
+          const auto copy_floor = natural_copies.find(ci);
+          const bool natural_copy = copy_floor != natural_copies.end();
           auto confirm = [&](int arm, int grasp) {
             if (!natural_copy) return solve_human(c.board, arm, grasp, who);
             return core::reach_hand(cell, who < 0 ? nullptr : &comfort.body(who),
@@ -1368,8 +1369,7 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
           if (h.second_grasp >= 0) second = confirm(h.second_arm, h.second_grasp);
           const double q =
               h.second_grasp >= 0 ? std::min(first.quality, second.quality) : first.quality;
-          const double floor =
-              natural_copy ? std::min(threshold, settings.comfort_floor) : threshold;
+          const double floor = natural_copy ? copy_floor->second : threshold;
           if (!first.reachable || (h.second_grasp >= 0 && !second.reachable) || q <= floor) {
             // The ways were found with the human's hands at the maps' grasps: they go.
             std::erase_if(result.shared,
@@ -1475,15 +1475,14 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
   // or not: a panel too tall to stand within max_rotation_deg below a short worker's shoulder
   // above the table lies further over; the goals Eq. 1 found for a part fitted in the band may all
   // be held high (the exchanges that reach them). Before each batch, a goal in their band that
-  // they would take naturally at other grasps (choose_natural) gets a copy at those grasps,
-  // searched for its ways as a new candidate. Last, after every other batch and fallback: they
-  // add goals and take none away. They draw on a budget of max_draws of their own.
+  // they would take naturally at other grasps (choose_natural) with a Q in S gets a copy at those
+  // grasps; after the batches, one with a Q down to comfort_floor. Last, after every other batch
+  // and fallback: they add goals and take none away. They draw on a budget of max_draws of their
+  // own.
   draw_limit = stage.draws + settings.max_draws;
   std::vector<int> wider_for(static_cast<std::size_t>(workers), 0);
   // Goals judged not natural for a worker (index body + 1): judged once.
   std::vector<std::set<int>> not_natural(static_cast<std::size_t>(workers));
-  // Goals whose natural grasps were looked for, per worker (index body + 1).
-  std::vector<std::set<std::size_t>> regrasped(static_cast<std::size_t>(workers));
   auto natural_for = [&](int ci, int w, const core::HeightBand& band) {
     const auto& c = result.candidates[static_cast<std::size_t>(ci)];
     const Eigen::Vector3d centre = c.board * grasps.com;
@@ -1515,58 +1514,81 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
     if (!natural) not_natural[static_cast<std::size_t>(w)].insert(ci);
     return natural;
   };
-  for (bool wider = natural_max_rotation > max_rotation; wider && stage.draws < draw_limit;) {
+  auto has_natural_goal = [&](int w) {
+    for (int ci = 0; ci < static_cast<int>(result.candidates.size()); ++ci) {
+      if (natural_for(ci, w, band_of[static_cast<std::size_t>(w)])) return true;
+    }
+    return false;
+  };
+  // Copies for worker w of the goals in their band (those not yet in `looked_at`) that they take
+  // naturally at other grasps (choose_natural, the maps' Q above `floor`), searched for their
+  // ways as new candidates: true when one was made.
+  auto copy_natural = [&](int w, double floor, std::set<std::size_t>& looked_at) {
+    const core::HeightBand& band = band_of[static_cast<std::size_t>(w)];
+    bool copied = false;
+    choosing_for = w - 1;
+    for (std::size_t ci = 0, n = result.candidates.size(); ci < n; ++ci) {
+      const auto& c = result.candidates[ci];
+      if (c.status != "goal" || !band.contains((c.board * grasps.com).z()) ||
+          !looked_at.insert(ci).second) {
+        continue;
+      }
+      const HumanChoice h = choose_natural(c.board, floor);
+      if (h.grasp < 0 ||
+          (h.grasp == choices[ci].grasp && h.second_grasp == choices[ci].second_grasp)) {
+        continue;
+      }
+      db::HandoverCandidateRecord copy;
+      copy.sample = static_cast<int>(result.candidates.size());
+      copy.board = c.board;
+      copy.distance = c.distance;
+      copy.quality = h.quality;
+      copy.status = "no_shared_grasp";
+      set_human(copy, h);
+      natural_copies[copy.sample] = floor;
+      result.candidates.push_back(copy);
+      choices.push_back(h);
+      if (threshold == settings.comfort_threshold) ++stage.comfortable;  // in S (at its floor)
+      copied = true;
+    }
+    stage.candidates = static_cast<int>(result.candidates.size());
+    return copied;
+  };
+  // Per worker (index body + 1): the goals looked at for copies above the threshold, and below.
+  std::vector<std::set<std::size_t>> copied_above(static_cast<std::size_t>(workers));
+  std::vector<std::set<std::size_t>> copied_below(static_cast<std::size_t>(workers));
+  for (bool wider = settings.natural_candidates > 0; wider && stage.draws < draw_limit;) {
     wider = false;
     for (int w = 0; w < workers; ++w) {
       const auto wi = static_cast<std::size_t>(w);
-      const core::HeightBand& band = band_of[wi];
-      if (settings.natural_candidates <= 0 || wider_for[wi] >= settings.max_candidates) continue;
-      bool has_natural_goal = false;
-      for (int ci = 0; ci < static_cast<int>(result.candidates.size()) && !has_natural_goal; ++ci) {
-        has_natural_goal = natural_for(ci, w, band);
-      }
-      if (has_natural_goal) continue;
-      // A goal in their band natural for them at other grasps (choose_natural): a copy of it with
-      // those, searched for its ways as any candidate, before more are drawn.
-      bool copied = false;
-      choosing_for = w - 1;
-      for (std::size_t ci = 0, n = result.candidates.size(); ci < n; ++ci) {
-        const auto& c = result.candidates[ci];
-        if (c.status != "goal" || !band.contains((c.board * grasps.com).z()) ||
-            !regrasped[wi].insert(ci).second) {
-          continue;
-        }
-        const HumanChoice h = choose_natural(c.board, std::min(threshold, settings.comfort_floor));
-        if (h.grasp < 0 ||
-            (h.grasp == choices[ci].grasp && h.second_grasp == choices[ci].second_grasp)) {
-          continue;
-        }
-        db::HandoverCandidateRecord copy;
-        copy.sample = static_cast<int>(result.candidates.size());
-        copy.board = c.board;
-        copy.distance = c.distance;
-        copy.quality = h.quality;
-        copy.status = "no_shared_grasp";
-        set_human(copy, h);
-        natural_copies.insert(static_cast<int>(result.candidates.size()));
-        result.candidates.push_back(copy);
-        choices.push_back(h);
-        if (threshold == settings.comfort_threshold) ++stage.comfortable;  // in S (its floor)
-        copied = true;
-      }
-      stage.candidates = static_cast<int>(result.candidates.size());
-      if (copied) {
+      if (has_natural_goal(w)) continue;
+      // Copies in S first, before more are drawn.
+      if (copy_natural(w, threshold, copied_above[wi])) {
         wider = true;
+        continue;
+      }
+      if (natural_max_rotation <= max_rotation || wider_for[wi] >= settings.max_candidates) {
         continue;
       }
       const int batch =
           std::min(settings.natural_candidates, settings.max_candidates - wider_for[wi]);
-      sample_candidates(stage.candidates + batch, draw_in_band(band, w, natural_max_rotation),
-                        w - 1);
+      sample_candidates(stage.candidates + batch,
+                        draw_in_band(band_of[wi], w, natural_max_rotation), w - 1);
       wider_for[wi] += batch;
       wider = true;
     }
     if (wider) search_shared();
+  }
+  // Last, for a worker the batches found no natural goal for: copies below the threshold, down
+  // to comfort_floor (a natural posture, by RULA, weighing above Eq. 4's Q there).
+  if (settings.natural_candidates > 0 && settings.comfort_floor < threshold) {
+    bool copied = false;
+    for (int w = 0; w < workers; ++w) {
+      if (has_natural_goal(w)) continue;
+      copied = copy_natural(w, settings.comfort_floor, copied_below[static_cast<std::size_t>(w)]) ||
+               copied;
+    }
+    if (copied) search_shared();
   }
   // Eq. 8 ranks over every batch.
   std::vector<db::HandoverCandidateRecord*> goals;
