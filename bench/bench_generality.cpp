@@ -61,6 +61,7 @@
 #include "hila/offline/build.hpp"
 #include "hila/online/board_planner.hpp"
 #include "hila/online/planner_model.hpp"
+#include "hila/online/receiving_scores.hpp"
 #include "hila/online/scene.hpp"
 #include "hila/online/world.hpp"
 #include "plan_check.hpp"
@@ -306,6 +307,8 @@ struct PartResult {
   std::string delivering_arm;
   double quality = 0.0;            // the human's comfort Q at the goal delivered to (paper Eq. 4)
   int goal_rank = -1;              // its Eq. 8 rank
+  bool natural_posture = false;    // the receiving posture natural (BoardPlan::natural_posture)
+  int rula = 0;                    // its RULA grand score (the worse hand's; 0: not scored)
   std::int64_t candidate_id = 0;   // handover_candidates.id of that goal
   double estimated_seconds = 0.0;  // the chosen way's estimated robot time
   int motions_planned = 0;         // BoardPlan::motions_planned (every attempt's)
@@ -378,6 +381,9 @@ PartResult plan_part(online::BoardPlanner& planner, const online::PlannerModel& 
     r.way = online::to_string(plan.mode);
     r.quality = plan.quality;
     r.goal_rank = plan.goal_rank;
+    r.natural_posture = plan.natural_posture;
+    const online::ReceivingScores scores = online::receiving_scores(model.cell(), plan, part.mass);
+    r.rula = scores.scored ? scores.rula().grand : 0;
     r.candidate_id = plan.candidate_id;
     r.estimated_seconds = plan.estimated_seconds;
     r.delivering_arm = plan.delivering_arm;
@@ -500,6 +506,8 @@ nlohmann::json part_json(const PartResult& r) {
     j["delivering_arm"] = r.delivering_arm;
     j["quality"] = r.quality;
     j["goal_rank"] = r.goal_rank;
+    j["natural_posture"] = r.natural_posture;
+    j["rula"] = r.rula;
     j["candidate"] = r.candidate_id;
     j["estimated_s"] = r.estimated_seconds;
   } else {
@@ -700,6 +708,7 @@ int run_products(const Options& opt) {
   // Delivered at a goal below the build's comfort threshold (HandoverSettings::comfort_floor).
   const double threshold = offline::HandoverSettings{}.comfort_threshold;
   int below_threshold = 0;
+  int natural = 0, rula_low = 0;  // delivered with a natural posture; with RULA <= 3
   std::map<std::string, std::pair<int, int>> by_kind;  // delivered, parts
   for (const auto& pr : results) {
     if (!pr.error.empty()) ++errors;
@@ -712,6 +721,8 @@ int run_products(const Options& opt) {
       if (p.delivered) {
         plan_s.push_back(p.plan_s);
         below_threshold += p.quality <= threshold;
+        natural += p.natural_posture;
+        rula_low += p.rula > 0 && p.rula <= 3;
       } else {
         ++causes[p.cause];
         const Limit limit = limit_of(p);
@@ -772,6 +783,9 @@ int run_products(const Options& opt) {
   std::cout << "\nDelivered below the comfort threshold (Q <= " << fixed(threshold, 2)
             << ", goals from the build's fallback down to its comfort floor): " << below_threshold
             << " of " << delivered << ".\n";
+  std::cout << "\nReceived by the cell's human (online::receiving_scores): a natural posture "
+               "(upright, RULA <= natural_max_rula) "
+            << natural << ", RULA <= 3 " << rula_low << " of " << delivered << ".\n";
   std::cout << "\nWhy parts were not delivered: " << physical << " of " << parts - delivered
             << " physically impossible in this cell, the rest limits of hila's planner.\n\n";
   print_causes(limits);
@@ -825,6 +839,8 @@ int run_products(const Options& opt) {
                       {"errors", errors},
                       {"physical", physical},
                       {"below_comfort_threshold", below_threshold},
+                      {"natural_posture", natural},
+                      {"rula_le_3", rula_low},
                       {"limits", limits},
                       {"causes", causes}};
     out["products"] = nlohmann::json::array();
