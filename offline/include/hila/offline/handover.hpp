@@ -33,7 +33,7 @@ struct HandoverSettings {
   // gets batches of natural_candidates more in their band within this of the target's
   // orientation (deg), up to max_candidates, until one is: a part too tall to stand within 45
   // degrees of its fitted orientation below a short worker's shoulder above the table (the
-  // cabinet's 700 mm laterals for a 1.50 m woman) is presented lying further over, and the worker
+  // cabinet's 587 mm laterals for a 1.50 m woman) is presented lying further over, and the worker
   // has more to turn; a part whose goals all came out held high is presented lower. Equal to
   // max_rotation_deg: no wider batches.
   double natural_max_rotation_deg = 90.0;
