@@ -426,39 +426,42 @@ HandoverResult plan_handover_goals(const core::Cell& cell, const core::ProductSp
              core::check_receiving_posture(cell, body, stance, {{name, r.joints}}, centre, load)
                  .natural(settings.natural_max_rula);
     };
+    // Of `from`, the grasps of `arm` the maps rank first (kNaturalGrasps with Q above `above`)
+    // whose hand, put in screen slot `slot`, is clear and natural carrying `load` kg: up to
+    // `want`, best first.
+    auto natural_grasps = [&](int arm, const std::vector<int>& from, int slot, double load,
+                              double above, std::size_t want) {
+      std::vector<ScoredGrasp> out;
+      int tried = 0;
+      for (const auto& s : score_grasps(comfort, choosing_for, arm, board, grasps.human, from)) {
+        if (out.size() >= want || s.quality <= above || ++tried > kNaturalGrasps) break;
+        if (human_hand_clear(board, slot, s.grasp) && natural_hand(arm, s.grasp, load)) {
+          out.push_back(s);
+        }
+      }
+      park_hand(screen_data, screen_hands[slot]);
+      return out;
+    };
     HumanChoice best;
     best.body = choosing_for;
     screen_data.set_body_pose(screen_board, board);
     const int arms = comfort.arm_count();
-    if (!stage.two_hands) {
+    if (!stage.two_hands) {  // one hand: the best natural grasp of either arm
       for (int a = 0; a < arms; ++a) {
-        int tried = 0;
         for (const auto& s :
-             score_grasps(comfort, choosing_for, a, board, grasps.human, eligible)) {
-          if (s.quality <= std::max(best.quality, floor) || ++tried > kNaturalGrasps) break;
-          if (!human_hand_clear(board, 0, s.grasp) || !natural_hand(a, s.grasp, part.mass)) {
-            continue;
-          }
+             natural_grasps(a, eligible, 0, part.mass, std::max(best.quality, floor), 1)) {
           best.quality = best.arm_quality = s.quality;
           best.default_quality = s.default_quality;
           best.arm = a;
           best.grasp = s.grasp;
         }
       }
-      park_hand(screen_data, screen_hands[0]);
     }
     if (best.grasp < 0 && arms >= 2) {
-      std::vector<ScoredGrasp> lists[2];
-      for (int a = 0; a < 2; ++a) {
-        int tried = 0;
-        for (const auto& s :
-             score_grasps(comfort, choosing_for, a, board, grasps.human, both_hands)) {
-          if (s.quality <= floor || ++tried > kNaturalGrasps) break;
-          if (human_hand_clear(board, a, s.grasp) && natural_hand(a, s.grasp, 0.5 * part.mass)) {
-            lists[a].push_back(s);
-          }
-        }
-      }
+      const auto all = static_cast<std::size_t>(kNaturalGrasps);
+      std::vector<ScoredGrasp> lists[2] = {
+          natural_grasps(0, both_hands, 0, 0.5 * part.mass, floor, all),
+          natural_grasps(1, both_hands, 1, 0.5 * part.mass, floor, all)};
       choose_pair(board, lists, best);
     }
     screen_data.set_body_pose(screen_board, kParked);
